@@ -1,0 +1,45 @@
+# photond: `make demo` renders the built-in Cornell box; `make test` runs every test.
+# Both install the missing Debian packages first (apt-get; skipped when all are present).
+
+BUILD ?= build
+JOBS ?= $(shell nproc)
+SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
+DEBIAN_PACKAGES := cmake g++ make pkg-config libembree-dev libtbb-dev libopenexr-dev libimath-dev \
+	libtinygltf-dev libcpp-httplib-dev nlohmann-json3-dev libglm-dev libpng-dev libgtest-dev \
+	libbenchmark-dev curl
+OUT ?= out
+
+.PHONY: all deps configure build test demo bench clean format
+
+all: build
+
+deps:
+	@missing=$$(for p in $(DEBIAN_PACKAGES); do \
+		dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q '^install ok installed' || echo $$p; \
+	done); \
+	if [ -n "$$missing" ]; then \
+		echo "installing Debian packages:" $$missing; \
+		$(SUDO) apt-get update -qq && \
+		DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends $$missing; \
+	fi
+
+configure: deps
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
+
+build: configure
+	cmake --build $(BUILD) -j$(JOBS)
+
+test: build
+	cd $(BUILD) && ctest --output-on-failure -j$(JOBS)
+
+demo: build
+	./deploy/demo.sh $(BUILD) $(OUT)
+
+bench: build
+	$(BUILD)/bench/ray_throughput_bench
+
+format:
+	find core protocol server clients tests bench -name '*.h' -o -name '*.cpp' | xargs clang-format -i
+
+clean:
+	rm -rf $(BUILD) $(OUT)

@@ -1,0 +1,132 @@
+#include "core/accel/ray_tracer.h"
+
+#include <pmmintrin.h>
+#include <xmmintrin.h>
+
+#include <cstring>
+
+namespace photond {
+
+Expected<std::shared_ptr<EmbreeDevice>> EmbreeDevice::create() {
+    std::shared_ptr<EmbreeDevice> device(new EmbreeDevice());
+    device->device_ = rtcNewDevice(nullptr);
+    if (!device->device_) {
+        return Error{"Embree: could not create a device (error " +
+                     std::to_string(static_cast<int>(rtcGetDeviceError(nullptr))) + ")"};
+    }
+    rtcSetDeviceErrorFunction(device->device_, &EmbreeDevice::on_error, device.get());
+    return device;
+}
+
+EmbreeDevice::~EmbreeDevice() {
+    if (device_) rtcReleaseDevice(device_);
+}
+
+void EmbreeDevice::on_error(void* user, RTCError code, const char* message) {
+    auto* self = static_cast<EmbreeDevice*>(user);
+    std::lock_guard lock(self->error_mutex_);
+    self->last_error_ = "Embree error " + std::to_string(static_cast<int>(code)) + ": " +
+                        (message ? message : "(no message)");
+}
+
+std::string EmbreeDevice::last_error() const {
+    std::lock_guard lock(error_mutex_);
+    return last_error_;
+}
+
+void enable_flush_denormals() {
+    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+}
+
+Expected<std::unique_ptr<RayTracer>> RayTracer::build(std::shared_ptr<EmbreeDevice> device,
+                                                      const Scene& scene) {
+    std::unique_ptr<RayTracer> tracer(new RayTracer());
+    tracer->device_ = device;
+    tracer->scene_ = &scene;
+    tracer->scene_scale_ = scene.bounds.empty() ? 1.0f : std::max(max_component(scene.bounds.extent()), 1e-30f);
+
+    RTCScene rtc_scene = rtcNewScene(device->handle());
+    if (!rtc_scene) return Error{"Embree: could not create a scene: " + device->last_error()};
+    tracer->rtc_scene_ = rtc_scene;
+    rtcSetSceneFlags(rtc_scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(rtc_scene, RTC_BUILD_QUALITY_HIGH);
+
+    if (!scene.triangles.empty()) {
+        RTCGeometry geometry = rtcNewGeometry(device->handle(), RTC_GEOMETRY_TYPE_TRIANGLE);
+        // Embree may read 16 bytes past the last vertex's 12: pad the buffer by one float4.
+        auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+            geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+            scene.positions.size() + 1));
+        auto* indices = static_cast<uint32_t*>(
+            rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                    3 * sizeof(uint32_t), scene.triangles.size()));
+        if (!vertices || !indices) {
+            rtcReleaseGeometry(geometry);
+            return Error{"Embree: could not allocate geometry buffers for " +
+                         std::to_string(scene.triangles.size()) +
+                         " triangles: " + device->last_error()};
+        }
+        std::memcpy(vertices, scene.positions.data(), scene.positions.size() * sizeof(Vec3));
+        std::memset(vertices + 3 * scene.positions.size(), 0, 3 * sizeof(float));
+        std::memcpy(indices, scene.triangles.data(), scene.triangles.size() * sizeof(glm::uvec3));
+        rtcCommitGeometry(geometry);
+        rtcAttachGeometryByID(rtc_scene, geometry, 0);
+        rtcReleaseGeometry(geometry);
+    }
+    rtcCommitScene(rtc_scene);
+    if (rtcGetDeviceError(device->handle()) != RTC_ERROR_NONE) {
+        return Error{"Embree: building the scene '" + scene.name + "' failed: " + device->last_error()};
+    }
+    return tracer;
+}
+
+RayTracer::~RayTracer() {
+    if (rtc_scene_) rtcReleaseScene(rtc_scene_);
+}
+
+std::optional<Hit> RayTracer::intersect(const Ray& ray) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRayHit rayhit;
+    rayhit.ray.org_x = ray.origin.x;
+    rayhit.ray.org_y = ray.origin.y;
+    rayhit.ray.org_z = ray.origin.z;
+    rayhit.ray.dir_x = ray.direction.x;
+    rayhit.ray.dir_y = ray.direction.y;
+    rayhit.ray.dir_z = ray.direction.z;
+    rayhit.ray.tnear = ray.tmin;
+    rayhit.ray.tfar = ray.tmax;
+    rayhit.ray.time = 0.0f;
+    rayhit.ray.mask = 0xFFFFFFFFu;
+    rayhit.ray.id = 0;
+    rayhit.ray.flags = 0;
+    rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rayhit.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(rtc_scene_, &context, &rayhit);
+    if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
+    return Hit{rayhit.ray.tfar, rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v};
+}
+
+bool RayTracer::occluded(const Ray& ray) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRay r;
+    r.org_x = ray.origin.x;
+    r.org_y = ray.origin.y;
+    r.org_z = ray.origin.z;
+    r.dir_x = ray.direction.x;
+    r.dir_y = ray.direction.y;
+    r.dir_z = ray.direction.z;
+    r.tnear = ray.tmin;
+    r.tfar = ray.tmax;
+    r.time = 0.0f;
+    r.mask = 0xFFFFFFFFu;
+    r.id = 0;
+    r.flags = 0;
+    rtcOccluded1(rtc_scene_, &context, &r);
+    return r.tfar < 0.0f;  // Embree sets tfar = -inf on an occluded ray
+}
+
+}  // namespace photond

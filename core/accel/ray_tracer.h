@@ -1,0 +1,98 @@
+// Ray queries against one scene on Embree 3. EmbreeDevice owns the Embree device and its error
+// callback; RayTracer owns one committed RTCScene built from a Scene. Both are immutable after
+// construction and safe to query from any number of threads at once.
+#pragma once
+
+#include <embree3/rtcore.h>
+
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include "core/math/vec.h"
+#include "core/scene/scene.h"
+#include "core/util/expected.h"
+
+namespace photond {
+
+/// RAII Embree device. Errors reported by Embree through its callback are kept and can be read.
+class EmbreeDevice {
+public:
+    static Expected<std::shared_ptr<EmbreeDevice>> create();
+    ~EmbreeDevice();
+    EmbreeDevice(const EmbreeDevice&) = delete;
+    EmbreeDevice& operator=(const EmbreeDevice&) = delete;
+
+    RTCDevice handle() const { return device_; }
+    /// The last error Embree reported (empty if none).
+    std::string last_error() const;
+
+private:
+    EmbreeDevice() = default;
+    static void on_error(void* user, RTCError code, const char* message);
+
+    RTCDevice device_ = nullptr;
+    mutable std::mutex error_mutex_;
+    std::string last_error_;
+};
+
+/// Sets flush-to-zero and denormals-are-zero for the calling thread, as Embree recommends for
+/// every thread that traces rays. Cheap; call it at the start of each parallel task.
+void enable_flush_denormals();
+
+struct Ray {
+    Vec3 origin{0.0f};
+    Vec3 direction{0.0f, 0.0f, 1.0f};  // need not be unit for occlusion, must be for intersect's t
+    float tmin = 0.0f;
+    float tmax = std::numeric_limits<float>::infinity();
+};
+
+struct Hit {
+    float t = 0.0f;
+    uint32_t triangle = 0;
+    float u = 0.0f;  // barycentric weight of the triangle's second vertex
+    float v = 0.0f;  // barycentric weight of the third vertex
+};
+
+class RayTracer {
+public:
+    static Expected<std::unique_ptr<RayTracer>> build(std::shared_ptr<EmbreeDevice> device,
+                                                      const Scene& scene);
+    ~RayTracer();
+    RayTracer(const RayTracer&) = delete;
+    RayTracer& operator=(const RayTracer&) = delete;
+
+    std::optional<Hit> intersect(const Ray& ray) const;
+    bool occluded(const Ray& ray) const;
+
+    /// Distance by which to move a ray origin off a surface at p so that it does not hit the
+    /// surface it leaves: a few float ulps of p's largest coordinate plus a tiny share of the
+    /// scene's size, so it scales with both the coordinates' magnitude and the scene's scale.
+    float offset_distance(const Vec3& p) const {
+        return kCoordinateUlps * max_abs_component(p) + kSceneRelativeOffset * scene_scale_;
+    }
+    /// p moved along the geometric normal n to the side `direction` leaves towards.
+    Vec3 offset_origin(const Vec3& p, const Vec3& n, const Vec3& direction) const {
+        const float d = offset_distance(p);
+        return glm::dot(direction, n) >= 0.0f ? p + d * n : p - d * n;
+    }
+
+    const Scene& scene() const { return *scene_; }
+    RTCScene handle() const { return rtc_scene_; }
+    float scene_scale() const { return scene_scale_; }
+
+    static constexpr float kCoordinateUlps = 64.0f * std::numeric_limits<float>::epsilon();
+    static constexpr float kSceneRelativeOffset = 1e-5f;
+
+private:
+    RayTracer() = default;
+
+    std::shared_ptr<EmbreeDevice> device_;
+    const Scene* scene_ = nullptr;
+    RTCScene rtc_scene_ = nullptr;
+    float scene_scale_ = 1.0f;
+};
+
+}  // namespace photond

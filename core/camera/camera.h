@@ -1,0 +1,47 @@
+// Pinhole perspective camera with ray differentials (Igehy 1999), for pixel-footprint-based
+// spacing later (irradiance cache, photon radii).
+#pragma once
+
+#include "core/math/vec.h"
+#include "core/scene/scene.h"
+#include "core/util/expected.h"
+
+namespace photond {
+
+struct CameraRay {
+    Vec3 origin{0.0f};
+    Vec3 direction{0.0f, 0.0f, -1.0f};  // unit
+    /// Unit directions of the rays through the neighbouring pixel positions (x + 1, y) and
+    /// (x, y + 1): the ray differentials of a pinhole camera share the origin.
+    Vec3 direction_dx{0.0f};
+    Vec3 direction_dy{0.0f};
+};
+
+class Camera {
+public:
+    /// Validates the description (finite, look_at != position, up not parallel) and sets up
+    /// the raster mapping for an image of width x height pixels.
+    static Expected<Camera> create(const CameraDesc& desc, int width, int height);
+
+    /// The ray through the raster position (x, y), x in [0, width), y in [0, height), y down.
+    CameraRay generate_ray(float x, float y) const;
+
+    /// Angle subtended by one pixel at the image centre (radians): the footprint of a pixel at
+    /// distance d is about d * pixel_angle() / cos.
+    float pixel_angle() const { return pixel_angle_; }
+    const Vec3& position() const { return position_; }
+    const Vec3& forward() const { return forward_; }
+    int width() const { return width_; }
+    int height() const { return height_; }
+
+private:
+    Vec3 raster_direction(float x, float y) const;
+
+    Vec3 position_{0.0f}, forward_{0.0f}, right_{0.0f}, up_{0.0f};
+    float tan_half_vfov_ = 0.0f;
+    float aspect_ = 1.0f;
+    int width_ = 0, height_ = 0;
+    float pixel_angle_ = 0.0f;
+};
+
+}  // namespace photond

@@ -1,0 +1,29 @@
+#include "core/integrators/direct.h"
+
+namespace photond {
+
+DirectIntegrator::DirectIntegrator(std::shared_ptr<const RenderScene> scene, int max_specular_depth)
+    : scene_(std::move(scene)), max_specular_depth_(max_specular_depth) {}
+
+Color DirectIntegrator::radiance(const CameraRay& ray, SampleContext& context) const {
+    return radiance_along(Ray{ray.origin, ray.direction}, 0, context);
+}
+
+Color DirectIntegrator::radiance_along(const Ray& ray, int depth, SampleContext& context) const {
+    const RenderScene& rs = *scene_;
+    const std::optional<Hit> hit = trace_ray(rs, ray, context.counters);
+    if (!hit) return Color(0.0f);
+    const SurfaceInteraction si = make_interaction(*rs.scene, *hit, ray.direction);
+    const Vec3 wo = -ray.direction;
+    Color radiance = rs.lights->emitted_radiance(si, wo);
+    const Bsdf bsdf = make_bsdf(*rs.scene, si, wo);
+    if (bsdf.has_non_delta()) radiance += sample_direct_light(rs, si, bsdf, wo, context, false);
+    if (bsdf.has_delta() && depth < max_specular_depth_) {
+        radiance += follow_delta_lobes(bsdf, wo, depth, context.rng, [&](const BsdfSample& s) {
+            return radiance_along(spawn_ray(rs, si, s.wi), depth + 1, context);
+        });
+    }
+    return radiance;
+}
+
+}  // namespace photond

@@ -1,0 +1,48 @@
+// Integrator `direct`: emitted light, direct light by light sampling, and ideal specular
+// reflection and refraction by recursion (Whitted). No indirect diffuse or glossy light.
+#pragma once
+
+#include <memory>
+
+#include "core/integrators/integrator.h"
+
+namespace photond {
+
+class DirectIntegrator final : public Integrator {
+public:
+    explicit DirectIntegrator(std::shared_ptr<const RenderScene> scene, int max_specular_depth = 16);
+    std::string_view name() const override { return "direct"; }
+    Color radiance(const CameraRay& ray, SampleContext& context) const override;
+
+private:
+    Color radiance_along(const Ray& ray, int depth, SampleContext& context) const;
+
+    std::shared_ptr<const RenderScene> scene_;
+    int max_specular_depth_;
+};
+
+/// Follows delta lobes at a hit: every lobe while depth < kBranchDepth (a noise-free first
+/// reflection and refraction), then one lobe chosen in proportion to its weight (unbiased, and
+/// no exponential growth of rays inside glass). `trace` is called with (direction, weight).
+template <typename TraceFn>
+Color follow_delta_lobes(const Bsdf& bsdf, const Vec3& wo, int depth, Rng& rng, TraceFn&& trace) {
+    constexpr int kBranchDepth = 2;
+    std::array<BsdfSample, 2> lobes;
+    const int count = bsdf.delta_lobes(wo, lobes);
+    if (count == 0) return Color(0.0f);
+    if (count == 1 || depth < kBranchDepth) {
+        Color sum(0.0f);
+        for (int i = 0; i < count; ++i) {
+            if (!is_black(lobes[i].weight)) sum += lobes[i].weight * trace(lobes[i]);
+        }
+        return sum;
+    }
+    const float w0 = average(lobes[0].weight), w1 = average(lobes[1].weight);
+    if (!(w0 + w1 > 0.0f)) return Color(0.0f);
+    const float p0 = w0 / (w0 + w1);
+    const int chosen = rng.next_float() < p0 ? 0 : 1;
+    const float p = chosen == 0 ? p0 : 1.0f - p0;
+    return lobes[chosen].weight / p * trace(lobes[chosen]);
+}
+
+}  // namespace photond

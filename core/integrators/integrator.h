@@ -1,0 +1,66 @@
+// The interface every integrator implements, and the per-sample context it receives.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string_view>
+
+#include "core/accel/ray_tracer.h"
+#include "core/camera/camera.h"
+#include "core/material/bsdf.h"
+#include "core/math/rng.h"
+#include "core/render/render_scene.h"
+#include "core/scene/interaction.h"
+
+namespace photond {
+
+/// Ray counts of one thread's work; summed after the pass (sums do not depend on the order).
+struct RayCounters {
+    uint64_t rays = 0;         // intersection queries
+    uint64_t shadow_rays = 0;  // occlusion queries
+
+    RayCounters& operator+=(const RayCounters& o) {
+        rays += o.rays;
+        shadow_rays += o.shadow_rays;
+        return *this;
+    }
+};
+
+/// What one camera sample may use: its own random stream and counters.
+struct SampleContext {
+    Rng& rng;
+    RayCounters& counters;
+};
+
+/// Computes the radiance arriving at the camera along a ray. Implementations are immutable
+/// during a render and called concurrently from every worker thread; all randomness comes from
+/// the SampleContext, so a pixel's value depends only on its random stream.
+class Integrator {
+public:
+    virtual ~Integrator() = default;
+    virtual std::string_view name() const = 0;
+    virtual Color radiance(const CameraRay& ray, SampleContext& context) const = 0;
+};
+
+/// Intersection query that counts itself.
+inline std::optional<Hit> trace_ray(const RenderScene& rs, const Ray& ray, RayCounters& counters) {
+    ++counters.rays;
+    return rs.tracer->intersect(ray);
+}
+
+/// A ray leaving the surface point of `si` in `direction`, offset against self-intersection.
+inline Ray spawn_ray(const RenderScene& rs, const SurfaceInteraction& si, const Vec3& direction) {
+    return Ray{rs.tracer->offset_origin(si.p, si.geometric_normal, direction), direction};
+}
+
+/// The BSDF at a hit seen from direction wo. Opaque materials are shaded two-sided (normals turned
+/// towards wo); transmissive ones keep the mesh's orientation, so the outside is the front side.
+Bsdf make_bsdf(const Scene& scene, const SurfaceInteraction& si, const Vec3& wo);
+
+/// Next-event estimation: one light sample with a shadow ray, lobes in `mask` only. With
+/// `use_mis`, area-light samples are weighted by the power heuristic against BSDF sampling.
+Color sample_direct_light(const RenderScene& rs, const SurfaceInteraction& si, const Bsdf& bsdf,
+                          const Vec3& wo, SampleContext& context, bool use_mis,
+                          LobeMask mask = kAllLobes);
+
+}  // namespace photond

@@ -1,0 +1,58 @@
+#include "core/integrators/path.h"
+
+namespace photond {
+
+PathIntegrator::PathIntegrator(std::shared_ptr<const RenderScene> scene, int max_depth,
+                               int roulette_start_depth)
+    : scene_(std::move(scene)), max_depth_(max_depth), roulette_start_depth_(roulette_start_depth) {}
+
+Color PathIntegrator::radiance(const CameraRay& camera_ray, SampleContext& context) const {
+    const RenderScene& rs = *scene_;
+    Color radiance(0.0f);
+    Color throughput(1.0f);
+    Ray ray{camera_ray.origin, camera_ray.direction};
+    bool previous_was_delta = true;  // the camera ray counts as specular: emission is taken whole
+    float previous_bsdf_pdf = 0.0f;
+    Vec3 previous_point = camera_ray.origin;
+
+    for (int depth = 0; depth < max_depth_; ++depth) {
+        const std::optional<Hit> hit = trace_ray(rs, ray, context.counters);
+        if (!hit) break;
+        const SurfaceInteraction si = make_interaction(*rs.scene, *hit, ray.direction);
+        const Vec3 wo = -ray.direction;
+
+        const Color emitted = rs.lights->emitted_radiance(si, wo);
+        if (!is_black(emitted)) {
+            float weight = 1.0f;
+            if (!previous_was_delta) {
+                const float light_pdf = rs.lights->pdf_incident_triangle(si.triangle, previous_point, si.p);
+                weight = power_heuristic(previous_bsdf_pdf, light_pdf);
+            }
+            radiance += throughput * emitted * weight;
+        }
+
+        const Bsdf bsdf = make_bsdf(*rs.scene, si, wo);
+        if (bsdf.has_non_delta())
+            radiance += throughput * sample_direct_light(rs, si, bsdf, wo, context, true);
+
+        const float u_lobe = context.rng.next_float();
+        const Vec2 u = context.rng.next_vec2();
+        const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u);
+        if (!s || !(s->pdf > 0.0f) || is_black(s->weight)) break;
+        throughput *= s->weight;
+        previous_was_delta = s->kind == LobeKind::Delta;
+        previous_bsdf_pdf = s->pdf;
+        previous_point = si.p;
+        ray = spawn_ray(rs, si, s->wi);
+
+        if (depth + 1 >= roulette_start_depth_) {
+            // Survive with the throughput's largest channel (capped), compensating survivors.
+            const float survive = std::min(0.95f, max_component(throughput));
+            if (!(survive > 0.0f) || context.rng.next_float() >= survive) break;
+            throughput /= survive;
+        }
+    }
+    return radiance;
+}
+
+}  // namespace photond

@@ -1,0 +1,206 @@
+#include "core/light/light_set.h"
+
+#include <limits>
+
+#include "core/math/frame.h"
+
+namespace photond {
+
+float LightSet::spot_falloff(const PunctualLight& light, float cos_angle) {
+    // KHR_lights_punctual, "Inner and Outer Cone Angles": smooth quadratic attenuation.
+    const float scale = 1.0f / std::max(0.001f, light.cos_inner - light.cos_outer);
+    const float offset = -light.cos_outer * scale;
+    const float t = std::clamp(cos_angle * scale + offset, 0.0f, 1.0f);
+    return t * t;
+}
+
+LightSet::LightSet(const Scene& scene) : scene_(&scene) {
+    scene_center_ = scene.bounds.empty() ? Vec3(0.0f) : scene.bounds.center();
+    scene_radius_ = std::max(scene.bounds.radius(), 1e-6f);
+    for (uint32_t i = 0; i < scene.lights.size(); ++i) {
+        const PunctualLight& l = scene.lights[i];
+        Entry e{LightKind::Point, i, Color(0.0f), 0.0f};
+        switch (l.type) {
+            case PunctualLightType::Point:
+                e.power = 4.0f * kPi * l.intensity;
+                break;
+            case PunctualLightType::Spot: {
+                e.kind = LightKind::Spot;
+                // Integral of the falloff over the sphere: full inside the inner cone, and
+                // ((c - cos_outer) / (cos_inner - cos_outer))^2 between the cones.
+                const float ci = l.cos_inner, co = std::min(l.cos_outer, l.cos_inner);
+                e.power = 2.0f * kPi * l.intensity * ((1.0f - ci) + (ci - co) / 3.0f);
+                break;
+            }
+            case PunctualLightType::Directional:
+                e.kind = LightKind::Directional;
+                e.power = kPi * scene_radius_ * scene_radius_ * l.intensity;
+                break;
+        }
+        lights_.push_back(e);
+    }
+    light_of_triangle_.assign(scene.triangles.size(), -1);
+    for (uint32_t t = 0; t < scene.triangles.size(); ++t) {
+        const Material& m = scene.materials[scene.triangle_materials[t]];
+        if (!m.is_emissive()) continue;
+        const float area = scene.triangle_area(t);
+        if (!(area > 0.0f) || !std::isfinite(area)) continue;  // zero-area emitters emit nothing
+        const float sides = m.double_sided ? 2.0f : 1.0f;
+        light_of_triangle_[t] = static_cast<int32_t>(lights_.size());
+        lights_.push_back(Entry{LightKind::Triangle, t, sides * kPi * area * m.emission, area});
+    }
+    std::vector<float> weights;
+    weights.reserve(lights_.size());
+    for (const Entry& e : lights_) {
+        weights.push_back(average(e.power));
+        total_power_ += e.power;
+    }
+    selection_ = DiscreteDistribution(weights);
+}
+
+std::optional<LightSample> LightSet::sample_incident(const Vec3& p, float u_select,
+                                                     const Vec2& u) const {
+    if (empty()) return std::nullopt;
+    float choice_pdf = 0.0f;
+    const uint32_t index = selection_.sample(u_select, &choice_pdf);
+    if (choice_pdf <= 0.0f) return std::nullopt;
+    const Entry& e = lights_[index];
+    LightSample s;
+    switch (e.kind) {
+        case LightKind::Point:
+        case LightKind::Spot: {
+            const PunctualLight& l = scene_->lights[e.index];
+            const Vec3 d = l.position - p;
+            const float dist2 = glm::dot(d, d);
+            if (!(dist2 > 0.0f)) return std::nullopt;
+            s.distance = std::sqrt(dist2);
+            s.wi = d / s.distance;
+            s.radiance = l.intensity / dist2;
+            if (e.kind == LightKind::Spot) s.radiance *= spot_falloff(l, glm::dot(-s.wi, l.direction));
+            s.pdf = choice_pdf;
+            s.is_delta = true;
+            s.point = l.position;
+            break;
+        }
+        case LightKind::Directional: {
+            const PunctualLight& l = scene_->lights[e.index];
+            s.wi = -l.direction;
+            s.distance = std::numeric_limits<float>::infinity();
+            s.radiance = l.intensity;
+            s.pdf = choice_pdf;
+            s.is_delta = true;
+            break;
+        }
+        case LightKind::Triangle: {
+            const glm::uvec3& t = scene_->triangles[e.index];
+            const Vec2 b = sample_uniform_triangle(u);
+            const Vec3& a0 = scene_->positions[t.x];
+            const Vec3 q = a0 + b.x * (scene_->positions[t.y] - a0) + b.y * (scene_->positions[t.z] - a0);
+            const Vec3 n = scene_->triangle_normal(e.index);
+            const Vec3 d = q - p;
+            const float dist2 = glm::dot(d, d);
+            if (!(dist2 > 0.0f)) return std::nullopt;
+            s.distance = std::sqrt(dist2);
+            s.wi = d / s.distance;
+            const float cos_light = glm::dot(-s.wi, n);
+            const Material& m = scene_->materials[scene_->triangle_materials[e.index]];
+            if (cos_light <= 0.0f && !m.double_sided) return std::nullopt;
+            const float abs_cos = std::abs(cos_light);
+            if (!(abs_cos > 0.0f)) return std::nullopt;
+            s.radiance = m.emission;
+            s.pdf = choice_pdf * dist2 / (abs_cos * e.area);
+            if (!std::isfinite(s.pdf)) return std::nullopt;
+            s.point = q;
+            s.normal = n;
+            break;
+        }
+    }
+    return s;
+}
+
+float LightSet::pdf_incident_triangle(uint32_t triangle, const Vec3& p, const Vec3& light_point) const {
+    const int32_t light = light_of_triangle_[triangle];
+    if (light < 0) return 0.0f;
+    const Entry& e = lights_[static_cast<size_t>(light)];
+    const Vec3 d = light_point - p;
+    const float dist2 = glm::dot(d, d);
+    if (!(dist2 > 0.0f)) return 0.0f;
+    const float abs_cos = std::abs(glm::dot(d, scene_->triangle_normal(triangle))) / std::sqrt(dist2);
+    if (!(abs_cos > 0.0f)) return 0.0f;
+    return selection_.probability(static_cast<uint32_t>(light)) * dist2 / (abs_cos * e.area);
+}
+
+Color LightSet::emitted_radiance(const SurfaceInteraction& si, const Vec3& wo) const {
+    const Material& m = scene_->materials[si.material];
+    if (!m.is_emissive()) return Color(0.0f);
+    if (!m.double_sided && glm::dot(wo, si.geometric_normal) <= 0.0f) return Color(0.0f);
+    return m.emission;
+}
+
+std::optional<EmissionSample> LightSet::sample_emission(float u_select, const Vec2& u_position,
+                                                        const Vec2& u_direction) const {
+    if (empty()) return std::nullopt;
+    float choice_pdf = 0.0f;
+    const uint32_t index = selection_.sample(u_select, &choice_pdf);
+    if (choice_pdf <= 0.0f) return std::nullopt;
+    const Entry& e = lights_[index];
+    EmissionSample s;
+    s.light = index;
+    switch (e.kind) {
+        case LightKind::Point: {
+            const PunctualLight& l = scene_->lights[e.index];
+            s.origin = l.position;
+            s.direction = sample_uniform_sphere(u_direction);
+            s.flux_weight = l.intensity * (4.0f * kPi) / choice_pdf;
+            break;
+        }
+        case LightKind::Spot: {
+            const PunctualLight& l = scene_->lights[e.index];
+            const float cos_max = std::min(l.cos_outer, l.cos_inner);
+            const Vec3 local = sample_uniform_cone(u_direction, cos_max);
+            s.origin = l.position;
+            s.direction = Frame(l.direction).to_world(local);
+            s.flux_weight = l.intensity * spot_falloff(l, local.z) / (uniform_cone_pdf(cos_max) * choice_pdf);
+            break;
+        }
+        case LightKind::Directional: {
+            const PunctualLight& l = scene_->lights[e.index];
+            // A disc of the scene's bounding radius, perpendicular to the light, outside the scene.
+            const Frame frame(l.direction);
+            const Vec2 d = sample_concentric_disk(u_position) * scene_radius_;
+            s.origin = scene_center_ - l.direction * (2.0f * scene_radius_) + frame.s * d.x + frame.t * d.y;
+            s.direction = l.direction;
+            s.normal = l.direction;
+            s.flux_weight = l.intensity * (kPi * scene_radius_ * scene_radius_) / choice_pdf;
+            break;
+        }
+        case LightKind::Triangle: {
+            const glm::uvec3& t = scene_->triangles[e.index];
+            const Vec2 b = sample_uniform_triangle(u_position);
+            const Vec3& a0 = scene_->positions[t.x];
+            s.origin = a0 + b.x * (scene_->positions[t.y] - a0) + b.y * (scene_->positions[t.z] - a0);
+            Vec3 n = scene_->triangle_normal(e.index);
+            const Material& m = scene_->materials[scene_->triangle_materials[e.index]];
+            Vec2 ud = u_direction;
+            float sides = 1.0f;
+            if (m.double_sided) {  // pick a face, reusing the random number
+                sides = 2.0f;
+                if (ud.x < 0.5f) {
+                    ud.x *= 2.0f;
+                } else {
+                    ud.x = std::min((ud.x - 0.5f) * 2.0f, 0x1.fffffep-1f);
+                    n = -n;
+                }
+            }
+            s.normal = n;
+            s.direction = Frame(n).to_world(sample_cosine_hemisphere(ud));
+            // Le * cos / (pdf_area * pdf_dir) = Le * pi * A, times the number of faces.
+            s.flux_weight = m.emission * (sides * kPi * e.area) / choice_pdf;
+            break;
+        }
+    }
+    if (!is_finite(s.flux_weight) || !is_finite(s.direction)) return std::nullopt;
+    return s;
+}
+
+}  // namespace photond

@@ -1,0 +1,85 @@
+// Every light of a scene in one set: punctual lights (point, spot, directional) and emissive
+// triangles, chosen by power. Immutable after construction; safe to share between threads.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "core/math/sampling.h"
+#include "core/scene/interaction.h"
+#include "core/scene/scene.h"
+
+namespace photond {
+
+enum class LightKind : uint8_t { Point, Spot, Directional, Triangle };
+
+/// A light sample seen from a shading point (next-event estimation).
+struct LightSample {
+    Vec3 wi{0.0f};            // unit, from the shading point towards the light
+    float distance = 0.0f;    // to the sampled light point; infinity for directional lights
+    Color radiance{0.0f};     // incident radiance along -wi (intensity / d^2 for point lights)
+    float pdf = 0.0f;         // solid-angle pdf incl. light choice; delta lights: choice probability
+    bool is_delta = false;
+    Vec3 point{0.0f};         // the light point (unused for directional lights)
+    Vec3 normal{0.0f};        // emitter normal (triangles), for the shadow ray's far offset
+};
+
+/// A photon leaving a light: origin, direction and its share of the total power. The flux
+/// weight's expectation over samples is the scene's total emitted power, so each of N emitted
+/// photons carries flux_weight / N.
+struct EmissionSample {
+    Vec3 origin{0.0f};
+    Vec3 direction{0.0f, 0.0f, 1.0f};
+    Vec3 normal{0.0f};     // emitter normal at the origin (zero for point lights)
+    Color flux_weight{0.0f};
+    uint32_t light = 0;    // index into LightSet
+};
+
+class LightSet {
+public:
+    explicit LightSet(const Scene& scene);
+
+    bool empty() const { return lights_.empty() || selection_.empty(); }
+    size_t size() const { return lights_.size(); }
+    LightKind kind(uint32_t light) const { return lights_[light].kind; }
+    /// Radiant power of one light (W), and of all lights together.
+    Color power(uint32_t light) const { return lights_[light].power; }
+    Color total_power() const { return total_power_; }
+    float selection_probability(uint32_t light) const { return selection_.probability(light); }
+
+    /// Picks a light by power and a point on it as seen from p.
+    std::optional<LightSample> sample_incident(const Vec3& p, float u_select, const Vec2& u) const;
+
+    /// Solid-angle pdf with which sample_incident(p, ...) would have produced `light_point` on the
+    /// emissive triangle hit by a ray from p (for multiple importance sampling).
+    float pdf_incident_triangle(uint32_t triangle, const Vec3& p, const Vec3& light_point) const;
+
+    /// Radiance an emissive surface sends towards wo (front face only unless double-sided).
+    Color emitted_radiance(const SurfaceInteraction& si, const Vec3& wo) const;
+
+    /// Samples a photon's origin and direction from the emission distribution of a light chosen
+    /// by power: point (uniform sphere), spot (uniform cone), directional (a disc covering the
+    /// scene's bounds), emissive triangles (uniform by area, cosine-weighted direction).
+    std::optional<EmissionSample> sample_emission(float u_select, const Vec2& u_position,
+                                                  const Vec2& u_direction) const;
+
+    /// Spot light angular falloff of KHR_lights_punctual (quadratic in the cosine).
+    static float spot_falloff(const PunctualLight& light, float cos_angle);
+
+private:
+    struct Entry {
+        LightKind kind;
+        uint32_t index;  // into Scene::lights or Scene::triangles
+        Color power;
+        float area;      // triangles
+    };
+    const Scene* scene_;
+    std::vector<Entry> lights_;
+    std::vector<int32_t> light_of_triangle_;  // -1 when the triangle emits nothing
+    DiscreteDistribution selection_;
+    Color total_power_{0.0f};
+    Vec3 scene_center_{0.0f};
+    float scene_radius_ = 0.0f;
+};
+
+}  // namespace photond

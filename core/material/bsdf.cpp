@@ -1,0 +1,573 @@
+// The glTF 2.0 metallic-roughness BSDF (glTF 2.0 spec, Appendix B; KHR_materials_transmission,
+// _ior, _specular). With metallic m, transmission t and base colour c, the BSDF is the mix
+//
+//   f = m * metal + (1 - m)(1 - t) * (specular layer over Lambert) + (1 - m) t * dielectric,
+//
+//   metal:      GGX reflection, Schlick Fresnel with F0 = c, F90 = 1;
+//   layer:      GGX reflection, Schlick Fresnel with F0 = min(((ior-1)/(ior+1))^2 specular_color,
+//               1) specular and F90 = specular, over the energy-compensated Lambertian lobe below;
+//   dielectric: a solid interface of index ior: GGX reflection and transmission with the exact
+//               dielectric Fresnel (Walter et al. 2007), transmission tinted by c; smooth: ideal
+//               mirror and refraction, with total internal reflection.
+//
+// Energy. Each microfacet lobe has albedo <= 1 (G2 <= G1 and F <= 1; the dielectric's F and
+// 1 - F share one microfacet). The Lambertian lobe under the layer is (Kelemen & Szirmay-Kalos
+// 2001, "A Microfacet Based Coupled Specular-Matte BRDF Model with Importance Sampling")
+//
+//   f_d(wo, wi) = c / pi * (1 - E(mu_o)) (1 - E(mu_i)) / (1 - E_avg),
+//
+// with E(mu) the layer's directional albedo and E_avg = int E(mu) 2 mu dmu. It is reciprocal and
+// its albedo is exactly c (1 - E(mu_o)), so layer + Lambert reflect E_true(mu_o) + c (1 - E(mu_o))
+// <= 1 as long as E is an upper bound of the true layer albedo. E comes from a table built at
+// first use whose bilinear interpolant is raised until it bounds the integrated albedo (see
+// AlbedoTable); E_avg is the exact integral of that interpolant, so the identity above is exact.
+// The three parts have weights summing to 1, hence sum f cos + delta weights <= 1 for c <= 1,
+// for every wo (Importance mode; Radiance mode adds the physical 1/eta^2 at refraction).
+#include "core/material/bsdf.h"
+
+#include <vector>
+
+#include "core/material/fresnel.h"
+#include "core/material/microfacet.h"
+#include "core/math/sampling.h"
+
+namespace photond {
+namespace {
+
+/// Smallest GGX alpha of a rough lobe: kDeltaRoughness^2 (rougher than this by construction;
+/// keeps D(h) = 1 / (pi alpha^2) at the peak well inside float range).
+constexpr float kMinAlpha = kDeltaRoughness * kDeltaRoughness;
+/// Index contrast below which the dielectric does not bend light: treated as delta pass-through
+/// (the rough BTDF's generalized half vector wo + eta wi degenerates as eta -> 1).
+constexpr float kMinIorContrast = 1e-3f;
+
+constexpr int kSlotDiffuse = 0;
+constexpr int kSlotSpecular = 1;
+constexpr int kSlotGlass = 2;
+
+/// Classifies a microfacet lobe by its perceptual roughness for the photon passes: ideal
+/// specular below kDeltaRoughness, glossy below kGlossyRoughness, otherwise diffuse (photons
+/// are stored on it). The Lambertian lobe is always LobeKind::Diffuse.
+LobeKind microfacet_lobe_kind(float roughness) {
+    if (roughness < kDeltaRoughness) return LobeKind::Delta;
+    if (roughness < kGlossyRoughness) return LobeKind::Glossy;
+    return LobeKind::Diffuse;
+}
+
+bool in_mask(LobeMask mask, LobeKind kind) { return (mask & mask_of(kind)) != 0; }
+
+/// Directional albedo of the GGX reflection lobe without Fresnel (`total`) and weighted by the
+/// Schlick term (1 - wo.h)^5 (`schlick`): a Schlick-Fresnel lobe reflects
+/// F0 total + (F90 - F0) schlick.
+struct SpecularAlbedo {
+    float total = 0.0f;
+    float schlick = 0.0f;
+};
+
+/// Integrates the albedo over visible normals (Heitz 2018): E = E_h[G2 / G1 * F], with a
+/// midpoint rule on a kQuadrature^2 grid of the sampling square.
+SpecularAlbedo integrate_specular_albedo(float roughness, float cos_theta) {
+    constexpr int kQuadrature = 32;
+    const GgxDistribution ggx(std::max(roughness * roughness, kMinAlpha));
+    const float mu = std::max(cos_theta, 1e-6f);
+    const Vec3 wo(safe_sqrt(1.0f - mu * mu), 0.0f, mu);
+    const float g1 = ggx.g1(wo);
+    double total = 0.0, schlick = 0.0;
+    for (int i = 0; i < kQuadrature; ++i) {
+        for (int j = 0; j < kQuadrature; ++j) {
+            const Vec2 u((i + 0.5f) / kQuadrature, (j + 0.5f) / kQuadrature);
+            const Vec3 h = ggx.sample_visible_normal(wo, u);
+            const Vec3 wi = reflect(wo, h);
+            if (wi.z <= 0.0f) continue;
+            const double w = ggx.g2(wo, wi) / g1;
+            total += w;
+            schlick += w * schlick_weight(glm::dot(wo, h));
+        }
+    }
+    const double n = kQuadrature * kQuadrature;
+    return {static_cast<float>(total / n), static_cast<float>(schlick / n)};
+}
+
+/// Upper bounds of the rough GGX lobe's albedo (total and Schlick-weighted) on a grid over
+/// roughness in [kDeltaRoughness, 1] (uniform) and mu = cos(theta_o) in [0, 1] (quadratic, dense
+/// at grazing angles), interpolated bilinearly (linear in mu). Built once, then read-only.
+class AlbedoTable {
+public:
+    static constexpr int kRoughnessNodes = 16;
+    static constexpr int kCosNodes = 32;
+
+    static const AlbedoTable& instance() {
+        static const AlbedoTable table;  // thread-safe initialisation
+        return table;
+    }
+
+    SpecularAlbedo lookup(float roughness, float mu) const {
+        const Cell c = locate(roughness, mu);
+        auto bilinear = [&](const std::vector<float>& v) {
+            const float a = std::lerp(v[index(c.j, c.k)], v[index(c.j, c.k + 1)], c.w_mu);
+            const float b = std::lerp(v[index(c.j + 1, c.k)], v[index(c.j + 1, c.k + 1)], c.w_mu);
+            return std::lerp(a, b, c.w_roughness);
+        };
+        return {bilinear(total_), bilinear(schlick_)};
+    }
+
+    /// Cosine-weighted averages int E(mu) 2 mu dmu of the interpolants of lookup().
+    SpecularAlbedo average(float roughness) const {
+        const Cell c = locate(roughness, 1.0f);
+        return {std::lerp(total_avg_[c.j], total_avg_[c.j + 1], c.w_roughness),
+                std::lerp(schlick_avg_[c.j], schlick_avg_[c.j + 1], c.w_roughness)};
+    }
+
+private:
+    struct Cell {
+        int j, k;
+        float w_roughness, w_mu;
+    };
+
+    static float node_roughness(float x) {
+        return kDeltaRoughness + (1.0f - kDeltaRoughness) * x / (kRoughnessNodes - 1);
+    }
+    static float node_cos(int k) { return sqr(static_cast<float>(k) / (kCosNodes - 1)); }
+    static int index(int j, int k) { return j * kCosNodes + k; }
+
+    static Cell locate(float roughness, float mu) {
+        const float x = (std::clamp(roughness, kDeltaRoughness, 1.0f) - kDeltaRoughness) /
+                        (1.0f - kDeltaRoughness) * (kRoughnessNodes - 1);
+        const int j = std::min(static_cast<int>(x), kRoughnessNodes - 2);
+        mu = std::clamp(mu, 0.0f, 1.0f);
+        const int k = std::min(static_cast<int>(std::sqrt(mu) * (kCosNodes - 1)), kCosNodes - 2);
+        const float mu0 = node_cos(k), mu1 = node_cos(k + 1);
+        return {j, k, x - j, std::clamp((mu - mu0) / (mu1 - mu0), 0.0f, 1.0f)};
+    }
+
+    AlbedoTable();
+
+    std::vector<float> total_, schlick_;         // node values, kRoughnessNodes x kCosNodes
+    std::vector<float> total_avg_, schlick_avg_;  // per roughness node
+};
+
+AlbedoTable::AlbedoTable() {
+    // Integrate on a grid kRefine times finer than the nodes, start from the node values, then
+    // raise the 4 corners of every cell by the largest amount the fine samples inside it exceed
+    // the bilinear interpolant (raising a node only raises its other cells' interpolants), so
+    // that the interpolant bounds the albedo from above. Finally add a margin for the
+    // quadrature error and clamp to the true albedo's bound 1.
+    constexpr int kRefine = 3;
+    constexpr float kRelativeMargin = 3e-3f, kAbsoluteMargin = 1.5e-3f;
+    constexpr int fine_r = (kRoughnessNodes - 1) * kRefine + 1;
+    constexpr int fine_c = (kCosNodes - 1) * kRefine + 1;
+    std::vector<SpecularAlbedo> fine(fine_r * fine_c);
+    for (int a = 0; a < fine_r; ++a) {
+        const float roughness = node_roughness(static_cast<float>(a) / kRefine);
+        for (int b = 0; b < fine_c; ++b) {
+            const int k = std::min(b / kRefine, kCosNodes - 2);
+            const float mu = std::lerp(node_cos(k), node_cos(k + 1),
+                                       static_cast<float>(b - k * kRefine) / kRefine);
+            fine[a * fine_c + b] = integrate_specular_albedo(roughness, mu);
+        }
+    }
+    total_.resize(kRoughnessNodes * kCosNodes);
+    schlick_.resize(kRoughnessNodes * kCosNodes);
+    for (int j = 0; j < kRoughnessNodes; ++j) {
+        for (int k = 0; k < kCosNodes; ++k) {
+            const SpecularAlbedo& e = fine[(j * kRefine) * fine_c + k * kRefine];
+            total_[index(j, k)] = e.total;
+            schlick_[index(j, k)] = e.schlick;
+        }
+    }
+    auto bound = [&](std::vector<float>& nodes, float SpecularAlbedo::*member) {
+        std::vector<float> raise(nodes.size(), 0.0f);
+        for (int j = 0; j + 1 < kRoughnessNodes; ++j) {
+            for (int k = 0; k + 1 < kCosNodes; ++k) {
+                float deficit = 0.0f;
+                for (int da = 0; da <= kRefine; ++da) {
+                    for (int db = 0; db <= kRefine; ++db) {
+                        const float wr = static_cast<float>(da) / kRefine;
+                        const float wm = static_cast<float>(db) / kRefine;
+                        const float interpolated = std::lerp(
+                            std::lerp(nodes[index(j, k)], nodes[index(j, k + 1)], wm),
+                            std::lerp(nodes[index(j + 1, k)], nodes[index(j + 1, k + 1)], wm),
+                            wr);
+                        const SpecularAlbedo& e =
+                            fine[(j * kRefine + da) * fine_c + k * kRefine + db];
+                        deficit = std::max(deficit, e.*member - interpolated);
+                    }
+                }
+                for (int corner : {index(j, k), index(j, k + 1), index(j + 1, k),
+                                   index(j + 1, k + 1)}) {
+                    raise[corner] = std::max(raise[corner], deficit);
+                }
+            }
+        }
+        for (size_t n = 0; n < nodes.size(); ++n) {
+            nodes[n] = std::min(1.0f, (nodes[n] + raise[n]) * (1.0f + kRelativeMargin) +
+                                          kAbsoluteMargin);
+        }
+    };
+    bound(total_, &SpecularAlbedo::total);
+    bound(schlick_, &SpecularAlbedo::schlick);
+
+    // Exact cosine-weighted integral of the piecewise-linear interpolant: on [a, a + h] with end
+    // values e0, e1, int 2 mu E dmu = h (a (e0 + e1) + h (e0 + 2 e1) / 3).
+    auto row_average = [&](const std::vector<float>& nodes, int j) {
+        double sum = 0.0;
+        for (int k = 0; k + 1 < kCosNodes; ++k) {
+            const double a = node_cos(k), h = node_cos(k + 1) - a;
+            const double e0 = nodes[index(j, k)], e1 = nodes[index(j, k + 1)];
+            sum += h * (a * (e0 + e1) + h * (e0 + 2.0 * e1) / 3.0);
+        }
+        return static_cast<float>(sum);
+    };
+    for (int j = 0; j < kRoughnessNodes; ++j) {
+        total_avg_.push_back(row_average(total_, j));
+        schlick_avg_.push_back(row_average(schlick_, j));
+    }
+}
+
+/// Albedo of the lobe without Fresnel and with the Schlick term: exact for the ideal mirror
+/// (1 and (1 - mu)^5), tabulated upper bounds for rough lobes.
+SpecularAlbedo specular_albedo_terms(bool smooth, float roughness, float mu) {
+    if (smooth) return {1.0f, schlick_weight(mu)};
+    return AlbedoTable::instance().lookup(roughness, mu);
+}
+
+}  // namespace
+
+Bsdf::Bsdf(const Material& material, const Color& base_color, const Frame& shading,
+           const Vec3& geometric_normal)
+    : frame_(shading), geometric_normal_(geometric_normal) {
+    // Clamp to the ranges the glTF spec allows, which is what the energy guarantee needs.
+    base_color_ = glm::clamp(base_color, Color(0.0f), Color(1.0f));
+    metallic_ = std::clamp(material.metallic, 0.0f, 1.0f);
+    transmission_ = std::clamp(material.transmission, 0.0f, 1.0f);
+    roughness_ = std::clamp(material.roughness, 0.0f, 1.0f);
+    ior_ = std::isfinite(material.ior) ? std::max(material.ior, 1.0f) : 1.5f;
+    const float specular = std::clamp(material.specular, 0.0f, 1.0f);
+
+    // KHR_materials_specular: F0 = min(F0(ior) * specular_color, 1) * specular, F90 = specular.
+    // Note F0 <= F90, so the layer albedo F0 total + (F90 - F0) schlick stays <= F90 <= 1.
+    const float f0_from_ior = sqr((ior_ - 1.0f) / (ior_ + 1.0f));
+    specular_f0_ =
+        glm::min(f0_from_ior * glm::max(material.specular_color, Color(0.0f)), Color(1.0f)) *
+        specular;
+    specular_f90_ = specular;
+
+    layer_weight_ = (1.0f - metallic_) * (1.0f - transmission_);
+    glass_weight_ = (1.0f - metallic_) * transmission_;
+    smooth_ = roughness_ < kDeltaRoughness;
+    alpha_ = std::max(sqr(roughness_), kMinAlpha);
+    glass_delta_ = smooth_ || ior_ < 1.0f + kMinIorContrast;
+    specular_kind_ = microfacet_lobe_kind(roughness_);
+    glass_kind_ = glass_delta_ ? LobeKind::Delta : specular_kind_;
+
+    // Normalisation of the coupled Lambertian lobe (see the top of this file).
+    const SpecularAlbedo avg =
+        smooth_ ? SpecularAlbedo{1.0f, 1.0f / 21.0f}  // int (1 - mu)^5 2 mu dmu = 1/21
+                : AlbedoTable::instance().average(roughness_);
+    const Color layer_avg =
+        specular_f0_ * avg.total + (Color(specular_f90_) - specular_f0_) * avg.schlick;
+    diffuse_weight_ = layer_weight_ * base_color_;
+    for (int ch = 0; ch < 3; ++ch) {
+        const float remaining = 1.0f - layer_avg[ch];
+        diffuse_norm_[ch] = remaining > 1e-6f ? 1.0f / remaining : 0.0f;
+        diffuse_[ch] = diffuse_norm_[ch] > 0.0f ? diffuse_weight_[ch] * remaining : 0.0f;
+    }
+
+    if (max_component(diffuse_) > 0.0f) lobes_ |= mask_of(LobeKind::Diffuse);
+    if (metallic_ > 0.0f || (layer_weight_ > 0.0f && specular_f90_ > 0.0f)) {
+        lobes_ |= mask_of(specular_kind_);
+    }
+    if (glass_weight_ > 0.0f) lobes_ |= mask_of(glass_kind_);
+}
+
+Color Bsdf::layer_albedo(float cos_theta) const {
+    const SpecularAlbedo e = specular_albedo_terms(smooth_, roughness_, cos_theta);
+    return specular_f0_ * e.total + (Color(specular_f90_) - specular_f0_) * e.schlick;
+}
+
+Color Bsdf::specular_albedo(float cos_theta) const {
+    // Metal (F0 = c, F90 = 1) plus the dielectric layer; exact when smooth.
+    const SpecularAlbedo e = specular_albedo_terms(smooth_, roughness_, cos_theta);
+    const Color metal = base_color_ * e.total + (Color(1.0f) - base_color_) * e.schlick;
+    return metallic_ * metal + layer_weight_ * layer_albedo(cos_theta);
+}
+
+Color Bsdf::lambert_albedo(float cos_theta) const {
+    // int f_d cos dwi = c (1 - E(mu_o)) (1 - E_avg) / (1 - E_avg).
+    const Color remaining = Color(1.0f) - layer_albedo(cos_theta);
+    Color rho(0.0f);
+    for (int ch = 0; ch < 3; ++ch) {
+        if (diffuse_norm_[ch] > 0.0f) rho[ch] = diffuse_weight_[ch] * remaining[ch];
+    }
+    return rho;
+}
+
+Color Bsdf::diffuse_reflectance(const Vec3& wo) const {
+    return lambert_albedo(std::min(std::abs(glm::dot(wo, frame_.n)), 1.0f));
+}
+
+bool Bsdf::geometry_agrees(const Vec3& wo, const Vec3& wi, bool local_reflection) const {
+    // pbrt-v3 style: the geometric normal decides reflection vs transmission.
+    const bool geometric_reflection =
+        glm::dot(wo, geometric_normal_) * glm::dot(wi, geometric_normal_) > 0.0f;
+    return geometric_reflection == local_reflection;
+}
+
+Bsdf::SlotProbabilities Bsdf::slot_probabilities(const Vec3& wo, bool outside,
+                                                 LobeMask mask) const {
+    // Each slot's estimated albedo for this wo (exact for Lambert and the smooth lobes). The
+    // estimates never depend on the TransportMode, so that pdf() needs none.
+    SlotProbabilities p{0.0f, 0.0f, 0.0f};
+    const float mu = wo.z;
+    if (in_mask(mask, LobeKind::Diffuse) && (lobes_ & mask_of(LobeKind::Diffuse))) {
+        p[kSlotDiffuse] = average(lambert_albedo(mu));
+    }
+    if (in_mask(mask, specular_kind_) && (metallic_ > 0.0f || layer_weight_ > 0.0f)) {
+        p[kSlotSpecular] = average(specular_albedo(mu));
+    }
+    if (in_mask(mask, glass_kind_) && glass_weight_ > 0.0f) {
+        const float f = fresnel_dielectric(mu, relative_ior(outside));
+        p[kSlotGlass] = glass_weight_ * (f + (1.0f - f) * average(base_color_));
+    }
+    const float sum = p[0] + p[1] + p[2];
+    if (!(sum > 0.0f)) return {0.0f, 0.0f, 0.0f};
+    for (float& v : p) v /= sum;
+    return p;
+}
+
+Color Bsdf::eval_local(const Vec3& wo, const Vec3& wi, bool outside, TransportMode mode,
+                       LobeMask mask) const {
+    Color f(0.0f);
+    const GgxDistribution ggx(alpha_);
+    if (wi.z > 0.0f) {
+        if (in_mask(mask, LobeKind::Diffuse)) {
+            f += diffuse_weight_ * kInvPi * (Color(1.0f) - layer_albedo(wo.z)) *
+                 (Color(1.0f) - layer_albedo(wi.z)) * diffuse_norm_;
+        }
+        const bool specular = !smooth_ && in_mask(mask, specular_kind_);
+        const bool glass = !glass_delta_ && glass_weight_ > 0.0f && in_mask(mask, glass_kind_);
+        if (specular || glass) {
+            // Torrance-Sparrow: F D G2 / (4 mu_o mu_i) (Walter et al. 2007, eq. 20).
+            const Vec3 h = glm::normalize(wo + wi);
+            const float cos_oh = glm::dot(wo, h);
+            const float common = ggx.d(h) * ggx.g2(wo, wi) / (4.0f * wo.z * wi.z);
+            if (specular) {
+                const Color metal = fresnel_schlick(base_color_, Color(1.0f), cos_oh);
+                const Color layer =
+                    fresnel_schlick(specular_f0_, Color(specular_f90_), cos_oh);
+                f += (metallic_ * metal + layer_weight_ * layer) * common;
+            }
+            if (glass) {
+                f += Color(glass_weight_ * fresnel_dielectric(cos_oh, relative_ior(outside)) *
+                           common);
+            }
+        }
+    } else if (wi.z < 0.0f && !glass_delta_ && glass_weight_ > 0.0f &&
+               in_mask(mask, glass_kind_)) {
+        // Rough dielectric transmission (Walter et al. 2007, eq. 21) with the generalized half
+        // vector h ~ wo + eta wi, eta = n_i / n_o (wi's side over wo's side).
+        const float eta = relative_ior(outside);
+        Vec3 h = wo + eta * wi;
+        if (glm::dot(h, h) < 1e-12f) return f;
+        h = glm::normalize(h);
+        if (h.z < 0.0f) h = -h;
+        const float cos_oh = glm::dot(wo, h), cos_ih = glm::dot(wi, h);
+        if (cos_oh <= 0.0f || cos_ih >= 0.0f) return f;  // back-facing microfacet
+        const float denom = cos_oh + eta * cos_ih;
+        float value = (1.0f - fresnel_dielectric(cos_oh, eta)) * ggx.d(h) * ggx.g2(wo, wi) *
+                      eta * eta * -cos_ih * cos_oh / (wo.z * -wi.z * denom * denom);
+        // Radiance is scaled by (n_o / n_i)^2 crossing the interface (Veach 1997, eq. 5.13).
+        if (mode == TransportMode::Radiance) value /= eta * eta;
+        f += glass_weight_ * value * base_color_;
+    }
+    return f;
+}
+
+float Bsdf::pdf_local(const Vec3& wo, const Vec3& wi, bool outside,
+                      const SlotProbabilities& slots) const {
+    const GgxDistribution ggx(alpha_);
+    const float p_specular = smooth_ ? 0.0f : slots[kSlotSpecular];
+    const float p_glass = glass_delta_ ? 0.0f : slots[kSlotGlass];
+    float pdf = 0.0f;
+    if (wi.z > 0.0f) {
+        pdf += slots[kSlotDiffuse] * cosine_hemisphere_pdf(wi.z);
+        if (p_specular > 0.0f || p_glass > 0.0f) {
+            // Reflection: visible-normal density times dh/dwi = 1 / (4 wo.h).
+            const Vec3 h = glm::normalize(wo + wi);
+            const float cos_oh = glm::dot(wo, h);
+            const float reflect_pdf = ggx.visible_normal_pdf(wo, h) / (4.0f * cos_oh);
+            pdf += p_specular * reflect_pdf;
+            if (p_glass > 0.0f) {
+                pdf += p_glass * fresnel_dielectric(cos_oh, relative_ior(outside)) * reflect_pdf;
+            }
+        }
+    } else if (wi.z < 0.0f && p_glass > 0.0f) {
+        // Refraction: dh/dwi = eta^2 |wi.h| / (wo.h + eta wi.h)^2 (Walter et al. 2007, eq. 17).
+        const float eta = relative_ior(outside);
+        Vec3 h = wo + eta * wi;
+        if (glm::dot(h, h) < 1e-12f) return pdf;
+        h = glm::normalize(h);
+        if (h.z < 0.0f) h = -h;
+        const float cos_oh = glm::dot(wo, h), cos_ih = glm::dot(wi, h);
+        if (cos_oh <= 0.0f || cos_ih >= 0.0f) return pdf;
+        const float denom = cos_oh + eta * cos_ih;
+        pdf += p_glass * (1.0f - fresnel_dielectric(cos_oh, eta)) *
+               ggx.visible_normal_pdf(wo, h) * eta * eta * -cos_ih / (denom * denom);
+    }
+    return pdf;
+}
+
+Color Bsdf::eval(const Vec3& wo, const Vec3& wi, TransportMode mode, LobeMask mask) const {
+    Vec3 o = frame_.to_local(wo), i = frame_.to_local(wi);
+    if (o.z == 0.0f || i.z == 0.0f) return Color(0.0f);
+    if (!geometry_agrees(wo, wi, o.z * i.z > 0.0f)) return Color(0.0f);
+    const bool outside = o.z > 0.0f;
+    if (!outside) {
+        o.z = -o.z;
+        i.z = -i.z;
+    }
+    return eval_local(o, i, outside, mode, mask);
+}
+
+float Bsdf::pdf(const Vec3& wo, const Vec3& wi, LobeMask mask) const {
+    Vec3 o = frame_.to_local(wo), i = frame_.to_local(wi);
+    if (o.z == 0.0f || i.z == 0.0f) return 0.0f;
+    if (!geometry_agrees(wo, wi, o.z * i.z > 0.0f)) return 0.0f;
+    const bool outside = o.z > 0.0f;
+    if (!outside) {
+        o.z = -o.z;
+        i.z = -i.z;
+    }
+    return pdf_local(o, i, outside, slot_probabilities(o, outside, mask));
+}
+
+std::optional<BsdfSample> Bsdf::sample(const Vec3& wo, float u_lobe, const Vec2& u,
+                                       TransportMode mode, LobeMask mask) const {
+    Vec3 o = frame_.to_local(wo);
+    if (!(o.z != 0.0f) || !is_finite(o)) return std::nullopt;
+    const bool outside = o.z > 0.0f;
+    if (!outside) o.z = -o.z;
+    const SlotProbabilities slots = slot_probabilities(o, outside, mask);
+
+    // Choose a slot with u_lobe; reuse the remainder of u_lobe for the reflect/refract choice.
+    int slot = -1;
+    float lower = 0.0f, chosen_lower = 0.0f;
+    for (int s = 0; s < 3; ++s) {
+        if (slots[s] <= 0.0f) continue;
+        slot = s;
+        chosen_lower = lower;
+        if (u_lobe < lower + slots[s]) break;
+        lower += slots[s];
+    }
+    if (slot < 0) return std::nullopt;
+    const float u_choice = std::clamp((u_lobe - chosen_lower) / slots[slot], 0.0f, 0x1.fffffep-1f);
+    const float eta = relative_ior(outside);
+
+    BsdfSample s;
+    Vec3 i;
+    const bool delta =
+        (slot == kSlotSpecular && smooth_) || (slot == kSlotGlass && glass_delta_);
+    if (delta) {
+        // All delta lobes share the mirror direction: its weight is their total reflectance over
+        // the total probability of choosing it.
+        const float f_glass = fresnel_dielectric(o.z, eta);
+        const bool mirror = slot == kSlotSpecular || u_choice < f_glass;
+        Color reflectance(0.0f);
+        float probability = 0.0f;
+        if (mirror) {
+            i = Vec3(-o.x, -o.y, o.z);
+            if (smooth_ && slots[kSlotSpecular] > 0.0f) {
+                reflectance += specular_albedo(o.z);
+                probability += slots[kSlotSpecular];
+            }
+            if (glass_delta_ && slots[kSlotGlass] > 0.0f) {
+                reflectance += Color(glass_weight_ * f_glass);
+                probability += slots[kSlotGlass] * f_glass;
+            }
+        } else {
+            if (!refract(o, Vec3(0, 0, 1), eta, &i)) return std::nullopt;
+            reflectance = glass_weight_ * (1.0f - f_glass) * base_color_;
+            if (mode == TransportMode::Radiance) reflectance /= eta * eta;
+            probability = slots[kSlotGlass] * (1.0f - f_glass);
+            s.is_transmission = true;
+            s.eta = eta;
+        }
+        if (!(probability > 0.0f) || is_black(reflectance)) return std::nullopt;
+        s.weight = reflectance / probability;
+        s.pdf = probability;
+        s.kind = LobeKind::Delta;
+    } else {
+        const GgxDistribution ggx(alpha_);
+        bool reflection = true;
+        if (slot == kSlotDiffuse) {
+            i = sample_cosine_hemisphere(u);
+        } else {
+            const Vec3 h = ggx.sample_visible_normal(o, u);
+            reflection =
+                slot == kSlotSpecular || u_choice < fresnel_dielectric(glm::dot(o, h), eta);
+            if (reflection) {
+                i = reflect(o, h);
+            } else if (!refract(o, h, eta, &i)) {
+                return std::nullopt;
+            }
+        }
+        // Below the horizon after reflection, or not across it after refraction: invalid.
+        if (reflection ? !(i.z > 0.0f) : !(i.z < 0.0f)) return std::nullopt;
+        const Color f = eval_local(o, i, outside, mode, mask);
+        const float pdf = pdf_local(o, i, outside, slots);
+        if (!(pdf > 0.0f) || is_black(f) || !is_finite(f)) return std::nullopt;
+        s.weight = f * std::abs(i.z) / pdf;
+        s.pdf = pdf;
+        s.kind = slot == kSlotDiffuse ? LobeKind::Diffuse
+                                      : (slot == kSlotSpecular ? specular_kind_ : glass_kind_);
+        s.is_transmission = i.z < 0.0f;
+        s.eta = s.is_transmission ? eta : 1.0f;
+    }
+    if (!outside) i.z = -i.z;
+    s.wi = frame_.to_world(i);
+    if (!geometry_agrees(wo, s.wi, !s.is_transmission)) return std::nullopt;
+    return s;
+}
+
+int Bsdf::delta_lobes(const Vec3& wo, std::array<BsdfSample, 2>& out, TransportMode mode) const {
+    if (!has_delta()) return 0;
+    Vec3 o = frame_.to_local(wo);
+    if (!(o.z != 0.0f) || !is_finite(o)) return 0;
+    const bool outside = o.z > 0.0f;
+    if (!outside) o.z = -o.z;
+    const float eta = relative_ior(outside);
+    const float f_glass =
+        glass_delta_ && glass_weight_ > 0.0f ? fresnel_dielectric(o.z, eta) : 0.0f;
+    auto to_world = [&](Vec3 i) {
+        if (!outside) i.z = -i.z;
+        return frame_.to_world(i);
+    };
+    int count = 0;
+    Color mirror(0.0f);
+    if (smooth_) mirror += specular_albedo(o.z);
+    mirror += Color(glass_weight_ * f_glass);
+    if (!is_black(mirror)) {
+        BsdfSample s;
+        s.wi = to_world(Vec3(-o.x, -o.y, o.z));
+        s.weight = mirror;
+        s.pdf = 1.0f;
+        s.kind = LobeKind::Delta;
+        if (geometry_agrees(wo, s.wi, true)) out[count++] = s;
+    }
+    Vec3 i;
+    if (glass_delta_ && glass_weight_ > 0.0f && f_glass < 1.0f &&
+        refract(o, Vec3(0, 0, 1), eta, &i)) {
+        BsdfSample s;
+        s.wi = to_world(i);
+        s.weight = glass_weight_ * (1.0f - f_glass) * base_color_;
+        if (mode == TransportMode::Radiance) s.weight /= eta * eta;
+        s.pdf = 1.0f;
+        s.kind = LobeKind::Delta;
+        s.is_transmission = true;
+        s.eta = eta;
+        if (!is_black(s.weight) && geometry_agrees(wo, s.wi, false)) out[count++] = s;
+    }
+    return count;
+}
+
+}  // namespace photond

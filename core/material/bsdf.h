@@ -1,0 +1,141 @@
+// The glTF 2.0 metallic-roughness BSDF (with KHR_materials_transmission, _ior, _specular):
+// Lambertian diffuse, a dielectric specular layer, metal, smooth and rough (GGX) reflection,
+// smooth and rough transmission. Evaluation, importance sampling and pdf per lobe, and each
+// lobe's classification (delta / glossy / diffuse) for the photon passes.
+//
+// Conventions: all directions are world-space unit vectors pointing AWAY from the surface;
+// wo towards the viewer (or where the photon goes), wi towards the light (or where it came from).
+// eval() and pdf() cover the non-delta lobes only and never include the cosine factor.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+
+#include "core/math/frame.h"
+#include "core/math/vec.h"
+#include "core/scene/scene.h"
+
+namespace photond {
+
+/// Camera paths carry radiance; photon paths carry importance-transported flux. They differ only
+/// at refraction: radiance is scaled by (eta_t / eta_i)^-2 there, flux is not.
+enum class TransportMode : uint8_t { Radiance, Importance };
+
+enum class LobeKind : uint8_t { Diffuse = 1, Glossy = 2, Delta = 4 };
+
+/// Bit set of LobeKind values, to evaluate or sample a subset of the lobes.
+using LobeMask = uint8_t;
+inline constexpr LobeMask kAllLobes = 7;
+inline constexpr LobeMask kNonDeltaLobes = 3;
+inline constexpr LobeMask mask_of(LobeKind k) { return static_cast<LobeMask>(k); }
+
+/// Perceptual roughness below which a microfacet lobe is treated as ideal specular (delta).
+inline constexpr float kDeltaRoughness = 0.02f;
+/// Perceptual roughness below which a non-delta microfacet lobe counts as glossy; at or above it
+/// the lobe counts as diffuse (photons are stored on it and it is gathered like diffuse light).
+inline constexpr float kGlossyRoughness = 0.4f;
+
+struct BsdfSample {
+    Vec3 wi;                  // world space, unit
+    Color weight{0.0f};       // f * |cos(wi, n_s)| / pdf; for delta lobes: reflectance / probability
+    float pdf = 0.0f;         // solid-angle pdf including the lobe choice; delta: the choice probability
+    LobeKind kind = LobeKind::Diffuse;
+    bool is_transmission = false;
+    /// eta of the medium wi lies in over that of wo's side (1 for reflection). Radiance along a
+    /// refracted camera path already includes the 1/eta^2 factor in `weight`.
+    float eta = 1.0f;
+};
+
+class Bsdf {
+public:
+    /// `shading` is the interpolated-normal frame and `geometric_normal` the triangle's normal, both
+    /// on the same side. For opaque materials the caller orients both towards wo (two-sided
+    /// shading); for transmissive materials the caller keeps the mesh's front-face orientation, so
+    /// that the outside (ior 1) is the side the normals point to.
+    Bsdf(const Material& material, const Color& base_color, const Frame& shading,
+         const Vec3& geometric_normal);
+
+    /// Sum of the non-delta lobes in `mask` (no cosine). Zero for delta-only materials.
+    /// Reflection vs transmission is decided by the geometric normal (reflection iff wo and wi
+    /// lie on the same side of it); where the shading frame disagrees the result is zero, so
+    /// shading normals cannot leak light through a surface. Reflection lobes are reciprocal.
+    Color eval(const Vec3& wo, const Vec3& wi, TransportMode mode = TransportMode::Radiance,
+               LobeMask mask = kAllLobes) const;
+    /// Solid-angle pdf with which sample() (same mask) returns wi, for MIS. Excludes delta lobes.
+    /// When `mask` includes delta lobes that exist, sample() picks one of them with probability
+    /// P_delta and pdf() integrates to 1 - P_delta: it is the density of sample()'s continuous
+    /// part, which is what MIS against light sampling needs (a light sample never hits a delta
+    /// lobe). Zero where the geometric normal contradicts the shading frame (see eval()).
+    float pdf(const Vec3& wo, const Vec3& wi, LobeMask mask = kAllLobes) const;
+    /// Importance-samples one lobe of `mask` (chosen by u_lobe in proportion to its estimated
+    /// albedo) and a direction in it. Empty when no lobe applies or the sample is invalid.
+    /// Non-delta samples: weight = eval(wo, wi, mode, mask) |cos| / pdf(wo, wi, mask) (all
+    /// non-delta lobes of the mask, one-sample MIS over the lobes). Delta samples: weight = the
+    /// total delta reflectance or transmittance towards wi over the probability of choosing it.
+    /// Photon tracing: call sample(-photon_direction, u_lobe, u, TransportMode::Importance); the
+    /// returned wi is the photon's next direction and its flux *= weight. This samples the
+    /// adjoint BSDF f*(wo, wi) = f(wi, wo): identical to f for reflection (reciprocal), and
+    /// Importance mode omits the 1/eta^2 radiance factor at refraction (Veach 1997, Sec. 5.2).
+    std::optional<BsdfSample> sample(const Vec3& wo, float u_lobe, const Vec2& u,
+                                     TransportMode mode = TransportMode::Radiance,
+                                     LobeMask mask = kAllLobes) const;
+    /// Every delta lobe at once (ideal mirror and ideal refraction), for deterministic recursion:
+    /// weight = reflectance or transmittance (pdf = 1). Returns how many were written.
+    int delta_lobes(const Vec3& wo, std::array<BsdfSample, 2>& out,
+                    TransportMode mode = TransportMode::Radiance) const;
+
+    bool has_delta() const { return (lobes_ & mask_of(LobeKind::Delta)) != 0; }
+    bool has_non_delta() const { return (lobes_ & kNonDeltaLobes) != 0; }
+    /// Which LobeKinds this BSDF has at all (a LobeMask).
+    LobeMask lobes() const { return lobes_; }
+    /// Reflectance of the Lambertian lobe alone (rho_d), so that L_o = rho_d / pi * E.
+    /// The lobe under the specular layer is (1 - E_s(wo)) (1 - E_s(wi)) / (1 - E_s_avg) times
+    /// a Lambertian one (energy-conserving and reciprocal, see bsdf.cpp), so its reflectance
+    /// depends on wo; this is its cosine-weighted average over wo. Prefer the overload below.
+    Color diffuse_reflectance() const { return diffuse_; }
+    /// Reflectance of the Lambertian lobe towards wo under uniform incident radiance: exact
+    /// L_o(wo) = rho_d(wo) / pi * E for uniform (ambient) lighting, and the lobe's albedo.
+    Color diffuse_reflectance(const Vec3& wo) const;
+
+private:
+    // Sampling slots: the Lambertian lobe, the specular reflection (metal + dielectric layer,
+    // sharing one GGX distribution) and the solid dielectric (reflection + transmission).
+    using SlotProbabilities = std::array<float, 3>;
+
+    // The helpers work in the shading frame flipped so that wo.z > 0; `outside` tells whether
+    // wo was on the normals' side (which matters for the dielectric's relative index only).
+    SlotProbabilities slot_probabilities(const Vec3& wo, bool outside, LobeMask mask) const;
+    Color eval_local(const Vec3& wo, const Vec3& wi, bool outside, TransportMode mode,
+                     LobeMask mask) const;
+    float pdf_local(const Vec3& wo, const Vec3& wi, bool outside,
+                    const SlotProbabilities& slots) const;
+    Color layer_albedo(float cos_theta) const;
+    Color lambert_albedo(float cos_theta) const;
+    Color specular_albedo(float cos_theta) const;
+    float relative_ior(bool outside) const { return outside ? ior_ : 1.0f / ior_; }
+    bool geometry_agrees(const Vec3& wo, const Vec3& wi, bool local_reflection) const;
+
+    Frame frame_;
+    Vec3 geometric_normal_;
+    Color base_color_;
+    Color diffuse_;           // cosine-weighted average reflectance of the Lambertian lobe
+    Color diffuse_weight_;    // (1 - metallic)(1 - transmission) base colour
+    Color diffuse_norm_;      // 1 / (1 - E_s_avg) per channel; 0 where the layer reflects all
+    Color specular_f0_;       // dielectric layer F0 (from ior and KHR_materials_specular)
+    float specular_f90_;      // dielectric layer F90 (the specular factor)
+    float metallic_;
+    float transmission_;
+    float layer_weight_;      // (1 - metallic)(1 - transmission): opaque dielectric part
+    float glass_weight_;      // (1 - metallic) transmission: solid dielectric part
+    float roughness_;         // perceptual roughness
+    float alpha_;             // GGX alpha = roughness^2
+    float ior_;
+    bool smooth_;             // roughness < kDeltaRoughness: reflection/transmission are delta
+    bool glass_delta_;        // smooth_, or ior ~ 1 (no refraction): the dielectric is delta
+    LobeKind specular_kind_;  // kind of the metal/layer reflection lobe
+    LobeKind glass_kind_;     // kind of the dielectric reflection/transmission lobe
+    LobeMask lobes_ = 0;
+};
+
+}  // namespace photond

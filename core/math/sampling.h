@@ -1,0 +1,92 @@
+// Warping of uniform random numbers to the distributions the renderer samples, with their pdfs.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "core/math/vec.h"
+
+namespace photond {
+
+/// Concentric map of the unit square onto the unit disc (Shirley & Chiu 1997).
+inline Vec2 sample_concentric_disk(const Vec2& u) {
+    const Vec2 o = 2.0f * u - Vec2(1.0f);
+    if (o.x == 0.0f && o.y == 0.0f) return {0.0f, 0.0f};
+    float r, theta;
+    if (std::abs(o.x) > std::abs(o.y)) {
+        r = o.x;
+        theta = (kPi / 4.0f) * (o.y / o.x);
+    } else {
+        r = o.y;
+        theta = (kPi / 2.0f) - (kPi / 4.0f) * (o.x / o.y);
+    }
+    return r * Vec2(std::cos(theta), std::sin(theta));
+}
+
+/// Cosine-weighted direction on the +z hemisphere; pdf = cos(theta) / pi.
+inline Vec3 sample_cosine_hemisphere(const Vec2& u) {
+    const Vec2 d = sample_concentric_disk(u);
+    const float z = safe_sqrt(1.0f - d.x * d.x - d.y * d.y);
+    return {d.x, d.y, z};
+}
+inline float cosine_hemisphere_pdf(float cos_theta) { return std::max(cos_theta, 0.0f) * kInvPi; }
+
+/// Uniform direction on the unit sphere; pdf = 1 / (4 pi).
+inline Vec3 sample_uniform_sphere(const Vec2& u) {
+    const float z = 1.0f - 2.0f * u.x;
+    const float r = safe_sqrt(1.0f - z * z);
+    const float phi = 2.0f * kPi * u.y;
+    return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+/// Uniform direction in the cone around +z with cos(half angle) = cos_max;
+/// pdf = 1 / (2 pi (1 - cos_max)).
+inline Vec3 sample_uniform_cone(const Vec2& u, float cos_max) {
+    const float cos_theta = (1.0f - u.x) + u.x * cos_max;
+    const float sin_theta = safe_sqrt(1.0f - cos_theta * cos_theta);
+    const float phi = 2.0f * kPi * u.y;
+    return {sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta};
+}
+inline float uniform_cone_pdf(float cos_max) { return 1.0f / (2.0f * kPi * (1.0f - cos_max)); }
+
+/// Uniform barycentrics (b0, b1) on a triangle (Heitz 2019, low-distortion map); b2 = 1-b0-b1.
+inline Vec2 sample_uniform_triangle(const Vec2& u) {
+    float b0, b1;
+    if (u.x < u.y) {
+        b0 = u.x / 2.0f;
+        b1 = u.y - b0;
+    } else {
+        b1 = u.y / 2.0f;
+        b0 = u.x - b1;
+    }
+    return {b0, b1};
+}
+
+/// Veach's power heuristic with beta = 2, for multiple importance sampling.
+inline float power_heuristic(float pdf_a, float pdf_b) {
+    const float a = pdf_a * pdf_a, b = pdf_b * pdf_b;
+    if (a == 0.0f) return 0.0f;
+    if (!std::isfinite(a)) return 1.0f;
+    return a / (a + b);
+}
+
+/// A discrete distribution proportional to non-negative weights (built once, then read-only).
+class DiscreteDistribution {
+public:
+    DiscreteDistribution() = default;
+    explicit DiscreteDistribution(std::span<const float> weights);
+
+    /// Picks an index for u in [0,1); returns the index and writes its probability.
+    /// u_remapped (optional) receives u rescaled to [0,1) within the chosen bin.
+    uint32_t sample(float u, float* probability, float* u_remapped = nullptr) const;
+    float probability(uint32_t index) const;
+    size_t size() const { return cdf_.empty() ? 0 : cdf_.size() - 1; }
+    double total() const { return total_; }
+    bool empty() const { return total_ <= 0.0; }
+
+private:
+    std::vector<double> cdf_;  // size n + 1, cdf_[0] = 0, cdf_[n] = 1
+    double total_ = 0.0;
+};
+
+}  // namespace photond

@@ -1,0 +1,184 @@
+#include "core/photon/kd_tree.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+
+#include <algorithm>
+#include <bit>
+#include <limits>
+
+namespace photond {
+namespace {
+
+// What the build sorts: 16 bytes (moved faster than 20-byte photons), and the input index that
+// breaks ties between equal coordinates.
+struct BuildItem {
+    Vec3 position;
+    uint32_t index;
+};
+static_assert(sizeof(BuildItem) == 16);
+
+// Subtrees at least this large are built as separate tasks.
+constexpr uint32_t kParallelThreshold = 1u << 14;
+constexpr uint8_t kLeafAxis = 3;
+
+// The order (coordinate, index) as one integer: the float's bits mapped to an unsigned integer
+// of the same order (-0 before +0, which stays consistent with the float order the queries use),
+// then the index. One compare instead of two branches.
+template <int kAxis>
+uint64_t sort_key(const BuildItem& item) {
+    const uint32_t bits = std::bit_cast<uint32_t>(item.position[kAxis]);
+    const uint32_t ordered = (bits & 0x80000000u) ? ~bits : (bits | 0x80000000u);
+    return (uint64_t(ordered) << 32) | item.index;
+}
+
+template <int kAxis>
+void select_median(BuildItem* first, BuildItem* median, BuildItem* last) {
+    std::nth_element(first, median, last, [](const BuildItem& a, const BuildItem& b) {
+        return sort_key<kAxis>(a) < sort_key<kAxis>(b);
+    });
+}
+
+uint8_t widest_axis(const BuildItem* items, uint32_t lo, uint32_t hi) {
+    Vec3 lower = items[lo].position, upper = items[lo].position;
+    for (uint32_t i = lo + 1; i < hi; ++i) {
+        lower = glm::min(lower, items[i].position);
+        upper = glm::max(upper, items[i].position);
+    }
+    const Vec3 e = upper - lower;
+    if (e.x >= e.y && e.x >= e.z) return 0;
+    return e.y >= e.z ? 1 : 2;
+}
+
+// Builds the subtree [lo, hi): its median by (coordinate, index) on the widest axis goes to the
+// middle, the rest to either side (Jensen 2001, section 6.3, with a median split instead of the
+// left-balanced one). Every step depends only on the contents of [lo, hi), never on timing.
+void build_subtree(BuildItem* items, uint8_t* axes, uint32_t lo, uint32_t hi) {
+    if (hi - lo <= PhotonKdTree::kLeafSize) return;
+    const uint8_t axis = widest_axis(items, lo, hi);
+    const uint32_t mid = lo + (hi - lo) / 2;
+    switch (axis) {
+        case 0: select_median<0>(items + lo, items + mid, items + hi); break;
+        case 1: select_median<1>(items + lo, items + mid, items + hi); break;
+        default: select_median<2>(items + lo, items + mid, items + hi); break;
+    }
+    axes[mid] = axis;
+    if (hi - lo >= kParallelThreshold) {
+        tbb::parallel_invoke([=] { build_subtree(items, axes, lo, mid); },
+                             [=] { build_subtree(items, axes, mid + 1, hi); });
+    } else {
+        build_subtree(items, axes, lo, mid);
+        build_subtree(items, axes, mid + 1, hi);
+    }
+}
+
+// (dist2, index) order of the k-nearest max-heap: the result is the k smallest in this order.
+bool closer(const KnnNeighbor& a, const KnnNeighbor& b) {
+    return a.dist2 < b.dist2 || (a.dist2 == b.dist2 && a.index < b.index);
+}
+
+// Replaces the root of the max-heap heap[0, n) and restores the heap property.
+void replace_heap_top(KnnNeighbor* heap, size_t n, KnnNeighbor value) {
+    size_t i = 0;
+    for (;;) {
+        size_t child = 2 * i + 1;
+        if (child >= n) break;
+        if (child + 1 < n && closer(heap[child], heap[child + 1])) ++child;
+        if (!closer(value, heap[child])) break;
+        heap[i] = heap[child];
+        i = child;
+    }
+    heap[i] = value;
+}
+
+}  // namespace
+
+void KnnResult::sort_by_distance() { std::sort(neighbors.begin(), neighbors.end(), closer); }
+
+PhotonKdTree::PhotonKdTree(std::vector<Photon> photons) {
+    const size_t max_photons = std::numeric_limits<uint32_t>::max() - 1;
+    std::vector<BuildItem> items;
+    items.reserve(std::min(photons.size(), max_photons));
+    for (size_t i = 0; i < photons.size() && items.size() < max_photons; ++i) {
+        const Vec3& position = photons[i].position;
+        if (!is_finite(position)) continue;
+        items.push_back({position, uint32_t(i)});
+        bounds_.extend(position);
+    }
+    const uint32_t n = uint32_t(items.size());
+    if (n == 0) return;
+
+    std::vector<uint8_t> axes(n, kLeafAxis);
+    build_subtree(items.data(), axes.data(), 0, n);
+
+    photons_.resize(n);
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, n, 1u << 14),
+                      [&](const tbb::blocked_range<uint32_t>& range) {
+                          for (uint32_t i = range.begin(); i < range.end(); ++i) {
+                              photons_[i] = photons[items[i].index];
+                              photons_[i].set_split_axis(axes[i]);
+                          }
+                      });
+}
+
+void PhotonKdTree::k_nearest(const Vec3& p, uint32_t k, float max_radius, KnnResult& out) const {
+    out.clear();
+    if (k == 0 || photons_.empty() || !is_finite(p) || !(max_radius >= 0.0f)) return;
+    std::vector<KnnNeighbor>& heap = out.neighbors;
+    const size_t capacity = std::min<size_t>(k, photons_.size());
+    if (heap.capacity() < capacity) heap.reserve(capacity);
+
+    // Until the heap is full, r2 is the max_radius ball; then the heap top's distance (Jensen
+    // 2001, section 6.3.1). Subtrees whose plane distance equals r2 are still visited, since
+    // they may hold a photon at the same distance with a smaller index.
+    float r2 = max_radius * max_radius;
+    float farthest2 = 0.0f;
+    bool full = false;
+    const auto consider = [&](uint32_t index, float d2) {
+        if (d2 > r2) return;
+        if (!full) {
+            heap.push_back({index, d2});
+            farthest2 = std::max(farthest2, d2);
+            if (heap.size() == capacity) {
+                std::make_heap(heap.begin(), heap.end(), closer);
+                full = true;
+                r2 = heap[0].dist2;
+            }
+        } else if (closer({index, d2}, heap[0])) {
+            replace_heap_top(heap.data(), heap.size(), {index, d2});
+            r2 = heap[0].dist2;
+        }
+    };
+
+    struct Entry {
+        uint32_t lo, hi;
+        float plane2;  // squared distance from p to the splitting plane that bounds this subtree
+    };
+    Entry stack[kMaxStackDepth];
+    int top = 0;
+    stack[top++] = {0, size(), 0.0f};
+    while (top > 0) {
+        const Entry entry = stack[--top];
+        if (entry.plane2 > r2) continue;
+        uint32_t lo = entry.lo, hi = entry.hi;
+        while (hi - lo > kLeafSize) {
+            const uint32_t mid = lo + (hi - lo) / 2;
+            const Photon& node = photons_[mid];
+            consider(mid, distance2(p, node.position));
+            const uint32_t axis = node.split_axis();
+            const float plane = p[axis] - node.position[axis];
+            const float plane2 = plane * plane;
+            if (plane <= 0.0f) {  // near side first; the far side waits on the stack
+                if (plane2 <= r2) stack[top++] = {mid + 1, hi, plane2};
+                hi = mid;
+            } else {
+                if (plane2 <= r2) stack[top++] = {lo, mid, plane2};
+                lo = mid + 1;
+            }
+        }
+        for (uint32_t i = lo; i < hi; ++i) consider(i, distance2(p, photons_[i].position));
+    }
+    out.radius2 = full ? heap[0].dist2 : farthest2;
+}
+
+}  // namespace photond

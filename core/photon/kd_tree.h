@@ -1,0 +1,141 @@
+// The photon map's kd-tree (Jensen, "Realistic Image Synthesis Using Photon Mapping", 2001,
+// section 6.3): a balanced tree over the photons themselves, stored implicitly in one array.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "core/photon/photon.h"
+#include "core/scene/scene.h"
+
+namespace photond {
+
+/// One photon found by a query: its index in the tree (PhotonKdTree::photon) and its squared
+/// distance to the query point.
+struct KnnNeighbor {
+    uint32_t index = 0;
+    float dist2 = 0.0f;
+};
+
+/// The result of PhotonKdTree::k_nearest. Keep one per thread and pass it to every query: its
+/// buffer is reused, so queries do not allocate once it has grown to k.
+struct KnnResult {
+    /// Up to k photons, in max-heap order of (dist2, index) (deterministic, not sorted; see
+    /// sort_by_distance).
+    std::vector<KnnNeighbor> neighbors;
+    /// Squared distance of the farthest photon returned: the radius actually used when k
+    /// photons were found (may be 0, e.g. coincident photons: never divide by it unchecked);
+    /// 0 when none was found. When fewer than k were found, the region searched was the
+    /// max_radius ball.
+    float radius2 = 0.0f;
+
+    size_t size() const { return neighbors.size(); }
+    bool empty() const { return neighbors.empty(); }
+    void clear() {
+        neighbors.clear();
+        radius2 = 0.0f;
+    }
+    /// Orders neighbors by increasing (dist2, index).
+    void sort_by_distance();
+};
+
+/// A kd-tree over photons, built once and then only read.
+///
+/// Thread safety: immutable after construction; every const member may be called concurrently
+/// from any number of threads (queries keep their state on the stack and in the caller's
+/// KnnResult). Share it as std::shared_ptr<const PhotonKdTree>.
+///
+/// Layout: the photons, reordered, in one array that is the tree in implicit in-order form: the
+/// subtree of index range [lo, hi) has its split photon at mid = lo + (hi - lo) / 2 (split axis
+/// in the photon's flags, split value its coordinate), left subtree [lo, mid), right subtree
+/// [mid + 1, hi); ranges of at most kLeafSize photons are leaves scanned linearly. Each subtree
+/// is contiguous in memory and no pointers or extra node records are stored: 20 bytes per photon,
+/// like Jensen's left-balanced heap, and faster to query (bench/kd_tree_bench.cpp measures both).
+/// Split axis: the largest extent of the subtree's bounding box (lowest axis on ties); split at
+/// the median of (coordinate, input index), so equal coordinates are ordered deterministically.
+///
+/// Build: parallel over subtrees with oneTBB in the current task arena; the tree does not
+/// depend on the number of threads. Photons with a non-finite position are dropped, so
+/// size() may be less than the input's size. Indices are positions in the tree's order, not in
+/// the input vector.
+class PhotonKdTree {
+public:
+    static constexpr uint32_t kLeafSize = 8;
+
+    /// An empty tree: every query returns nothing.
+    PhotonKdTree() = default;
+    /// Builds the tree; takes the photons (at most 2^32 - 2 are kept).
+    explicit PhotonKdTree(std::vector<Photon> photons);
+
+    /// The (at most) k photons nearest to p within max_radius (distance <= max_radius), the
+    /// nearest by (squared distance, index): ties are broken by the smaller index, so the result
+    /// is exactly that of a brute-force search. Empty for k = 0, an empty tree, a non-finite p,
+    /// or a negative or NaN max_radius; max_radius may be +infinity.
+    void k_nearest(const Vec3& p, uint32_t k, float max_radius, KnnResult& out) const;
+
+    /// Calls f(uint32_t index, float dist2) for every photon with distance <= radius to p, in a
+    /// deterministic order. Nothing for a non-finite p or a negative or NaN radius.
+    template <class F>
+    void for_each_in_radius(const Vec3& p, float radius, F&& f) const;
+
+    const Photon& photon(uint32_t index) const { return photons_[index]; }
+    std::span<const Photon> photons() const { return photons_; }
+    uint32_t size() const { return uint32_t(photons_.size()); }
+    bool empty() const { return photons_.empty(); }
+    /// Memory held by the tree (the photon array's capacity).
+    size_t bytes() const { return photons_.capacity() * sizeof(Photon); }
+    /// Bounds of the photon positions (empty for an empty tree).
+    const Bounds3& bounds() const { return bounds_; }
+
+    /// The squared distance every query uses (one expression, so tests can reproduce it).
+    static float distance2(const Vec3& a, const Vec3& b) {
+        const float dx = a.x - b.x, dy = a.y - b.y, dz = a.z - b.z;
+        return dx * dx + dy * dy + dz * dz;
+    }
+
+private:
+    // Deeper than any balanced tree over < 2^32 photons (depth <= 32).
+    static constexpr int kMaxStackDepth = 64;
+
+    std::vector<Photon> photons_;
+    Bounds3 bounds_;
+};
+
+template <class F>
+void PhotonKdTree::for_each_in_radius(const Vec3& p, float radius, F&& f) const {
+    if (photons_.empty() || !is_finite(p) || !(radius >= 0.0f)) return;
+    const float r2 = radius * radius;
+    struct Range {
+        uint32_t lo, hi;
+    };
+    Range stack[kMaxStackDepth];
+    int top = 0;
+    stack[top++] = {0, size()};
+    while (top > 0) {
+        --top;
+        uint32_t lo = stack[top].lo, hi = stack[top].hi;
+        while (hi - lo > kLeafSize) {
+            const uint32_t mid = lo + (hi - lo) / 2;
+            const Photon& node = photons_[mid];
+            const float d2 = distance2(p, node.position);
+            if (d2 <= r2) f(mid, d2);
+            const uint32_t axis = node.split_axis();
+            const float plane = p[axis] - node.position[axis];
+            if (plane <= 0.0f) {  // p on the left side: the right one only if the ball crosses
+                if (plane * plane <= r2) stack[top++] = {mid + 1, hi};
+                hi = mid;
+            } else {
+                if (plane * plane <= r2) stack[top++] = {lo, mid};
+                lo = mid + 1;
+            }
+        }
+        for (uint32_t i = lo; i < hi; ++i) {
+            const float d2 = distance2(p, photons_[i].position);
+            if (d2 <= r2) f(i, d2);
+        }
+    }
+}
+
+}  // namespace photond

@@ -1,0 +1,90 @@
+#include "core/photon/photon.h"
+
+#include <cfloat>
+#include <cmath>
+
+namespace photond {
+namespace {
+
+// constexpr sine and cosine (Taylor series in double, arguments in [-pi, pi]) so that the
+// decoding tables are constant-initialised: no static initialisation order to worry about.
+constexpr double kPiDouble = 3.14159265358979323846;
+
+constexpr double reduce_angle(double x) {
+    while (x > kPiDouble) x -= 2.0 * kPiDouble;
+    while (x < -kPiDouble) x += 2.0 * kPiDouble;
+    return x;
+}
+
+constexpr double constexpr_sin(double x) {
+    x = reduce_angle(x);
+    double term = x, sum = x;
+    for (int n = 1; n < 30; ++n) {
+        term *= -x * x / double((2 * n) * (2 * n + 1));
+        sum += term;
+    }
+    return sum;
+}
+
+constexpr double constexpr_cos(double x) { return constexpr_sin(x + 0.5 * kPiDouble); }
+
+constexpr PhotonDirectionTables make_direction_tables() {
+    PhotonDirectionTables t{};
+    for (int i = 0; i < 256; ++i) {
+        const double theta = (i + 0.5) * kPiDouble / 256.0;
+        const double phi = (i + 0.5) * 2.0 * kPiDouble / 256.0;
+        t.cos_theta[i] = float(constexpr_cos(theta));
+        t.sin_theta[i] = float(constexpr_sin(theta));
+        t.cos_phi[i] = float(constexpr_cos(phi));
+        t.sin_phi[i] = float(constexpr_sin(phi));
+    }
+    return t;
+}
+
+// Flux channels as encodable numbers: NaN and negatives -> 0, +inf -> FLT_MAX.
+float sanitize_channel(float c) {
+    if (!(c > 0.0f)) return 0.0f;
+    return std::min(c, FLT_MAX);
+}
+
+}  // namespace
+
+constinit const PhotonDirectionTables kPhotonDirectionTables = make_direction_tables();
+
+Photon make_photon(Vec3 position, Vec3 direction, Color flux, uint8_t user_flags) {
+    Photon p;
+    p.position = position;
+    p.flags_ = uint8_t((user_flags << 2) | 3u);
+
+    // Flux: shared exponent from the largest channel, mantissas rounded to nearest (the encoded
+    // value is the representable one nearest to each channel for that exponent).
+    const double rgb[3] = {sanitize_channel(flux.x), sanitize_channel(flux.y),
+                           sanitize_channel(flux.z)};
+    const double largest = std::max(rgb[0], std::max(rgb[1], rgb[2]));
+    int exponent = 0;
+    std::frexp(largest, &exponent);  // largest = f * 2^exponent, f in [0.5, 1)
+    if (largest > 0.0 && exponent >= Photon::kMinFluxExponent) {
+        if (std::lround(std::ldexp(largest, 10 - exponent)) >= 1024) ++exponent;  // rounds up
+        exponent = std::min(exponent, Photon::kMaxFluxExponent);
+        uint32_t mantissas = 0;
+        for (int c = 0; c < 3; ++c) {
+            const long m = std::min(1023l, std::lround(std::ldexp(rgb[c], 10 - exponent)));
+            mantissas |= uint32_t(m) << (10 * c);
+        }
+        p.flux_mantissas_ = mantissas;
+        p.flux_exponent_ = uint8_t(exponent - Photon::kMinFluxExponent + 1);
+    }
+
+    // Direction: theta = acos(z), phi = atan2(y, x) (Jensen 2001, section 6.3).
+    const float length = glm::length(direction);
+    Vec3 d = (length > 0.0f && std::isfinite(length)) ? direction / length : Vec3(0, 0, 1);
+    if (!is_finite(d)) d = Vec3(0, 0, 1);
+    const float theta = std::acos(std::clamp(d.z, -1.0f, 1.0f));
+    float phi = std::atan2(d.y, d.x);
+    if (phi < 0.0f) phi += 2.0f * kPi;
+    p.theta_ = uint8_t(std::min(255, int(theta * (256.0f / kPi))));
+    p.phi_ = uint8_t(int(phi * (256.0f / (2.0f * kPi))) & 255);  // phi = 2 pi wraps to bin 0
+    return p;
+}
+
+}  // namespace photond

@@ -1,0 +1,16 @@
+#include "core/render/render_scene.h"
+
+namespace photond {
+
+Expected<std::shared_ptr<const RenderScene>> RenderScene::create(std::shared_ptr<EmbreeDevice> device,
+                                                                 std::shared_ptr<const Scene> scene) {
+    auto render_scene = std::make_shared<RenderScene>();
+    render_scene->scene = scene;
+    auto tracer = RayTracer::build(std::move(device), *scene);
+    if (!tracer) return tracer.error();
+    render_scene->tracer = std::move(tracer).value();
+    render_scene->lights = std::make_unique<LightSet>(*scene);
+    return std::shared_ptr<const RenderScene>(std::move(render_scene));
+}
+
+}  // namespace photond

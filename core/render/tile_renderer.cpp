@@ -1,0 +1,84 @@
+#include "core/render/tile_renderer.h"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <mutex>
+
+namespace photond {
+
+std::vector<PixelRect> make_tiles(const PixelRect& area, int tile_size) {
+    std::vector<PixelRect> tiles;
+    const int size = std::max(tile_size, 1);
+    for (int y = area.y0; y < area.y1; y += size) {
+        for (int x = area.x0; x < area.x1; x += size) {
+            tiles.push_back({x, y, std::min(x + size, area.x1), std::min(y + size, area.y1)});
+        }
+    }
+    return tiles;
+}
+
+TileRenderResult render_tiles(const Integrator& integrator, const Camera& camera,
+                              const TileSettings& settings, const RenderCallbacks& callbacks) {
+    const int width = camera.width(), height = camera.height();
+    const PixelRect frame{0, 0, width, height};
+    const PixelRect area = settings.region ? settings.region->intersect(frame) : frame;
+    const std::vector<PixelRect> tiles = make_tiles(area, settings.tile_size);
+    const int spp = std::max(settings.samples_per_pixel, 1);
+
+    TileRenderResult result;
+    result.image = Image(width, height);
+    result.tiles_total = tiles.size();
+    std::atomic<size_t> tiles_done{0};
+    std::atomic<bool> cancelled{false};
+    tbb::enumerable_thread_specific<RayCounters> counters;
+
+    auto render_tile = [&](const PixelRect& tile) {
+        enable_flush_denormals();
+        RayCounters& local = counters.local();
+        for (int y = tile.y0; y < tile.y1; ++y) {
+            for (int x = tile.x0; x < tile.x1; ++x) {
+                const uint64_t pixel = static_cast<uint64_t>(y) * static_cast<uint64_t>(width) + x;
+                DVec3 sum(0.0);
+                for (int s = 0; s < spp; ++s) {
+                    Rng rng = Rng::for_stream(settings.seed, pixel, static_cast<uint64_t>(s));
+                    SampleContext context{rng, local};
+                    const Vec2 jitter = rng.next_vec2();
+                    const CameraRay ray = camera.generate_ray(static_cast<float>(x) + jitter.x,
+                                                              static_cast<float>(y) + jitter.y);
+                    const Color L = integrator.radiance(ray, context);
+                    // A non-finite sample (a numerical failure) is dropped rather than poisoning
+                    // the pixel; every pixel of the output stays finite.
+                    if (is_finite(L)) sum += DVec3(L);
+                }
+                result.image.at(x, y) = Color(sum / static_cast<double>(spp));
+            }
+        }
+    };
+
+    tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
+    arena.execute([&] {
+        tbb::parallel_for(
+            tbb::blocked_range<size_t>(0, tiles.size(), 1),
+            [&](const tbb::blocked_range<size_t>& range) {
+                for (size_t i = range.begin(); i != range.end(); ++i) {
+                    if ((callbacks.cancel && callbacks.cancel->load(std::memory_order_relaxed)) ||
+                        cancelled.load(std::memory_order_relaxed)) {
+                        cancelled = true;
+                        return;
+                    }
+                    render_tile(tiles[i]);
+                    const size_t done = tiles_done.fetch_add(1) + 1;
+                    if (callbacks.on_tile) callbacks.on_tile({tiles[i], done, tiles.size()}, result.image);
+                }
+            },
+            tbb::simple_partitioner());
+    });
+    for (const RayCounters& c : counters) result.counters += c;
+    result.tiles_done = tiles_done.load();
+    result.cancelled = cancelled.load();
+    return result;
+}
+
+}  // namespace photond

@@ -1,0 +1,56 @@
+// The tile renderer: splits the frame (or a region of it) into tiles, renders them in parallel on
+// a oneTBB arena, and reports each finished tile. Every pixel sample draws its random numbers from
+// a stream derived from (seed, pixel, sample), so the image is bit-identical for any thread count
+// and any tile order.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "core/camera/camera.h"
+#include "core/image/image.h"
+#include "core/integrators/integrator.h"
+
+namespace photond {
+
+struct TileSettings {
+    int tile_size = 32;
+    int samples_per_pixel = 4;
+    uint64_t seed = 1;
+    int threads = 0;                     // 0 = every core
+    std::optional<PixelRect> region;     // render only this part of the frame (others stay black)
+};
+
+/// The tiles covering `area`, row by row.
+std::vector<PixelRect> make_tiles(const PixelRect& area, int tile_size);
+
+struct TileEvent {
+    PixelRect rect;
+    size_t tiles_done = 0;
+    size_t tiles_total = 0;
+};
+
+struct RenderCallbacks {
+    /// Called after each tile, from the worker thread that finished it (calls may overlap);
+    /// `frame` holds the finished tile's pixels (and other tiles' in any state).
+    std::function<void(const TileEvent&, const Image& frame)> on_tile;
+    /// Checked before each tile starts: when set, the remaining tiles are skipped.
+    const std::atomic<bool>* cancel = nullptr;
+};
+
+struct TileRenderResult {
+    Image image;
+    RayCounters counters;
+    size_t tiles_done = 0;
+    size_t tiles_total = 0;
+    bool cancelled = false;
+};
+
+/// Renders with `integrator` through `camera` (whose size is the frame's).
+TileRenderResult render_tiles(const Integrator& integrator, const Camera& camera,
+                              const TileSettings& settings, const RenderCallbacks& callbacks = {});
+
+}  // namespace photond

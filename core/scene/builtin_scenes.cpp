@@ -1,0 +1,302 @@
+#include "core/scene/builtin_scenes.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "core/math/frame.h"
+#include "core/scene/shapes.h"
+
+namespace photond {
+
+namespace {
+
+// Sphere tessellation: level 5 (20480 triangles) so that smooth-normal glass refracts cleanly.
+constexpr int kSphereSubdivisions = 5;
+
+Material lambertian(std::string name, const Color& albedo) {
+    Material m;
+    m.name = std::move(name);
+    m.base_color = albedo;
+    m.metallic = 0.0f;
+    m.roughness = 1.0f;
+    m.specular = 0.0f;  // KHR_materials_specular factor 0: no dielectric layer, purely Lambertian
+    return m;
+}
+
+Material emitter(std::string name, const Color& albedo, const Color& radiance) {
+    Material m = lambertian(std::move(name), albedo);
+    m.emission = radiance;
+    m.double_sided = false;
+    return m;
+}
+
+Material mirror(std::string name) {
+    Material m;
+    m.name = std::move(name);
+    m.base_color = Color(0.95f);
+    m.metallic = 1.0f;
+    m.roughness = 0.0f;
+    return m;
+}
+
+Material glass(std::string name) {
+    Material m;
+    m.name = std::move(name);
+    m.base_color = Color(1.0f);
+    m.metallic = 0.0f;
+    m.roughness = 0.0f;
+    m.transmission = 1.0f;
+    m.ior = 1.5f;
+    return m;
+}
+
+/// A level-kSphereSubdivisions sphere of `radius` whose lowest vertex touches y = floor_y.
+MeshData sphere_resting_on(float floor_y, float x, float z, float radius) {
+    MeshData sphere = make_icosphere(Vec3(0.0f), radius, kSphereSubdivisions);
+    float lowest = 0.0f;
+    for (const Vec3& p : sphere.positions) lowest = std::min(lowest, p.y);
+    const Vec3 offset(x, floor_y - lowest, z);
+    for (Vec3& p : sphere.positions) p += offset;
+    return sphere;
+}
+
+Expected<Scene> finish(SceneBuilder& builder, const Status& status, std::string_view name) {
+    if (!status) {
+        return Error{"built-in scene '" + std::string(name) + "': " + status.error().message};
+    }
+    return builder.build();
+}
+
+/// Jensen's photon-mapping Cornell box; see the header for the layout.
+Expected<Scene> make_cornell_box() {
+    constexpr float kHalf = 2.75f, kHeight = 5.5f, kLightSide = 1.3f, kLightGap = 0.01f;
+    SceneBuilder builder("cornell-box");
+    const uint32_t white = builder.add_material(lambertian("white", Color(0.75f)));
+    const uint32_t red = builder.add_material(lambertian("red", Color(0.75f, 0.25f, 0.25f)));
+    const uint32_t blue = builder.add_material(lambertian("blue", Color(0.25f, 0.25f, 0.75f)));
+    const uint32_t light =
+        builder.add_material(emitter("light", Color(0.75f), Color(kCornellLightRadiance)));
+    const uint32_t chrome = builder.add_material(mirror("mirror"));
+    const uint32_t crystal = builder.add_material(glass("glass"));
+
+    const Vec3 interior(0.0f, 0.5f * kHeight, 0.0f);
+    const Vec3 ex(2.0f * kHalf, 0.0f, 0.0f), ey(0.0f, kHeight, 0.0f), ez(0.0f, 0.0f, 2.0f * kHalf);
+    const Vec3 lower(-kHalf, 0.0f, -kHalf);
+    const Vec3 top = lower + ey;
+    const Vec3 right = lower + ex;
+    const Vec3 back = lower;
+    Status st;
+    // Every wall faces the interior; the front (z = +kHalf) stays open.
+    if (st) st = add_mesh(builder, make_quad(lower, ex, ez, interior - lower), white);  // floor
+    if (st) st = add_mesh(builder, make_quad(top, ex, ez, interior - top), white);      // ceiling
+    if (st) st = add_mesh(builder, make_quad(back, ex, ey, interior - back), white);    // back wall
+    if (st) st = add_mesh(builder, make_quad(lower, ey, ez, interior - lower), red);    // left, -x
+    if (st) st = add_mesh(builder, make_quad(right, ey, ez, interior - right), blue);   // right, +x
+    // The light: a thin square just below the ceiling, front face down.
+    const Vec3 light_corner(-0.5f * kLightSide, kHeight - kLightGap, -0.5f * kLightSide);
+    if (st) {
+        st = add_mesh(builder,
+                      make_quad(light_corner, Vec3(kLightSide, 0.0f, 0.0f),
+                                Vec3(0.0f, 0.0f, kLightSide), Vec3(0.0f, -1.0f, 0.0f)),
+                      light);
+    }
+    if (st) st = add_mesh(builder, sphere_resting_on(0.0f, -1.4f, -1.2f, 1.0f), chrome);
+    if (st) st = add_mesh(builder, sphere_resting_on(0.0f, 1.3f, 0.9f, 1.0f), crystal);
+
+    CameraDesc camera;
+    camera.name = "camera";
+    // Framing the open front (5.5 high) from 8 units in front of it, as the classic camera.
+    camera.position = Vec3(0.0f, 0.5f * kHeight, kHalf + 8.0f);
+    camera.look_at = Vec3(0.0f, 0.5f * kHeight, 0.0f);
+    camera.up = Vec3(0.0f, 1.0f, 0.0f);
+    camera.vfov_deg = 39.3077f;
+    camera.aspect = 0.0f;
+    builder.add_camera(camera);
+    return finish(builder, st, "cornell-box");
+}
+
+/// The Cornell box data (Cornell University Program of Computer Graphics), in millimetres; the
+/// scene scales it by 0.01. Quads in the published corner order.
+constexpr float kCornellScale = 0.01f;
+using Quad = std::array<Vec3, 4>;
+constexpr Quad kCornellFloor = {
+    {{552.8f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 559.2f}, {549.6f, 0.0f, 559.2f}}};
+constexpr Quad kCornellBackWall = {{{549.6f, 0.0f, 559.2f},
+                                    {0.0f, 0.0f, 559.2f},
+                                    {0.0f, 548.8f, 559.2f},
+                                    {556.0f, 548.8f, 559.2f}}};
+constexpr Quad kCornellRightWall = {{{0.0f, 0.0f, 559.2f},  // green
+                                     {0.0f, 0.0f, 0.0f},
+                                     {0.0f, 548.8f, 0.0f},
+                                     {0.0f, 548.8f, 559.2f}}};
+constexpr Quad kCornellLeftWall = {{{552.8f, 0.0f, 0.0f},  // red
+                                    {549.6f, 0.0f, 559.2f},
+                                    {556.0f, 548.8f, 559.2f},
+                                    {556.0f, 548.8f, 0.0f}}};
+// The ceiling 0..556 x 0..559.2 at y = 548.8, and the light 213..343 x 227..332 in it.
+constexpr float kCornellCeilingY = 548.8f;
+constexpr std::array<float, 4> kCornellCeilingX = {0.0f, 213.0f, 343.0f, 556.0f};
+constexpr std::array<float, 4> kCornellCeilingZ = {0.0f, 227.0f, 332.0f, 559.2f};
+// Blocks: the published top faces, in make_box's corner order (bits 0 and 2) at y = 0 and top.
+constexpr std::array<Vec2, 4> kShortBlockXZ = {
+    {{130.0f, 65.0f}, {82.0f, 225.0f}, {290.0f, 114.0f}, {240.0f, 272.0f}}};
+constexpr float kShortBlockHeight = 165.0f;
+constexpr std::array<Vec2, 4> kTallBlockXZ = {
+    {{423.0f, 247.0f}, {265.0f, 296.0f}, {472.0f, 406.0f}, {314.0f, 456.0f}}};
+constexpr float kTallBlockHeight = 330.0f;
+
+Quad scaled(const Quad& quad) {
+    return {quad[0] * kCornellScale, quad[1] * kCornellScale, quad[2] * kCornellScale,
+            quad[3] * kCornellScale};
+}
+
+MeshData cornell_block(const std::array<Vec2, 4>& xz, float height) {
+    std::array<Vec3, 8> corners;
+    for (int i = 0; i < 8; ++i) {
+        const Vec2& c = xz[(i & 1) | ((i & 4) >> 1)];
+        corners[i] = kCornellScale * Vec3(c.x, (i & 2) ? height : 0.0f, c.y);
+    }
+    return make_box(corners);
+}
+
+Expected<Scene> make_cornell_box_diffuse() {
+    SceneBuilder builder("cornell-box-diffuse");
+    const uint32_t white = builder.add_material(lambertian("white", Color(0.73f)));
+    const uint32_t red = builder.add_material(lambertian("red", Color(0.63f, 0.065f, 0.05f)));
+    const uint32_t green = builder.add_material(lambertian("green", Color(0.14f, 0.45f, 0.091f)));
+    const uint32_t light =
+        builder.add_material(emitter("light", Color(0.78f), kCornellDiffuseLightRadiance));
+
+    const Vec3 interior = kCornellScale * Vec3(278.0f, 274.4f, 279.6f);
+    const auto add_wall = [&](const Quad& quad, uint32_t material) {
+        const Quad q = scaled(quad);
+        const Vec3 centroid = 0.25f * (q[0] + q[1] + q[2] + q[3]);
+        return add_mesh(builder, make_quad(q, interior - centroid), material);
+    };
+    Status st = add_wall(kCornellFloor, white);
+    if (st) st = add_wall(kCornellBackWall, white);
+    if (st) st = add_wall(kCornellRightWall, green);
+    if (st) st = add_wall(kCornellLeftWall, red);
+    // The ceiling as a 3 x 3 grid whose centre cell is the light: the light sits exactly at the
+    // published height without z-fighting, and the cells share their corners (no T-junctions).
+    for (int i = 0; i < 3 && st; ++i) {
+        for (int k = 0; k < 3 && st; ++k) {
+            const float x0 = kCornellCeilingX[i], x1 = kCornellCeilingX[i + 1];
+            const float z0 = kCornellCeilingZ[k], z1 = kCornellCeilingZ[k + 1];
+            const Quad cell = {{{x1, kCornellCeilingY, z0},
+                                {x1, kCornellCeilingY, z1},
+                                {x0, kCornellCeilingY, z1},
+                                {x0, kCornellCeilingY, z0}}};
+            st = add_wall(cell, i == 1 && k == 1 ? light : white);
+        }
+    }
+    if (st) st = add_mesh(builder, cornell_block(kShortBlockXZ, kShortBlockHeight), white);
+    if (st) st = add_mesh(builder, cornell_block(kTallBlockXZ, kTallBlockHeight), white);
+
+    CameraDesc camera;
+    camera.name = "camera";
+    camera.position = kCornellScale * Vec3(278.0f, 273.0f, -800.0f);
+    camera.look_at = kCornellScale * Vec3(278.0f, 273.0f, 0.0f);
+    camera.up = Vec3(0.0f, 1.0f, 0.0f);
+    // 35 mm focal length on a 25 mm film.
+    camera.vfov_deg = 2.0f * std::atan(12.5f / 35.0f) * (180.0f / kPi);
+    camera.aspect = 0.0f;
+    builder.add_camera(camera);
+    return finish(builder, st, "cornell-box-diffuse");
+}
+
+/// "caustic" (area_light false) and "caustic-area" (area_light true).
+Expected<Scene> make_caustic(bool area_light) {
+    constexpr float kFloorHalf = 20.0f, kSphereRadius = 1.0f;
+    const std::string name = area_light ? "caustic-area" : "caustic";
+    SceneBuilder builder(name);
+    const uint32_t floor = builder.add_material(lambertian("floor", Color(0.8f)));
+    const uint32_t crystal = builder.add_material(glass("glass"));
+
+    Status st = add_mesh(
+        builder,
+        make_quad(Vec3(-kFloorHalf, 0.0f, -kFloorHalf), Vec3(2.0f * kFloorHalf, 0.0f, 0.0f),
+                  Vec3(0.0f, 0.0f, 2.0f * kFloorHalf), Vec3(0.0f, 1.0f, 0.0f)),
+        floor);
+    const MeshData sphere = sphere_resting_on(0.0f, 0.0f, 0.0f, kSphereRadius);
+    if (st) st = add_mesh(builder, sphere, crystal);
+
+    if (!area_light) {
+        PunctualLight light;
+        light.type = PunctualLightType::Point;
+        light.name = "point-light";
+        light.position = kCausticLightPosition;
+        light.intensity = Color(kCausticLightIntensity);
+        builder.add_light(light);
+    } else {
+        // Equal power: 4 pi I = pi L A, so L = 4 I / A.
+        constexpr float kArea = kCausticAreaLightSide * kCausticAreaLightSide;
+        const Color radiance(4.0f * kCausticLightIntensity / kArea);
+        const uint32_t light = builder.add_material(emitter("area-light", Color(0.0f), radiance));
+        const Vec3 sphere_center(0.0f, kSphereRadius, 0.0f);
+        const Frame frame(glm::normalize(sphere_center - kCausticLightPosition));
+        const Vec3 corner =
+            kCausticLightPosition - 0.5f * kCausticAreaLightSide * (frame.s + frame.t);
+        if (st) {
+            st = add_mesh(builder,
+                          make_quad(corner, kCausticAreaLightSide * frame.s,
+                                    kCausticAreaLightSide * frame.t, frame.n),
+                          light);
+        }
+    }
+
+    CameraDesc camera;
+    camera.name = "camera";
+    // Looking down at 30 degrees at the sphere and the caustic in front of it, to its right.
+    const Vec3 target(0.5f, 0.5f, 0.5f);
+    const float distance = 8.0f;
+    camera.look_at = target;
+    camera.position = target + distance * Vec3(0.0f, std::sin(kPi / 6.0f), std::cos(kPi / 6.0f));
+    camera.up = Vec3(0.0f, 1.0f, 0.0f);
+    camera.vfov_deg = 40.0f;
+    camera.aspect = 0.0f;
+    builder.add_camera(camera);
+    return finish(builder, st, name);
+}
+
+Expected<Scene> make_furnace() {
+    SceneBuilder builder("furnace");
+    const uint32_t shell =
+        builder.add_material(emitter("furnace", Color(kFurnaceAlbedo), Color(kFurnaceEmission)));
+    // Inward-facing: the front (emitting) side looks at the centre.
+    MeshData sphere = make_icosphere(Vec3(0.0f), 1.0f, 4);
+    flip_orientation(sphere);
+    const Status st = add_mesh(builder, sphere, shell);
+
+    CameraDesc camera;
+    camera.name = "camera";
+    camera.position = Vec3(0.0f);
+    camera.look_at = Vec3(0.0f, 0.0f, -1.0f);
+    camera.up = Vec3(0.0f, 1.0f, 0.0f);
+    camera.vfov_deg = 60.0f;
+    camera.aspect = 0.0f;
+    builder.add_camera(camera);
+    return finish(builder, st, "furnace");
+}
+
+}  // namespace
+
+std::vector<std::string> builtin_scene_names() {
+    return {"cornell-box", "cornell-box-diffuse", "caustic", "caustic-area", "furnace"};
+}
+
+Expected<Scene> make_builtin_scene(std::string_view name) {
+    if (name == "cornell-box") return make_cornell_box();
+    if (name == "cornell-box-diffuse") return make_cornell_box_diffuse();
+    if (name == "caustic") return make_caustic(false);
+    if (name == "caustic-area") return make_caustic(true);
+    if (name == "furnace") return make_furnace();
+    std::string known;
+    for (const std::string& n : builtin_scene_names()) known += (known.empty() ? "" : ", ") + n;
+    return Error{"unknown built-in scene '" + std::string(name) + "'; known scenes: " + known};
+}
+
+}  // namespace photond

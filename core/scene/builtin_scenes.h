@@ -1,0 +1,79 @@
+// Scenes compiled into the binary, for tests, validation against analytic results and demos.
+// Each has exactly one camera (aspect 0: the image's) that frames it. Radiometric units:
+// emission is radiance (W/m^2/sr), point-light intensity W/sr. Emission values are chosen so
+// that exposure 0 gives a well exposed image (direct irradiance about pi on the lit floor, so a
+// white Lambertian floor shows a radiance near its albedo).
+//
+//  "cornell-box"          Jensen's photon-mapping Cornell box ("Realistic Image Synthesis Using
+//                         Photon Mapping", 2001): a 5.5 x 5.5 x 5.5 box, x in [-2.75, 2.75]
+//                         (red wall at -x, blue at +x), y in [0, 5.5] (floor at 0), z in
+//                         [-2.75, 2.75], back wall at z = -2.75, open front at z = +2.75 facing
+//                         the camera. Lambertian walls: white 0.75, red (0.75, 0.25, 0.25), blue
+//                         (0.25, 0.25, 0.75). A 1.3 x 1.3 square light facing down, 0.01 below
+//                         the ceiling, radiance kCornellLightRadiance (white). A mirror sphere
+//                         (radius 1, back left) and a glass sphere (ior 1.5, radius 1, front
+//                         right) resting on the floor.
+//  "cornell-box-diffuse"  The Cornell University Program of Computer Graphics "Cornell Box" data
+//                         (556 x 548.8 x 559.2 mm, light 213..343 x 227..332 at y = 548.8, the
+//                         short and tall blocks at their published corners), in the published
+//                         coordinates scaled by 0.01 (1 unit = 10 cm). All Lambertian: white
+//                         (0.73), red (0.63, 0.065, 0.05) on the left (+x), green (0.14, 0.45,
+//                         0.091) on the right (x = 0). The light fills a hole cut in the ceiling
+//                         (no z-fighting, exact published position), radiance
+//                         kCornellDiffuseLightRadiance. Published camera: from (278, 273, -800)
+//                         towards +z, 35 mm lens on a 25 mm film: vfov = 2 atan(12.5 / 35).
+//  "caustic"              A glass sphere (ior 1.5, radius 1) resting on a 40 x 40 Lambertian
+//                         floor (0.8 grey) at y = 0, centre (0, ~1, 0), lit by a point light of
+//                         intensity kCausticLightIntensity at kCausticLightPosition (above, to the
+//                         left and behind), so that the focused caustic lands inside the shadow,
+//                         in front and to the right of the sphere, in view of the camera, which
+//                         looks down at 30 degrees.
+//  "caustic-area"         The same, with the point light replaced by a kCausticAreaLightSide
+//                         square one-sided Lambertian emitter centred at the same position and
+//                         facing the sphere's centre, of equal total power: point light
+//                         Phi = 4 pi I, area light Phi = pi L A, so L = 4 I / A. (Equal power,
+//                         not equal intensity: along its normal it is 4 times brighter and it
+//                         sends nothing behind its plane, so its image is about 2 stops brighter
+//                         than the point light's; compare it with its own path-traced reference.)
+//  "furnace"              A closed sphere of radius 1 whose faces (front, emitting side) point
+//                         to its centre, Lambertian with albedo kFurnaceAlbedo and emission
+//                         kFurnaceEmission; the camera at the centre. Every ray sees the radiance
+//                         Le / (1 - albedo) = kFurnaceRadiance = 2 (sum of the Neumann series).
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/math/vec.h"
+#include "core/scene/scene.h"
+#include "core/util/expected.h"
+
+namespace photond {
+
+inline constexpr float kFurnaceAlbedo = 0.5f;
+inline constexpr float kFurnaceEmission = 1.0f;
+/// The exact radiance everywhere inside the furnace: Le / (1 - albedo).
+inline constexpr float kFurnaceRadiance = kFurnaceEmission / (1.0f - kFurnaceAlbedo);
+
+/// "cornell-box": white light radiance; direct irradiance at the floor centre about pi.
+inline constexpr float kCornellLightRadiance = 57.0f;
+/// "cornell-box-diffuse": the light's radiance, warm white (relative colour of the usual RGB
+/// rendering of the data's spectrum); luminance of the direct irradiance at the floor centre
+/// about pi.
+inline constexpr Color kCornellDiffuseLightRadiance{90.0f, 68.5f, 33.0f};
+
+/// "caustic": point light position and intensity (W/sr); floor irradiance next to the sphere
+/// about pi.
+inline constexpr Vec3 kCausticLightPosition{-3.0f, 6.0f, -2.0f};
+inline constexpr float kCausticLightIntensity = 240.0f;
+/// "caustic-area": side of the square light replacing the point light.
+inline constexpr float kCausticAreaLightSide = 0.1f;
+
+/// The names make_builtin_scene accepts, in a fixed order.
+std::vector<std::string> builtin_scene_names();
+
+/// Builds a built-in scene; an unknown name gives an Error that lists the known names.
+Expected<Scene> make_builtin_scene(std::string_view name);
+
+}  // namespace photond

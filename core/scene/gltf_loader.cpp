@@ -1,0 +1,1234 @@
+#include "core/scene/gltf_loader.h"
+
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <exception>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <optional>
+#include <set>
+#include <string_view>
+#include <system_error>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+namespace photond {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Limits that keep hostile uploads from exhausting memory or the stack.
+constexpr uint64_t kMaxFileBytes = uint64_t(2) << 30;  // tinygltf takes 32-bit lengths
+constexpr int kMaxNodeDepth = 256;
+constexpr size_t kMaxNodeVisits = size_t(1) << 20;  // bounds DAG-shaped instancing blow-ups
+constexpr size_t kMaxSceneTriangles = size_t(1) << 25;
+constexpr size_t kMaxSceneVertices = size_t(1) << 26;
+constexpr uint32_t kMaxImageSide = 16384;
+constexpr uint64_t kMaxImagePixels = uint64_t(1) << 26;
+
+const std::set<std::string, std::less<>> kSupportedRequiredExtensions = {
+    "KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_transmission",
+    "KHR_materials_ior", "KHR_materials_specular"};
+
+std::string quoted(const std::string& name) { return name.empty() ? "" : " '" + name + "'"; }
+
+std::string trim_trailing_whitespace(std::string text) {
+    while (!text.empty() && std::isspace(static_cast<unsigned char>(text.back()))) text.pop_back();
+    return text;
+}
+
+// ---------------------------------------------------------------------------------------------
+// File access sandbox: every path tinygltf wants to open passes through these callbacks.
+
+struct FileSandbox {
+    bool allow_files = false;          // false for uploads: any external uri is refused
+    fs::path root;                     // canonical bundle root
+    std::string base_dir;              // the base directory handed to tinygltf
+    std::vector<std::string> refused;  // "uri (reason)" for every refusal, in order
+};
+
+bool path_is_inside(const fs::path& root, const fs::path& path) {
+    auto root_it = root.begin();
+    auto path_it = path.begin();
+    for (; root_it != root.end(); ++root_it, ++path_it) {
+        if (root_it->empty()) continue;  // trailing separator
+        if (path_it == path.end() || *root_it != *path_it) return false;
+    }
+    return true;
+}
+
+fs::path canonical_directory(const fs::path& dir) {
+    std::error_code ec;
+    fs::path canonical = fs::weakly_canonical(fs::absolute(dir, ec), ec);
+    if (ec) return {};
+    if (!canonical.has_filename() && canonical.has_relative_path())
+        canonical = canonical.parent_path();
+    return canonical;
+}
+
+void record_refusal(FileSandbox& box, const std::string& uri, const std::string& reason) {
+    const std::string entry = "uri '" + uri + "' " + reason;
+    if (std::find(box.refused.begin(), box.refused.end(), entry) == box.refused.end())
+        box.refused.push_back(entry);
+}
+
+// tinygltf joins the uri to base_dir, then tries "./" + uri relative to the working directory.
+// Returns the uri part of the first form; nullopt for the working-directory fallback, which is
+// never allowed (it would read relative to wherever the server happens to run).
+std::optional<std::string> uri_of_path(const FileSandbox& box, const std::string& path) {
+    if (!box.base_dir.empty()) {
+        const std::string prefix =
+            box.base_dir.back() == '/' ? box.base_dir : box.base_dir + "/";  // as tinygltf joins
+        if (path.compare(0, prefix.size(), prefix) == 0) return path.substr(prefix.size());
+        return std::nullopt;
+    }
+    if (path.compare(0, 2, "./") == 0) return path.substr(2);
+    return path;
+}
+
+bool looks_absolute_or_remote(const std::string& uri) {
+    if (uri.empty()) return false;
+    if (uri[0] == '/' || uri[0] == '\\') return true;
+    // "C:\x", "file:///x", "http://x": a scheme or drive letter before the first separator.
+    const size_t colon = uri.find(':');
+    const size_t slash = uri.find_first_of("/\\");
+    return colon != std::string::npos && (slash == std::string::npos || colon < slash);
+}
+
+// The canonical path of an allowed file, or nullopt (with the refusal recorded).
+std::optional<fs::path> resolve_in_sandbox(FileSandbox& box, const std::string& path) {
+    const std::optional<std::string> uri = uri_of_path(box, path);
+    if (!uri) return std::nullopt;
+    if (!box.allow_files) {
+        record_refusal(box, *uri,
+                       "refers to an external file; uploaded scenes must be self-contained "
+                       "(.glb or data: URIs only)");
+        return std::nullopt;
+    }
+    if (looks_absolute_or_remote(*uri)) {
+        record_refusal(box, *uri,
+                       "is absolute or remote; only relative paths inside the bundle "
+                       "root are allowed");
+        return std::nullopt;
+    }
+    std::error_code ec;
+    // weakly_canonical resolves "..", "." and symbolic links of every existing component.
+    const fs::path canonical = fs::weakly_canonical(fs::path(path), ec);
+    if (ec) return std::nullopt;
+    if (!path_is_inside(box.root, canonical)) {
+        record_refusal(box, *uri, "escapes the bundle root '" + box.root.string() + "'");
+        return std::nullopt;
+    }
+    return canonical;
+}
+
+bool sandbox_file_exists(const std::string& path, void* user) {
+    FileSandbox& box = *static_cast<FileSandbox*>(user);
+    const std::optional<fs::path> resolved = resolve_in_sandbox(box, path);
+    if (!resolved) return false;
+    std::error_code ec;
+    return fs::is_regular_file(*resolved, ec);
+}
+
+std::string sandbox_expand_path(const std::string& path, void*) { return path; }
+
+bool read_whole_file(const fs::path& path, std::vector<unsigned char>* out, std::string* err) {
+    std::error_code ec;
+    const uintmax_t size = fs::file_size(path, ec);
+    if (ec) {
+        if (err) *err = ec.message();
+        return false;
+    }
+    if (size > kMaxFileBytes) {
+        if (err) *err = "file larger than " + std::to_string(kMaxFileBytes) + " bytes";
+        return false;
+    }
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        if (err) *err = "cannot open";
+        return false;
+    }
+    out->resize(static_cast<size_t>(size));
+    if (size > 0 &&
+        !in.read(reinterpret_cast<char*>(out->data()), static_cast<std::streamsize>(size))) {
+        if (err) *err = "read failed";
+        return false;
+    }
+    return true;
+}
+
+bool sandbox_read_file(std::vector<unsigned char>* out, std::string* err, const std::string& path,
+                       void* user) {
+    FileSandbox& box = *static_cast<FileSandbox*>(user);
+    const std::optional<fs::path> resolved = resolve_in_sandbox(box, path);
+    if (!resolved) {
+        if (err) *err = "refused";
+        return false;
+    }
+    return read_whole_file(*resolved, out, err);
+}
+
+bool sandbox_write_file(std::string* err, const std::string&, const std::vector<unsigned char>&,
+                        void*) {
+    if (err) *err = "writing is not supported";
+    return false;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Images: tinygltf hands us the encoded bytes; we keep them as-is and decode only the images a
+// material actually uses, after the whole file was accepted.
+
+struct ImageLoadContext {
+    const tinygltf::Model* model = nullptr;
+};
+
+bool keep_encoded_image(tinygltf::Image* image, const int image_index, std::string* err,
+                        std::string*, int, int, const unsigned char* bytes, int size, void* user) {
+    const ImageLoadContext& context = *static_cast<const ImageLoadContext*>(user);
+    if (image->bufferView >= 0) {
+        // tinygltf does not check that an image's bufferView lies inside its buffer.
+        const tinygltf::Model& model = *context.model;
+        const auto view_index = static_cast<size_t>(image->bufferView);
+        const tinygltf::BufferView& view = model.bufferViews.at(view_index);
+        const tinygltf::Buffer& buffer = model.buffers.at(static_cast<size_t>(view.buffer));
+        if (view.byteOffset > buffer.data.size() ||
+            view.byteLength > buffer.data.size() - view.byteOffset) {
+            if (err)
+                *err += "image " + std::to_string(image_index) + ": bufferView " +
+                        std::to_string(view_index) + " reaches past the end of buffer " +
+                        std::to_string(view.buffer) + "\n";
+            return false;
+        }
+    }
+    if (bytes == nullptr || size <= 0) {
+        if (err) *err += "image " + std::to_string(image_index) + " is empty\n";
+        return false;
+    }
+    image->image.assign(bytes, bytes + size);
+    image->as_is = true;
+    return true;
+}
+
+bool is_png(std::span<const uint8_t> b) {
+    static constexpr uint8_t kMagic[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    return b.size() >= 8 && std::memcmp(b.data(), kMagic, 8) == 0;
+}
+
+bool is_jpeg(std::span<const uint8_t> b) {
+    return b.size() >= 3 && b[0] == 0xff && b[1] == 0xd8 && b[2] == 0xff;
+}
+
+uint32_t read_be16(const uint8_t* p) { return (uint32_t(p[0]) << 8) | p[1]; }
+uint32_t read_be32(const uint8_t* p) { return (read_be16(p) << 16) | read_be16(p + 2); }
+
+// Width and height from the PNG IHDR chunk or the first JPEG start-of-frame segment, so that
+// absurd images are refused before the decoder allocates.
+std::optional<std::pair<uint32_t, uint32_t>> encoded_image_size(std::span<const uint8_t> b) {
+    if (is_png(b)) {
+        if (b.size() < 24 || std::memcmp(b.data() + 12, "IHDR", 4) != 0) return std::nullopt;
+        return std::make_pair(read_be32(b.data() + 16), read_be32(b.data() + 20));
+    }
+    if (is_jpeg(b)) {
+        size_t pos = 2;
+        while (pos + 4 <= b.size()) {
+            if (b[pos] != 0xff) return std::nullopt;
+            const uint8_t marker = b[pos + 1];
+            if (marker == 0xff) {  // fill byte
+                ++pos;
+                continue;
+            }
+            if (marker == 0x01 || (marker >= 0xd0 && marker <= 0xd8)) {  // no payload
+                pos += 2;
+                continue;
+            }
+            const uint32_t length = read_be16(b.data() + pos + 2);
+            const bool start_of_frame = marker >= 0xc0 && marker <= 0xcf && marker != 0xc4 &&
+                                        marker != 0xc8 && marker != 0xcc;
+            if (start_of_frame) {
+                if (pos + 9 > b.size()) return std::nullopt;
+                return std::make_pair(read_be16(b.data() + pos + 7), read_be16(b.data() + pos + 5));
+            }
+            if (length < 2) return std::nullopt;
+            pos += 2 + length;
+        }
+    }
+    return std::nullopt;
+}
+
+// sRGB electro-optical transfer function, IEC 61966-2-1.
+float srgb_to_linear(float c) {
+    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
+Expected<Texture> decode_base_color_image(const tinygltf::Image& image, int image_index) {
+    const std::string what = "image " + std::to_string(image_index) + quoted(image.name) +
+                             (image.uri.empty() ? "" : " (uri '" + image.uri + "')");
+    if (!image.as_is || image.image.empty()) return Error{what + " could not be read"};
+    const std::span<const uint8_t> bytes(image.image.data(), image.image.size());
+    if (!is_png(bytes) && !is_jpeg(bytes)) return Error{what + " is neither PNG nor JPEG"};
+    const auto size = encoded_image_size(bytes);
+    if (!size) return Error{what + " has an unreadable header"};
+    const auto [width, height] = *size;
+    if (width == 0 || height == 0 || width > kMaxImageSide || height > kMaxImageSide ||
+        uint64_t(width) * height > kMaxImagePixels)
+        return Error{what + " has unsupported dimensions " + std::to_string(width) + "x" +
+                     std::to_string(height) + " (at most " + std::to_string(kMaxImageSide) +
+                     " per side and " + std::to_string(kMaxImagePixels) + " pixels)"};
+
+    tinygltf::Image decoded;
+    std::string err, warn;
+    // Without user data the decoder expands every image to RGBA, 8 or 16 bits per channel.
+    if (!tinygltf::LoadImageData(&decoded, image_index, &err, &warn, 0, 0, image.image.data(),
+                                 static_cast<int>(image.image.size()), nullptr))
+        return Error{what + " cannot be decoded: " + trim_trailing_whitespace(err)};
+    const size_t texel_count = size_t(decoded.width) * size_t(decoded.height);
+    const size_t bytes_per_channel = decoded.bits == 16 ? 2 : 1;
+    if (decoded.width <= 0 || decoded.height <= 0 || decoded.component != 4 ||
+        (decoded.bits != 8 && decoded.bits != 16) ||
+        decoded.image.size() < texel_count * 4 * bytes_per_channel)
+        return Error{what + " decoded to an unexpected pixel layout"};
+
+    Texture texture;
+    texture.width = decoded.width;
+    texture.height = decoded.height;
+    texture.texels.resize(texel_count);
+    if (decoded.bits == 8) {
+        float table[256];
+        for (int i = 0; i < 256; ++i) table[i] = srgb_to_linear(float(i) / 255.0f);
+        const uint8_t* p = decoded.image.data();
+        for (size_t i = 0; i < texel_count; ++i, p += 4)
+            texture.texels[i] = Color(table[p[0]], table[p[1]], table[p[2]]);
+    } else {
+        const uint8_t* p = decoded.image.data();
+        for (size_t i = 0; i < texel_count; ++i, p += 8) {
+            uint16_t rgb[3];
+            std::memcpy(rgb, p, sizeof(rgb));  // stb returns native-endian 16-bit samples
+            texture.texels[i] =
+                Color(srgb_to_linear(rgb[0] / 65535.0f), srgb_to_linear(rgb[1] / 65535.0f),
+                      srgb_to_linear(rgb[2] / 65535.0f));
+        }
+    }
+    return texture;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Accessors.
+
+int component_size(int component_type) {
+    switch (component_type) {
+        case TINYGLTF_COMPONENT_TYPE_BYTE:
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+            return 1;
+        case TINYGLTF_COMPONENT_TYPE_SHORT:
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+            return 2;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+        case TINYGLTF_COMPONENT_TYPE_FLOAT:
+            return 4;
+        default:
+            return 0;
+    }
+}
+
+int component_count(int type) {
+    switch (type) {
+        case TINYGLTF_TYPE_SCALAR:
+            return 1;
+        case TINYGLTF_TYPE_VEC2:
+            return 2;
+        case TINYGLTF_TYPE_VEC3:
+            return 3;
+        case TINYGLTF_TYPE_VEC4:
+            return 4;
+        case TINYGLTF_TYPE_MAT2:
+            return 4;
+        case TINYGLTF_TYPE_MAT3:
+            return 9;
+        case TINYGLTF_TYPE_MAT4:
+            return 16;
+        default:
+            return 0;
+    }
+}
+
+std::string type_name(int type) {
+    switch (type) {
+        case TINYGLTF_TYPE_SCALAR:
+            return "SCALAR";
+        case TINYGLTF_TYPE_VEC2:
+            return "VEC2";
+        case TINYGLTF_TYPE_VEC3:
+            return "VEC3";
+        case TINYGLTF_TYPE_VEC4:
+            return "VEC4";
+        case TINYGLTF_TYPE_MAT2:
+            return "MAT2";
+        case TINYGLTF_TYPE_MAT3:
+            return "MAT3";
+        case TINYGLTF_TYPE_MAT4:
+            return "MAT4";
+        default:
+            return "type " + std::to_string(type);
+    }
+}
+
+std::string component_type_name(int component_type) {
+    switch (component_type) {
+        case TINYGLTF_COMPONENT_TYPE_BYTE:
+            return "BYTE";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+            return "UNSIGNED_BYTE";
+        case TINYGLTF_COMPONENT_TYPE_SHORT:
+            return "SHORT";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+            return "UNSIGNED_SHORT";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+            return "UNSIGNED_INT";
+        case TINYGLTF_COMPONENT_TYPE_FLOAT:
+            return "FLOAT";
+        default:
+            return "componentType " + std::to_string(component_type);
+    }
+}
+
+/// An accessor's elements, tightly packed, with sparse substitution applied.
+struct PackedAccessor {
+    std::vector<uint8_t> bytes;
+    size_t count = 0;
+    int component_type = 0;
+    int components = 0;
+    bool normalized = false;
+};
+
+uint32_t read_unsigned(const uint8_t* p, int component_type) {
+    switch (component_type) {
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+            return p[0];
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+            uint16_t v;
+            std::memcpy(&v, p, 2);
+            return v;
+        }
+        default: {
+            uint32_t v;
+            std::memcpy(&v, p, 4);
+            return v;
+        }
+    }
+}
+
+// glTF 2.0 section 3.11 "Animations" gives the normalized-integer to float mapping used here.
+float read_float_component(const uint8_t* p, int component_type, bool normalized) {
+    switch (component_type) {
+        case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+            float v;
+            std::memcpy(&v, p, 4);
+            return v;
+        }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+            return normalized ? p[0] / 255.0f : float(p[0]);
+        case TINYGLTF_COMPONENT_TYPE_BYTE: {
+            const auto v = static_cast<int8_t>(p[0]);
+            return normalized ? std::max(v / 127.0f, -1.0f) : float(v);
+        }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+            uint16_t v;
+            std::memcpy(&v, p, 2);
+            return normalized ? v / 65535.0f : float(v);
+        }
+        case TINYGLTF_COMPONENT_TYPE_SHORT: {
+            int16_t v;
+            std::memcpy(&v, p, 2);
+            return normalized ? std::max(v / 32767.0f, -1.0f) : float(v);
+        }
+        default: {
+            uint32_t v;
+            std::memcpy(&v, p, 4);
+            return float(v);
+        }
+    }
+}
+
+/// What a mesh attribute or index accessor must look like.
+struct AccessorRule {
+    std::vector<int> types;
+    std::vector<int> float_component_types;       // accepted as they are
+    std::vector<int> normalized_component_types;  // accepted only with "normalized": true
+    std::vector<int> integer_component_types;     // accepted only without "normalized"
+};
+
+class GltfSceneReader {
+public:
+    GltfSceneReader(const tinygltf::Model& model, std::string display_name)
+        : model_(model), file_(std::move(display_name)), builder_(file_) {
+        for (const tinygltf::Buffer& buffer : model_.buffers)
+            total_buffer_bytes_ += buffer.data.size();
+    }
+
+    Expected<Scene> read();
+
+private:
+    Error fail(const std::string& message) const { return Error{file_ + ": " + message}; }
+
+    Expected<PackedAccessor> pack_accessor(int index, const std::string& context,
+                                           const std::string& role, const AccessorRule& rule);
+    Status check_view_range(int view_index, size_t byte_offset, size_t count, size_t element_size,
+                            bool use_view_stride, const std::string& what, const uint8_t** data,
+                            size_t* stride) const;
+
+    Status load_mesh(int mesh_index);
+    Expected<uint32_t> scene_material(int material_index);
+    Expected<int> scene_texture(int texture_index, const std::string& context);
+    Status visit_node(int node_index, const Mat4& parent, int depth);
+    Status add_camera(const tinygltf::Node& node, int node_index, const Mat4& world);
+    Status add_light(const tinygltf::Node& node, int node_index, const Mat4& world);
+    Expected<Mat4> local_transform(const tinygltf::Node& node, int node_index) const;
+
+    struct DecodedPrimitive {
+        std::vector<Vec3> positions;
+        std::vector<Vec3> normals;
+        std::vector<Vec2> uvs;
+        std::vector<glm::uvec3> triangles;
+        uint32_t material = 0;
+    };
+
+    const tinygltf::Model& model_;
+    std::string file_;
+    SceneBuilder builder_;
+    size_t total_buffer_bytes_ = 0;
+    std::vector<std::optional<std::vector<DecodedPrimitive>>> meshes_;
+    std::map<int, uint32_t> materials_;  // glTF material (-1: default) -> scene material
+    std::map<int, int> textures_;        // glTF image -> scene texture
+    std::vector<uint8_t> on_path_;       // cycle detection during the node walk
+    size_t node_visits_ = 0;
+    size_t triangle_count_ = 0;
+    size_t vertex_count_ = 0;
+};
+
+Status GltfSceneReader::check_view_range(int view_index, size_t byte_offset, size_t count,
+                                         size_t element_size, bool use_view_stride,
+                                         const std::string& what, const uint8_t** data,
+                                         size_t* stride) const {
+    if (view_index < 0 || static_cast<size_t>(view_index) >= model_.bufferViews.size())
+        return fail(what + " uses bufferView " + std::to_string(view_index) +
+                    ", which does not exist");
+    const tinygltf::BufferView& view = model_.bufferViews[static_cast<size_t>(view_index)];
+    const std::string view_name = "bufferView " + std::to_string(view_index) + quoted(view.name);
+    if (view.buffer < 0 || static_cast<size_t>(view.buffer) >= model_.buffers.size())
+        return fail(view_name + " uses buffer " + std::to_string(view.buffer) +
+                    ", which does not exist");
+    const std::vector<unsigned char>& buffer =
+        model_.buffers[static_cast<size_t>(view.buffer)].data;
+    if (view.byteOffset > buffer.size() || view.byteLength > buffer.size() - view.byteOffset)
+        return fail(view_name + " (bytes " + std::to_string(view.byteOffset) + " + " +
+                    std::to_string(view.byteLength) + ") reaches past the end of buffer " +
+                    std::to_string(view.buffer) + " (" + std::to_string(buffer.size()) + " bytes)");
+    *stride = use_view_stride && view.byteStride != 0 ? view.byteStride : element_size;
+    if (*stride < element_size)
+        return fail(view_name + " has byteStride " + std::to_string(view.byteStride) +
+                    ", smaller than the " + std::to_string(element_size) + "-byte elements of " +
+                    what);
+    *data = buffer.data() + view.byteOffset + byte_offset;
+    if (count == 0) return Status::ok();
+    // Overflow-safe form of byte_offset + stride * (count - 1) + element_size <= byteLength.
+    if (byte_offset > view.byteLength || view.byteLength - byte_offset < element_size ||
+        (count - 1) > (view.byteLength - byte_offset - element_size) / *stride)
+        return fail(what + " (" + std::to_string(count) + " elements from byte " +
+                    std::to_string(byte_offset) + ") reads past the end of its " + view_name +
+                    " (" + std::to_string(view.byteLength) + " bytes)");
+    return Status::ok();
+}
+
+Expected<PackedAccessor> GltfSceneReader::pack_accessor(int index, const std::string& context,
+                                                        const std::string& role,
+                                                        const AccessorRule& rule) {
+    if (index < 0 || static_cast<size_t>(index) >= model_.accessors.size())
+        return fail(context + role + " uses accessor " + std::to_string(index) +
+                    ", which does not exist");
+    const tinygltf::Accessor& accessor = model_.accessors[static_cast<size_t>(index)];
+    const std::string what =
+        context + "accessor " + std::to_string(index) + quoted(accessor.name) + " (" + role + ")";
+
+    const auto contains = [](const std::vector<int>& list, int v) {
+        return std::find(list.begin(), list.end(), v) != list.end();
+    };
+    if (!contains(rule.types, accessor.type))
+        return fail(what + " has type " + type_name(accessor.type) + ", expected " +
+                    type_name(rule.types.front()));
+    const int ct = accessor.componentType;
+    const bool accepted = contains(rule.float_component_types, ct) ||
+                          (accessor.normalized && contains(rule.normalized_component_types, ct)) ||
+                          (!accessor.normalized && contains(rule.integer_component_types, ct));
+    if (!accepted)
+        return fail(what + " has componentType " + component_type_name(ct) +
+                    (accessor.normalized ? " (normalized)" : "") + ", which " + role +
+                    " does not allow");
+
+    PackedAccessor packed;
+    packed.count = accessor.count;
+    packed.component_type = ct;
+    packed.components = component_count(accessor.type);
+    packed.normalized = accessor.normalized;
+    const size_t element_size = size_t(component_size(ct)) * size_t(packed.components);
+
+    if (accessor.bufferView >= 0) {
+        const uint8_t* data = nullptr;
+        size_t stride = 0;
+        if (Status st = check_view_range(accessor.bufferView, accessor.byteOffset, accessor.count,
+                                         element_size, true, what, &data, &stride);
+            !st)
+            return st.error();
+        packed.bytes.resize(accessor.count * element_size);
+        for (size_t i = 0; i < accessor.count; ++i)
+            std::memcpy(packed.bytes.data() + i * element_size, data + i * stride, element_size);
+    } else {
+        // No bufferView: all zeros (before sparse substitution). The count is not bounded by any
+        // buffer, so refuse counts beyond the file's whole binary payload before allocating.
+        if (accessor.count > total_buffer_bytes_)
+            return fail(what + " has count " + std::to_string(accessor.count) +
+                        ", beyond the size of all buffers (" + std::to_string(total_buffer_bytes_) +
+                        " bytes)");
+        packed.bytes.assign(accessor.count * element_size, 0);
+    }
+
+    if (accessor.sparse.isSparse) {
+        const auto& sparse = accessor.sparse;
+        if (sparse.count < 1 || static_cast<size_t>(sparse.count) > accessor.count)
+            return fail(what + " has a sparse count of " + std::to_string(sparse.count) + " for " +
+                        std::to_string(accessor.count) + " elements");
+        const int index_type = sparse.indices.componentType;
+        if (index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+            index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+            index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+            return fail(what + " has sparse indices of " + component_type_name(index_type));
+        if (sparse.indices.byteOffset < 0 || sparse.values.byteOffset < 0)
+            return fail(what + " has a negative sparse byteOffset");
+        const auto sparse_count = static_cast<size_t>(sparse.count);
+        const uint8_t* index_data = nullptr;
+        const uint8_t* value_data = nullptr;
+        size_t index_stride = 0, value_stride = 0;
+        if (Status st = check_view_range(sparse.indices.bufferView,
+                                         static_cast<size_t>(sparse.indices.byteOffset),
+                                         sparse_count, size_t(component_size(index_type)), false,
+                                         what + " sparse indices", &index_data, &index_stride);
+            !st)
+            return st.error();
+        if (Status st = check_view_range(sparse.values.bufferView,
+                                         static_cast<size_t>(sparse.values.byteOffset),
+                                         sparse_count, element_size, false, what + " sparse values",
+                                         &value_data, &value_stride);
+            !st)
+            return st.error();
+        for (size_t i = 0; i < sparse_count; ++i) {
+            const uint32_t target = read_unsigned(index_data + i * index_stride, index_type);
+            if (target >= accessor.count)
+                return fail(what + " sparse index " + std::to_string(i) + " is " +
+                            std::to_string(target) + ", beyond the " +
+                            std::to_string(accessor.count) + " elements");
+            std::memcpy(packed.bytes.data() + size_t(target) * element_size,
+                        value_data + i * value_stride, element_size);
+        }
+    }
+    return packed;
+}
+
+// Converts packed float-like accessor data, refusing NaN and infinity.
+template <typename VecT>
+Expected<std::vector<VecT>> unpack_vectors(const PackedAccessor& packed, const std::string& what) {
+    constexpr int kComponents = VecT::length();
+    std::vector<VecT> out(packed.count);
+    const size_t component_bytes = size_t(component_size(packed.component_type));
+    const uint8_t* p = packed.bytes.data();
+    for (size_t i = 0; i < packed.count; ++i) {
+        for (int c = 0; c < kComponents; ++c, p += component_bytes) {
+            const float v = read_float_component(p, packed.component_type, packed.normalized);
+            if (!std::isfinite(v))
+                return Error{what + " has a non-finite value at element " + std::to_string(i)};
+            out[i][c] = v;
+        }
+    }
+    return out;
+}
+
+const AccessorRule kPositionRule{{TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, {}, {}};
+const AccessorRule kNormalRule{{TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, {}, {}};
+const AccessorRule kTexcoordRule{
+    {TINYGLTF_TYPE_VEC2},
+    {TINYGLTF_COMPONENT_TYPE_FLOAT},
+    {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
+    {}};
+const AccessorRule kIndexRule{
+    {TINYGLTF_TYPE_SCALAR},
+    {},
+    {},
+    {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+     TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT}};
+
+// ---------------------------------------------------------------------------------------------
+// Materials and textures.
+
+// A number from an extension object: the default when absent, an error when of the wrong type.
+Expected<double> extension_number(const tinygltf::ExtensionMap& extensions, const char* extension,
+                                  const char* key, double fallback) {
+    const auto it = extensions.find(extension);
+    if (it == extensions.end() || !it->second.IsObject() || !it->second.Has(key)) return fallback;
+    const tinygltf::Value& v = it->second.Get(key);
+    if (!v.IsNumber()) return Error{std::string(extension) + "." + key + " is not a number"};
+    return v.GetNumberAsDouble();
+}
+
+Expected<Color> extension_color(const tinygltf::ExtensionMap& extensions, const char* extension,
+                                const char* key, Color fallback) {
+    const auto it = extensions.find(extension);
+    if (it == extensions.end() || !it->second.IsObject() || !it->second.Has(key)) return fallback;
+    const tinygltf::Value& v = it->second.Get(key);
+    if (!v.IsArray() || v.ArrayLen() != 3)
+        return Error{std::string(extension) + "." + key + " is not an array of 3 numbers"};
+    Color c;
+    for (int i = 0; i < 3; ++i) {
+        if (!v.Get(i).IsNumber())
+            return Error{std::string(extension) + "." + key + " is not an array of 3 numbers"};
+        c[i] = static_cast<float>(v.Get(i).GetNumberAsDouble());
+    }
+    return c;
+}
+
+Expected<int> GltfSceneReader::scene_texture(int texture_index, const std::string& context) {
+    if (texture_index < 0 || static_cast<size_t>(texture_index) >= model_.textures.size())
+        return fail(context + "baseColorTexture uses texture " + std::to_string(texture_index) +
+                    ", which does not exist");
+    const tinygltf::Texture& texture = model_.textures[static_cast<size_t>(texture_index)];
+    const int source = texture.source;
+    if (source < 0 || static_cast<size_t>(source) >= model_.images.size())
+        return fail(context + "texture " + std::to_string(texture_index) + quoted(texture.name) +
+                    " has no usable image source (" + std::to_string(source) + ")");
+    if (const auto it = textures_.find(source); it != textures_.end()) return it->second;
+    Expected<Texture> decoded =
+        decode_base_color_image(model_.images[static_cast<size_t>(source)], source);
+    if (!decoded) return fail(context + decoded.error().message);
+    const int scene_index = static_cast<int>(builder_.add_texture(std::move(decoded).value()));
+    textures_.emplace(source, scene_index);
+    return scene_index;
+}
+
+Expected<uint32_t> GltfSceneReader::scene_material(int material_index) {
+    if (const auto it = materials_.find(material_index); it != materials_.end()) return it->second;
+    Material m;
+    if (material_index < 0) {
+        // glTF 2.0 section 3.9.6: the default material has base colour 1, metallic 1,
+        // roughness 1.
+        m.name = "default";
+        m.base_color = Color(1.0f);
+        m.metallic = 1.0f;
+        m.roughness = 1.0f;
+    } else {
+        if (static_cast<size_t>(material_index) >= model_.materials.size())
+            return fail("material " + std::to_string(material_index) + " does not exist");
+        const tinygltf::Material& g = model_.materials[static_cast<size_t>(material_index)];
+        const std::string context =
+            "material " + std::to_string(material_index) + quoted(g.name) + ": ";
+        const tinygltf::PbrMetallicRoughness& pbr = g.pbrMetallicRoughness;
+        m.name = g.name.empty() ? "material " + std::to_string(material_index) : g.name;
+        if (pbr.baseColorFactor.size() != 4 || g.emissiveFactor.size() != 3)
+            return fail(context + "baseColorFactor or emissiveFactor has the wrong length");
+        m.base_color = glm::max(Color(float(pbr.baseColorFactor[0]), float(pbr.baseColorFactor[1]),
+                                      float(pbr.baseColorFactor[2])),
+                                Color(0.0f));
+        m.metallic = std::clamp(float(pbr.metallicFactor), 0.0f, 1.0f);
+        m.roughness = std::clamp(float(pbr.roughnessFactor), 0.0f, 1.0f);
+        m.double_sided = g.doubleSided;
+
+        const auto& ext = g.extensions;
+        Expected<double> strength =
+            extension_number(ext, "KHR_materials_emissive_strength", "emissiveStrength", 1.0);
+        Expected<double> transmission =
+            extension_number(ext, "KHR_materials_transmission", "transmissionFactor", 0.0);
+        Expected<double> ior = extension_number(ext, "KHR_materials_ior", "ior", 1.5);
+        Expected<double> specular =
+            extension_number(ext, "KHR_materials_specular", "specularFactor", 1.0);
+        Expected<Color> specular_color =
+            extension_color(ext, "KHR_materials_specular", "specularColorFactor", Color(1.0f));
+        for (const Error* e : {strength ? nullptr : &strength.error(),
+                               transmission ? nullptr : &transmission.error(),
+                               ior ? nullptr : &ior.error(), specular ? nullptr : &specular.error(),
+                               specular_color ? nullptr : &specular_color.error()}) {
+            if (e) return fail(context + e->message);
+        }
+        const Color emissive(float(g.emissiveFactor[0]), float(g.emissiveFactor[1]),
+                             float(g.emissiveFactor[2]));
+        m.emission = glm::max(emissive * float(*strength), Color(0.0f));
+        m.transmission = std::clamp(float(*transmission), 0.0f, 1.0f);
+        m.ior = std::max(float(*ior), 1.0f);
+        m.specular = std::clamp(float(*specular), 0.0f, 1.0f);
+        m.specular_color = glm::max(*specular_color, Color(0.0f));
+        if (!is_finite(m.base_color) || !is_finite(m.emission) || !is_finite(m.specular_color) ||
+            !std::isfinite(m.metallic) || !std::isfinite(m.roughness) || !std::isfinite(m.ior) ||
+            !std::isfinite(m.transmission) || !std::isfinite(m.specular))
+            return fail(context + "has a non-finite factor");
+
+        if (pbr.baseColorTexture.index >= 0) {
+            Expected<int> texture = scene_texture(pbr.baseColorTexture.index, context);
+            if (!texture) return texture.error();
+            m.base_color_texture = *texture;
+        }
+    }
+    const uint32_t index = builder_.add_material(std::move(m));
+    materials_.emplace(material_index, index);
+    return index;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Meshes.
+
+Status GltfSceneReader::load_mesh(int mesh_index) {
+    const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(mesh_index)];
+    std::vector<DecodedPrimitive> decoded;
+    for (size_t p = 0; p < mesh.primitives.size(); ++p) {
+        const tinygltf::Primitive& prim = mesh.primitives[p];
+        const std::string context = "mesh " + std::to_string(mesh_index) + quoted(mesh.name) +
+                                    " primitive " + std::to_string(p) + ": ";
+        const int mode = prim.mode;
+        if (mode == TINYGLTF_MODE_POINTS || mode == TINYGLTF_MODE_LINE ||
+            mode == TINYGLTF_MODE_LINE_LOOP || mode == TINYGLTF_MODE_LINE_STRIP)
+            continue;  // points and lines have no area to render
+        if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+            mode != TINYGLTF_MODE_TRIANGLE_FAN)
+            return fail(context + "unknown primitive mode " + std::to_string(mode));
+        const auto position_it = prim.attributes.find("POSITION");
+        if (position_it == prim.attributes.end()) continue;  // nothing to place
+
+        DecodedPrimitive out;
+        {
+            Expected<PackedAccessor> packed =
+                pack_accessor(position_it->second, context, "POSITION", kPositionRule);
+            if (!packed) return packed.error();
+            auto positions = unpack_vectors<Vec3>(*packed, "");
+            if (!positions) {
+                const auto& a = model_.accessors[static_cast<size_t>(position_it->second)];
+                return fail(context + "accessor " + std::to_string(position_it->second) +
+                            quoted(a.name) + " (POSITION)" + positions.error().message);
+            }
+            out.positions = std::move(positions).value();
+        }
+        const size_t vertex_count = out.positions.size();
+
+        // Reads an optional per-vertex attribute with the same element count as POSITION.
+        const auto read_attribute = [&](const std::string& name, const AccessorRule& rule,
+                                        auto* target) -> Status {
+            const auto it = prim.attributes.find(name);
+            if (it == prim.attributes.end()) return Status::ok();
+            Expected<PackedAccessor> packed = pack_accessor(it->second, context, name, rule);
+            if (!packed) return packed.error();
+            const auto& a = model_.accessors[static_cast<size_t>(it->second)];
+            const std::string what = context + "accessor " + std::to_string(it->second) +
+                                     quoted(a.name) + " (" + name + ")";
+            if (packed->count != vertex_count)
+                return fail(what + " has " + std::to_string(packed->count) +
+                            " elements but POSITION has " + std::to_string(vertex_count));
+            using VecT = typename std::remove_pointer_t<decltype(target)>::value_type;
+            auto values = unpack_vectors<VecT>(*packed, "");
+            if (!values) return fail(what + values.error().message);
+            *target = std::move(values).value();
+            return Status::ok();
+        };
+        if (Status st = read_attribute("NORMAL", kNormalRule, &out.normals); !st) return st;
+
+        Expected<uint32_t> material = scene_material(prim.material);
+        if (!material) {
+            if (prim.material >= 0 && static_cast<size_t>(prim.material) >= model_.materials.size())
+                return fail(context + "material " + std::to_string(prim.material) +
+                            " does not exist");
+            return material.error();
+        }
+        out.material = *material;
+        int texcoord_set = 0;
+        if (prim.material >= 0) {
+            const auto& info = model_.materials[static_cast<size_t>(prim.material)]
+                                   .pbrMetallicRoughness.baseColorTexture;
+            if (info.index >= 0) texcoord_set = std::max(info.texCoord, 0);
+        }
+        if (Status st =
+                read_attribute("TEXCOORD_" + std::to_string(texcoord_set), kTexcoordRule, &out.uvs);
+            !st)
+            return st;
+
+        std::vector<uint32_t> indices;
+        if (prim.indices >= 0) {
+            Expected<PackedAccessor> packed =
+                pack_accessor(prim.indices, context, "indices", kIndexRule);
+            if (!packed) return packed.error();
+            indices.resize(packed->count);
+            const size_t size = size_t(component_size(packed->component_type));
+            for (size_t i = 0; i < packed->count; ++i) {
+                indices[i] = read_unsigned(packed->bytes.data() + i * size, packed->component_type);
+                if (indices[i] >= vertex_count) {
+                    const auto& a = model_.accessors[static_cast<size_t>(prim.indices)];
+                    return fail(context + "accessor " + std::to_string(prim.indices) +
+                                quoted(a.name) + " (indices) element " + std::to_string(i) +
+                                " is " + std::to_string(indices[i]) + ", out of range of the " +
+                                std::to_string(vertex_count) + " vertices");
+                }
+            }
+        } else {
+            indices.resize(vertex_count);
+            for (size_t i = 0; i < vertex_count; ++i) indices[i] = static_cast<uint32_t>(i);
+        }
+
+        const size_t n = indices.size();
+        if (mode == TINYGLTF_MODE_TRIANGLES) {
+            if (n % 3 != 0)
+                return fail(context + "has " + std::to_string(n) +
+                            " vertices or indices, not a multiple of 3 for TRIANGLES");
+            out.triangles.reserve(n / 3);
+            for (size_t i = 0; i + 2 < n; i += 3)
+                out.triangles.emplace_back(indices[i], indices[i + 1], indices[i + 2]);
+        } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+            // glTF 2.0 section 3.7.2.1: triangle i = (v_i, v_{i+1+i%2}, v_{i+2-i%2}).
+            for (size_t i = 0; i + 2 < n; ++i) {
+                const glm::uvec3 t(indices[i], indices[i + 1 + i % 2], indices[i + 2 - i % 2]);
+                if (t.x == t.y || t.y == t.z || t.x == t.z) continue;  // strip-joining degenerate
+                out.triangles.push_back(t);
+            }
+        } else {
+            // TRIANGLE_FAN: triangle i = (v_{i+1}, v_{i+2}, v_0), same winding as (v_0, ...).
+            for (size_t i = 1; i + 1 < n; ++i)
+                out.triangles.emplace_back(indices[0], indices[i], indices[i + 1]);
+        }
+        decoded.push_back(std::move(out));
+    }
+    meshes_[static_cast<size_t>(mesh_index)] = std::move(decoded);
+    return Status::ok();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Nodes.
+
+Expected<Mat4> GltfSceneReader::local_transform(const tinygltf::Node& node, int node_index) const {
+    const std::string context = "node " + std::to_string(node_index) + quoted(node.name) + ": ";
+    const auto all_finite = [](const std::vector<double>& v) {
+        return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
+    };
+    if (!node.matrix.empty()) {
+        if (node.matrix.size() != 16 || !all_finite(node.matrix))
+            return fail(context + "matrix must be 16 finite numbers");
+        Mat4 m;
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r)
+                m[c][r] = float(node.matrix[size_t(c * 4 + r)]);  // column-major
+        return m;
+    }
+    if ((!node.translation.empty() && node.translation.size() != 3) ||
+        (!node.rotation.empty() && node.rotation.size() != 4) ||
+        (!node.scale.empty() && node.scale.size() != 3) || !all_finite(node.translation) ||
+        !all_finite(node.rotation) || !all_finite(node.scale))
+        return fail(context + "translation, rotation or scale is malformed or non-finite");
+    Mat4 t(1.0f), r(1.0f), s(1.0f);
+    if (!node.translation.empty())
+        t[3] = Vec4(float(node.translation[0]), float(node.translation[1]),
+                    float(node.translation[2]), 1.0f);
+    if (!node.rotation.empty()) {
+        // Unit quaternion (x, y, z, w) to a rotation matrix (columns below).
+        double x = node.rotation[0], y = node.rotation[1], z = node.rotation[2],
+               w = node.rotation[3];
+        const double len = std::sqrt(x * x + y * y + z * z + w * w);
+        if (!(len > 0.0)) return fail(context + "rotation is a zero quaternion");
+        x /= len, y /= len, z /= len, w /= len;
+        const Mat3 rot(float(1 - 2 * (y * y + z * z)), float(2 * (x * y + z * w)),
+                       float(2 * (x * z - y * w)),  // column 0
+                       float(2 * (x * y - z * w)), float(1 - 2 * (x * x + z * z)),
+                       float(2 * (y * z + x * w)),  // column 1
+                       float(2 * (x * z + y * w)), float(2 * (y * z - x * w)),
+                       float(1 - 2 * (x * x + y * y)));  // column 2
+        r = Mat4(rot);
+    }
+    if (!node.scale.empty()) {
+        s[0][0] = float(node.scale[0]);
+        s[1][1] = float(node.scale[1]);
+        s[2][2] = float(node.scale[2]);
+    }
+    return t * r * s;
+}
+
+Status GltfSceneReader::add_camera(const tinygltf::Node& node, int node_index, const Mat4& world) {
+    const std::string context = "node " + std::to_string(node_index) + quoted(node.name) + ": ";
+    if (node.camera < 0 || static_cast<size_t>(node.camera) >= model_.cameras.size())
+        return fail(context + "camera " + std::to_string(node.camera) + " does not exist");
+    const tinygltf::Camera& camera = model_.cameras[static_cast<size_t>(node.camera)];
+    if (camera.type != "perspective") return Status::ok();  // orthographic cameras: skipped
+    const double yfov = camera.perspective.yfov;
+    if (!(yfov > 0.0 && yfov < double(kPi)))
+        return fail(context + "camera " + std::to_string(node.camera) + quoted(camera.name) +
+                    " has yfov " + std::to_string(yfov) + ", outside (0, pi)");
+    const Mat3 linear(world);
+    const Vec3 forward_raw = linear * Vec3(0.0f, 0.0f, -1.0f);
+    const Vec3 up_raw = linear * Vec3(0.0f, 1.0f, 0.0f);
+    const float forward_len = glm::length(forward_raw);
+    if (!(forward_len > 0.0f) || !std::isfinite(forward_len))
+        return fail(context + "camera transform is degenerate");
+    const Vec3 forward = forward_raw / forward_len;
+    Vec3 up = up_raw - glm::dot(up_raw, forward) * forward;  // orthogonal to the view direction
+    const float up_len = glm::length(up);
+    if (!(up_len > 0.0f) || !std::isfinite(up_len))
+        return fail(context + "camera transform is degenerate");
+    up /= up_len;
+
+    CameraDesc desc;
+    desc.name = !camera.name.empty() ? camera.name : node.name;
+    desc.position = Vec3(world[3]);
+    desc.look_at = desc.position + forward;
+    desc.up = up;
+    desc.vfov_deg = float(yfov * 180.0 / double(kPi));
+    const double aspect = camera.perspective.aspectRatio;
+    desc.aspect = aspect > 0.0 && std::isfinite(aspect) ? float(aspect) : 0.0f;
+    if (!is_finite(desc.position)) return fail(context + "camera position is not finite");
+    builder_.add_camera(std::move(desc));
+    return Status::ok();
+}
+
+Status GltfSceneReader::add_light(const tinygltf::Node& node, int node_index, const Mat4& world) {
+    const std::string context = "node " + std::to_string(node_index) + quoted(node.name) + ": ";
+    const tinygltf::Value& ext = node.extensions.at("KHR_lights_punctual");
+    if (!ext.IsObject() || !ext.Has("light") || !ext.Get("light").IsNumber())
+        return fail(context + "KHR_lights_punctual has no light index");
+    const double light_index = ext.Get("light").GetNumberAsDouble();
+    if (!(light_index >= 0.0) || light_index >= double(model_.lights.size()))
+        return fail(context + "light " + std::to_string(light_index) + " does not exist");
+    const auto index = static_cast<size_t>(light_index);
+    const tinygltf::Light& light = model_.lights[index];
+    const std::string what = context + "light " + std::to_string(index) + quoted(light.name);
+
+    PunctualLight out;
+    out.name = !light.name.empty() ? light.name : node.name;
+    if (light.type == "point") {
+        out.type = PunctualLightType::Point;
+    } else if (light.type == "spot") {
+        out.type = PunctualLightType::Spot;
+    } else if (light.type == "directional") {
+        out.type = PunctualLightType::Directional;
+    } else {
+        return fail(what + " has unknown type '" + light.type + "'");
+    }
+    Color color(1.0f);
+    if (!light.color.empty()) {
+        if (light.color.size() != 3) return fail(what + " color must have 3 components");
+        color = Color(float(light.color[0]), float(light.color[1]), float(light.color[2]));
+    }
+    const float intensity = float(light.intensity);
+    out.intensity = glm::max(color * intensity, Color(0.0f));
+    out.position = Vec3(world[3]);
+    const Vec3 direction = Mat3(world) * Vec3(0.0f, 0.0f, -1.0f);
+    const float len = glm::length(direction);
+    if (out.type != PunctualLightType::Point) {
+        if (!(len > 0.0f) || !std::isfinite(len)) return fail(what + " has a degenerate transform");
+        out.direction = direction / len;
+    }
+    if (out.type == PunctualLightType::Spot) {
+        // KHR_lights_punctual: 0 <= inner < outer <= pi/2 (defaults 0 and pi/4).
+        const double outer = std::clamp(light.spot.outerConeAngle, 0.0, double(kPi) / 2.0);
+        const double inner = std::clamp(light.spot.innerConeAngle, 0.0, outer);
+        out.cos_outer = float(std::cos(outer));
+        out.cos_inner = float(std::cos(inner));
+    }
+    if (!is_finite(out.intensity) || !is_finite(out.position) || !is_finite(out.direction) ||
+        !std::isfinite(out.cos_inner) || !std::isfinite(out.cos_outer))
+        return fail(what + " has a non-finite value");
+    builder_.add_light(std::move(out));
+    return Status::ok();
+}
+
+Status GltfSceneReader::visit_node(int node_index, const Mat4& parent, int depth) {
+    const auto index = static_cast<size_t>(node_index);
+    const tinygltf::Node& node = model_.nodes[index];
+    const std::string context = "node " + std::to_string(node_index) + quoted(node.name) + ": ";
+    if (on_path_[index])
+        return fail(context + "is its own ancestor (the node hierarchy has a cycle)");
+    if (depth > kMaxNodeDepth)
+        return fail(context + "the node hierarchy is deeper than " + std::to_string(kMaxNodeDepth) +
+                    " levels");
+    if (++node_visits_ > kMaxNodeVisits)
+        return fail("the node hierarchy instantiates more than " + std::to_string(kMaxNodeVisits) +
+                    " nodes");
+
+    Expected<Mat4> local = local_transform(node, node_index);
+    if (!local) return local.error();
+    const Mat4 world = parent * *local;
+
+    if (node.mesh >= 0) {
+        if (static_cast<size_t>(node.mesh) >= model_.meshes.size())
+            return fail(context + "mesh " + std::to_string(node.mesh) + " does not exist");
+        auto& cached = meshes_[static_cast<size_t>(node.mesh)];
+        if (!cached) {
+            if (Status st = load_mesh(node.mesh); !st) return st;
+        }
+        for (size_t p = 0; p < cached->size(); ++p) {
+            const DecodedPrimitive& prim = (*cached)[p];
+            if (prim.triangles.empty()) continue;
+            const size_t new_vertices =
+                prim.normals.empty() ? 3 * prim.triangles.size() : prim.positions.size();
+            triangle_count_ += prim.triangles.size();
+            vertex_count_ += new_vertices;
+            if (triangle_count_ > kMaxSceneTriangles || vertex_count_ > kMaxSceneVertices)
+                return fail("the scene has more than " + std::to_string(kMaxSceneTriangles) +
+                            " triangles or " + std::to_string(kMaxSceneVertices) + " vertices");
+            if (Status st = builder_.add_mesh(prim.positions, prim.normals, prim.uvs,
+                                              prim.triangles, prim.material, world);
+                !st) {
+                const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(node.mesh)];
+                return fail(context + "mesh " + std::to_string(node.mesh) + quoted(mesh.name) +
+                            " primitive " + std::to_string(p) + ": " + st.error().message);
+            }
+        }
+    }
+    if (node.camera >= 0) {
+        if (Status st = add_camera(node, node_index, world); !st) return st;
+    }
+    if (node.extensions.count("KHR_lights_punctual")) {
+        if (Status st = add_light(node, node_index, world); !st) return st;
+    }
+
+    on_path_[index] = 1;
+    for (int child : node.children) {
+        if (child < 0 || static_cast<size_t>(child) >= model_.nodes.size())
+            return fail(context + "child node " + std::to_string(child) + " does not exist");
+        if (Status st = visit_node(child, world, depth + 1); !st) return st;
+    }
+    on_path_[index] = 0;
+    return Status::ok();
+}
+
+Expected<Scene> GltfSceneReader::read() {
+    for (const std::string& extension : model_.extensionsRequired) {
+        if (!kSupportedRequiredExtensions.count(extension))
+            return fail("requires the unsupported extension " + extension);
+    }
+    meshes_.resize(model_.meshes.size());
+    on_path_.assign(model_.nodes.size(), 0);
+
+    std::vector<int> roots;
+    if (model_.defaultScene >= 0 || !model_.scenes.empty()) {
+        const int scene_index = model_.defaultScene >= 0 ? model_.defaultScene : 0;
+        if (static_cast<size_t>(scene_index) >= model_.scenes.size())
+            return fail("default scene " + std::to_string(scene_index) + " does not exist");
+        roots = model_.scenes[static_cast<size_t>(scene_index)].nodes;
+        for (int root : roots) {
+            if (root < 0 || static_cast<size_t>(root) >= model_.nodes.size())
+                return fail("scene " + std::to_string(scene_index) + ": node " +
+                            std::to_string(root) + " does not exist");
+        }
+    } else {
+        // No scenes: every node that is nobody's child is a root.
+        std::vector<uint8_t> is_child(model_.nodes.size(), 0);
+        for (const tinygltf::Node& node : model_.nodes)
+            for (int child : node.children)
+                if (child >= 0 && static_cast<size_t>(child) < is_child.size())
+                    is_child[static_cast<size_t>(child)] = 1;
+        for (size_t i = 0; i < model_.nodes.size(); ++i)
+            if (!is_child[i]) roots.push_back(static_cast<int>(i));
+    }
+    for (int root : roots)
+        if (Status st = visit_node(root, Mat4(1.0f), 0); !st) return st.error();
+
+    if (triangle_count_ == 0) return fail("contains no triangles");
+    Expected<Scene> scene = builder_.build();
+    if (!scene) return fail(scene.error().message);
+    return scene;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Entry points.
+
+bool has_glb_magic(std::span<const uint8_t> bytes) {
+    return bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+}
+
+Expected<Scene> load_from_bytes(std::span<const uint8_t> bytes, const std::string& display_name,
+                                FileSandbox& sandbox) {
+    if (bytes.size() > kMaxFileBytes)
+        return Error{display_name + ": file larger than " + std::to_string(kMaxFileBytes) +
+                     " bytes"};
+    const bool binary = has_glb_magic(bytes);
+    if (binary && bytes.size() >= 12) {
+        uint32_t declared = 0;
+        std::memcpy(&declared, bytes.data() + 8, 4);  // little-endian hosts only (x86, ARM)
+        if (declared > bytes.size())
+            return Error{display_name + ": GLB is truncated: its header declares " +
+                         std::to_string(declared) + " bytes, the data has " +
+                         std::to_string(bytes.size())};
+    }
+
+    tinygltf::Model model;
+    tinygltf::TinyGLTF parser;
+    parser.SetFsCallbacks(tinygltf::FsCallbacks{&sandbox_file_exists, &sandbox_expand_path,
+                                                &sandbox_read_file, &sandbox_write_file, &sandbox});
+    ImageLoadContext image_context{&model};
+    parser.SetImageLoader(&keep_encoded_image, &image_context);
+
+    std::string err, warn;
+    bool ok = false;
+    try {
+        const auto size = static_cast<unsigned int>(bytes.size());
+        ok = binary ? parser.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), size,
+                                                  sandbox.base_dir)
+                    : parser.LoadASCIIFromString(&model, &err, &warn,
+                                                 reinterpret_cast<const char*>(bytes.data()), size,
+                                                 sandbox.base_dir);
+    } catch (const std::exception& e) {
+        ok = false;
+        err += std::string("parser exception: ") + e.what();
+    }
+    // A refused uri is reported even where tinygltf only warned (images) or failed vaguely.
+    if (!sandbox.refused.empty()) return Error{display_name + ": " + sandbox.refused.front()};
+    if (!ok) {
+        std::string detail = trim_trailing_whitespace(err);
+        if (detail.empty()) detail = trim_trailing_whitespace(warn);
+        return Error{display_name + ": cannot load " + (binary ? "GLB" : "glTF") + ": " +
+                     (detail.empty() ? "unknown error" : detail)};
+    }
+    try {
+        GltfSceneReader reader(model, display_name);
+        return reader.read();
+    } catch (const std::exception& e) {
+        // Defensive: the reader checks indices itself, but never let a throw escape the loader.
+        return Error{display_name + ": " + e.what()};
+    }
+}
+
+}  // namespace
+
+Expected<Scene> load_gltf_file(const std::filesystem::path& file, const GltfLoadOptions& options) {
+    const std::string display_name = file.filename().string();
+    std::error_code ec;
+    const fs::path canonical_file = fs::weakly_canonical(fs::absolute(file, ec), ec);
+    if (ec || !fs::is_regular_file(canonical_file, ec))
+        return Error{display_name + ": cannot open '" + file.string() + "': not a readable file"};
+
+    FileSandbox sandbox;
+    sandbox.allow_files = true;
+    sandbox.root = canonical_directory(options.bundle_root.empty() ? canonical_file.parent_path()
+                                                                   : options.bundle_root);
+    if (sandbox.root.empty() || !fs::is_directory(sandbox.root, ec))
+        return Error{display_name + ": bundle root '" + options.bundle_root.string() +
+                     "' is not a directory"};
+    if (!path_is_inside(sandbox.root, canonical_file))
+        return Error{display_name + ": the file lies outside the bundle root '" +
+                     sandbox.root.string() + "'"};
+    sandbox.base_dir = canonical_file.parent_path().string();
+
+    std::vector<unsigned char> bytes;
+    std::string read_error;
+    if (!read_whole_file(canonical_file, &bytes, &read_error))
+        return Error{display_name + ": cannot read '" + file.string() + "': " + read_error};
+    return load_from_bytes(bytes, display_name, sandbox);
+}
+
+Expected<Scene> load_gltf_memory(std::span<const uint8_t> bytes, const std::string& display_name) {
+    FileSandbox sandbox;  // allow_files = false: every external uri is refused
+    return load_from_bytes(bytes, display_name, sandbox);
+}
+
+}  // namespace photond

@@ -1,0 +1,170 @@
+#include "core/scene/scene.h"
+
+#include <cmath>
+#include <string>
+
+namespace photond {
+
+Color Texture::sample(const Vec2& uv) const {
+    if (width <= 0 || height <= 0 || texels.empty()) return Color(1.0f);
+    // Texel centres at half-integers; repeat wrapping as glTF's default sampler.
+    const float x = uv.x * static_cast<float>(width) - 0.5f;
+    const float y = uv.y * static_cast<float>(height) - 0.5f;
+    if (!std::isfinite(x) || !std::isfinite(y)) return texels[0];
+    const float fx = std::floor(x), fy = std::floor(y);
+    const float tx = x - fx, ty = y - fy;
+    auto wrap = [](long long i, int n) { return static_cast<int>(((i % n) + n) % n); };
+    const int x0 = wrap(static_cast<long long>(fx), width), x1 = wrap(static_cast<long long>(fx) + 1, width);
+    const int y0 = wrap(static_cast<long long>(fy), height), y1 = wrap(static_cast<long long>(fy) + 1, height);
+    const auto at = [&](int xi, int yi) { return texels[static_cast<size_t>(yi) * width + xi]; };
+    return (1.0f - ty) * ((1.0f - tx) * at(x0, y0) + tx * at(x1, y0)) +
+           ty * ((1.0f - tx) * at(x0, y1) + tx * at(x1, y1));
+}
+
+Color Scene::base_color(uint32_t material, const Vec2& uv) const {
+    const Material& m = materials[material];
+    if (m.base_color_texture < 0) return m.base_color;
+    return m.base_color * textures[static_cast<size_t>(m.base_color_texture)].sample(uv);
+}
+
+float Scene::triangle_area(uint32_t triangle) const {
+    const glm::uvec3& t = triangles[triangle];
+    return 0.5f * glm::length(glm::cross(positions[t.y] - positions[t.x],
+                                         positions[t.z] - positions[t.x]));
+}
+
+Vec3 Scene::triangle_normal(uint32_t triangle) const {
+    const glm::uvec3& t = triangles[triangle];
+    const Vec3 c = glm::cross(positions[t.y] - positions[t.x], positions[t.z] - positions[t.x]);
+    const float len = glm::length(c);
+    return len > 0.0f && std::isfinite(len) ? c / len : Vec3(0.0f);
+}
+
+Status Scene::validate() const {
+    if (normals.size() != positions.size() || uvs.size() != positions.size())
+        return Error{"scene '" + name + "': per-vertex arrays differ in size"};
+    if (triangle_materials.size() != triangles.size())
+        return Error{"scene '" + name + "': per-triangle material array differs in size"};
+    for (size_t i = 0; i < positions.size(); ++i) {
+        if (!is_finite(positions[i]))
+            return Error{"scene '" + name + "': vertex " + std::to_string(i) +
+                         " has a non-finite position"};
+    }
+    for (size_t i = 0; i < triangles.size(); ++i) {
+        const glm::uvec3& t = triangles[i];
+        if (t.x >= positions.size() || t.y >= positions.size() || t.z >= positions.size())
+            return Error{"scene '" + name + "': triangle " + std::to_string(i) +
+                         " indexes a vertex out of range"};
+        if (triangle_materials[i] >= materials.size())
+            return Error{"scene '" + name + "': triangle " + std::to_string(i) +
+                         " uses a material out of range"};
+    }
+    for (const Material& m : materials) {
+        if (m.base_color_texture >= static_cast<int>(textures.size()))
+            return Error{"scene '" + name + "': material '" + m.name +
+                         "' uses a texture out of range"};
+        if (!is_finite(m.base_color) || !is_finite(m.emission) || !std::isfinite(m.ior) ||
+            !std::isfinite(m.roughness) || !std::isfinite(m.metallic))
+            return Error{"scene '" + name + "': material '" + m.name + "' has a non-finite factor"};
+    }
+    for (const PunctualLight& l : lights) {
+        if (!is_finite(l.position) || !is_finite(l.direction) || !is_finite(l.intensity))
+            return Error{"scene '" + name + "': light '" + l.name + "' has a non-finite value"};
+    }
+    return Status::ok();
+}
+
+SceneBuilder::SceneBuilder(std::string name) { scene_.name = std::move(name); }
+
+uint32_t SceneBuilder::add_material(Material material) {
+    scene_.materials.push_back(std::move(material));
+    return static_cast<uint32_t>(scene_.materials.size() - 1);
+}
+
+uint32_t SceneBuilder::add_texture(Texture texture) {
+    scene_.textures.push_back(std::move(texture));
+    return static_cast<uint32_t>(scene_.textures.size() - 1);
+}
+
+void SceneBuilder::add_light(PunctualLight light) { scene_.lights.push_back(std::move(light)); }
+
+void SceneBuilder::add_camera(CameraDesc camera) { scene_.cameras.push_back(std::move(camera)); }
+
+Status SceneBuilder::add_mesh(std::span<const Vec3> positions, std::span<const Vec3> normals,
+                              std::span<const Vec2> uvs, std::span<const glm::uvec3> triangles,
+                              uint32_t material, const Mat4& transform) {
+    if (!normals.empty() && normals.size() != positions.size())
+        return Error{"mesh normals count differs from positions count"};
+    if (!uvs.empty() && uvs.size() != positions.size())
+        return Error{"mesh texture-coordinate count differs from positions count"};
+    for (size_t i = 0; i < positions.size(); ++i) {
+        if (!is_finite(positions[i]))
+            return Error{"vertex " + std::to_string(i) + " has a non-finite position"};
+        if (!normals.empty() && !is_finite(normals[i]))
+            return Error{"vertex " + std::to_string(i) + " has a non-finite normal"};
+        if (!uvs.empty() && !(std::isfinite(uvs[i].x) && std::isfinite(uvs[i].y)))
+            return Error{"vertex " + std::to_string(i) + " has a non-finite texture coordinate"};
+    }
+    for (size_t i = 0; i < triangles.size(); ++i) {
+        const glm::uvec3& t = triangles[i];
+        if (t.x >= positions.size() || t.y >= positions.size() || t.z >= positions.size())
+            return Error{"triangle " + std::to_string(i) + " indexes a vertex beyond the " +
+                         std::to_string(positions.size()) + " given"};
+    }
+    const Mat3 linear(transform);
+    const bool mirrored = glm::determinant(linear) < 0.0f;
+    const Mat3 normal_matrix = glm::transpose(glm::inverse(linear));
+    const auto world = [&](const Vec3& p) { return Vec3(transform * Vec4(p, 1.0f)); };
+
+    auto& s = scene_;
+    if (normals.empty()) {
+        // glTF 2.0: meshes without normals are shaded flat; unweld so each triangle has its own.
+        for (const glm::uvec3& t : triangles) {
+            const uint32_t base = static_cast<uint32_t>(s.positions.size());
+            Vec3 p[3] = {world(positions[t.x]), world(positions[t.y]), world(positions[t.z])};
+            if (mirrored) std::swap(p[1], p[2]);
+            const Vec3 c = glm::cross(p[1] - p[0], p[2] - p[0]);
+            const float len = glm::length(c);
+            const Vec3 n = len > 0.0f && std::isfinite(len) ? c / len : Vec3(0.0f, 0.0f, 1.0f);
+            const uint32_t idx[3] = {t.x, mirrored ? t.z : t.y, mirrored ? t.y : t.z};
+            for (int k = 0; k < 3; ++k) {
+                s.positions.push_back(p[k]);
+                s.normals.push_back(n);
+                s.uvs.push_back(uvs.empty() ? Vec2(0.0f) : uvs[idx[k]]);
+                s.bounds.extend(p[k]);
+            }
+            s.triangles.emplace_back(base, base + 1, base + 2);
+            s.triangle_materials.push_back(material);
+        }
+        return Status::ok();
+    }
+    const uint32_t base = static_cast<uint32_t>(s.positions.size());
+    for (size_t i = 0; i < positions.size(); ++i) {
+        const Vec3 p = world(positions[i]);
+        Vec3 n = normal_matrix * normals[i];
+        const float len = glm::length(n);
+        n = len > 0.0f && std::isfinite(len) ? n / len : Vec3(0.0f);  // zero: use the face normal
+        s.positions.push_back(p);
+        s.normals.push_back(n);
+        s.uvs.push_back(uvs.empty() ? Vec2(0.0f) : uvs[i]);
+        s.bounds.extend(p);
+    }
+    for (const glm::uvec3& t : triangles) {
+        s.triangles.push_back(mirrored ? glm::uvec3(t.x, t.z, t.y) + base : t + base);
+        s.triangle_materials.push_back(material);
+    }
+    return Status::ok();
+}
+
+Expected<Scene> SceneBuilder::build() {
+    for (const PunctualLight& l : scene_.lights) {
+        if (l.type != PunctualLightType::Directional) scene_.bounds.extend(l.position);
+    }
+    if (Status st = scene_.validate(); !st) return st.error();
+    Scene out = std::move(scene_);
+    scene_ = Scene{};
+    scene_.name = out.name;
+    return out;
+}
+
+}  // namespace photond

@@ -1,0 +1,132 @@
+// The renderer's scene: world-space triangles with materials, punctual lights and cameras.
+// Built once (by the glTF loader or a built-in scene) through SceneBuilder, then immutable and
+// shared read-only by every thread.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/math/vec.h"
+#include "core/util/expected.h"
+
+namespace photond {
+
+/// An RGB texture in linear space, sampled bilinearly with repeat wrapping.
+struct Texture {
+    int width = 0;
+    int height = 0;
+    std::vector<Color> texels;  // row-major, row 0 at v = 0 (glTF: top of the image)
+
+    Color sample(const Vec2& uv) const;
+};
+
+/// The glTF 2.0 metallic-roughness material with the extensions we read
+/// (KHR_materials_transmission, _ior, _specular, _emissive_strength).
+struct Material {
+    std::string name;
+    Color base_color{0.8f};
+    int base_color_texture = -1;  // index into Scene::textures, multiplied with base_color
+    float metallic = 0.0f;
+    float roughness = 1.0f;      // perceptual roughness; GGX alpha = roughness^2
+    float ior = 1.5f;
+    float transmission = 0.0f;   // KHR_materials_transmission factor: solid dielectric
+    float specular = 1.0f;       // KHR_materials_specular factor
+    Color specular_color{1.0f};  // KHR_materials_specular colour factor
+    Color emission{0.0f};        // emitted radiance: emissiveFactor * emissive_strength
+    bool double_sided = false;   // emits from both faces when true (else the front face only)
+
+    bool is_emissive() const { return max_component(emission) > 0.0f; }
+};
+
+enum class PunctualLightType : uint8_t { Point, Spot, Directional };
+
+/// KHR_lights_punctual. Units are radiometric: intensity in W/sr (point, spot), irradiance in
+/// W/m^2 (directional). The glTF photometric values are taken as these numbers unchanged.
+struct PunctualLight {
+    PunctualLightType type = PunctualLightType::Point;
+    std::string name;
+    Vec3 position{0.0f};
+    Vec3 direction{0.0f, 0.0f, -1.0f};  // unit; the direction the light travels (spot, directional)
+    Color intensity{1.0f};              // colour * intensity
+    float cos_inner = 1.0f;             // spot: full intensity inside the inner cone
+    float cos_outer = 0.0f;             // spot: zero outside the outer cone
+};
+
+/// A pinhole camera: position, orientation and vertical field of view.
+struct CameraDesc {
+    std::string name;
+    Vec3 position{0.0f, 0.0f, 1.0f};
+    Vec3 look_at{0.0f};
+    Vec3 up{0.0f, 1.0f, 0.0f};
+    float vfov_deg = 40.0f;
+    float aspect = 0.0f;  // width / height from the file; 0 = take the image's
+};
+
+struct Bounds3 {
+    Vec3 lower{std::numeric_limits<float>::infinity()};
+    Vec3 upper{-std::numeric_limits<float>::infinity()};
+
+    void extend(const Vec3& p) {
+        lower = glm::min(lower, p);
+        upper = glm::max(upper, p);
+    }
+    bool empty() const { return lower.x > upper.x; }
+    Vec3 center() const { return 0.5f * (lower + upper); }
+    Vec3 extent() const { return upper - lower; }
+    float radius() const { return empty() ? 0.0f : 0.5f * glm::length(extent()); }
+};
+
+/// Immutable after construction. Triangles are in world space; the geometric normal of triangle
+/// (a, b, c) is normalize(cross(b - a, c - a)) and marks its front face (counter-clockwise, as glTF).
+struct Scene {
+    std::string name;
+    std::vector<Vec3> positions;
+    std::vector<Vec3> normals;  // per vertex, unit, same size as positions
+    std::vector<Vec2> uvs;      // per vertex, same size as positions
+    std::vector<glm::uvec3> triangles;
+    std::vector<uint32_t> triangle_materials;  // per triangle, index into materials
+    std::vector<Material> materials;
+    std::vector<Texture> textures;
+    std::vector<PunctualLight> lights;
+    std::vector<CameraDesc> cameras;
+    Bounds3 bounds;  // of all triangles (and of punctual light positions)
+
+    /// Checks the invariants every consumer relies on (sizes, index ranges, finite data).
+    Status validate() const;
+    /// Base colour of a material at a texture coordinate (texture times factor).
+    Color base_color(uint32_t material, const Vec2& uv) const;
+    float triangle_area(uint32_t triangle) const;
+    Vec3 triangle_normal(uint32_t triangle) const;  // geometric, unit (zero for degenerate)
+};
+
+/// Assembles a Scene: transforms meshes into world space, generates flat normals where a mesh
+/// has none, keeps winding and normals consistent under mirroring transforms.
+class SceneBuilder {
+public:
+    explicit SceneBuilder(std::string name);
+
+    uint32_t add_material(Material material);
+    uint32_t add_texture(Texture texture);
+    void add_light(PunctualLight light);
+    void add_camera(CameraDesc camera);
+
+    /// Adds an indexed triangle mesh under a transform. `normals` and `uvs` may be empty (flat
+    /// normals are generated; uv = 0) or have one entry per position. A transform with a negative
+    /// determinant reverses the winding so that front faces stay front faces.
+    Status add_mesh(std::span<const Vec3> positions, std::span<const Vec3> normals,
+                    std::span<const Vec2> uvs, std::span<const glm::uvec3> triangles,
+                    uint32_t material, const Mat4& transform = Mat4(1.0f));
+
+    /// Validates and returns the scene; the builder is left empty.
+    Expected<Scene> build();
+
+    size_t material_count() const { return scene_.materials.size(); }
+
+private:
+    Scene scene_;
+};
+
+}  // namespace photond

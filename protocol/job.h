@@ -1,0 +1,201 @@
+// The job description v1 of the render service (PRODUCT.md, "Job description v1"): plain structs,
+// their JSON mapping, validation with the offending field's path, and a JSON Schema built from the
+// same limits. Versioned by adding fields, never by changing what a field means.
+//
+// A job is read in two steps: the preset named by "preset" (default "final", see presets.h)
+// supplies every default, then each field present in the document overrides its default. Unknown
+// fields are errors that name the field, so that a typo is never silently ignored.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "core/util/expected.h"
+
+namespace photond::protocol {
+
+/// An inclusive integer range [min, max].
+struct IntegerRange {
+    int64_t min;
+    uint64_t max;
+};
+
+/// A real range whose ends are open or closed, e.g. (0, 1].
+struct NumberRange {
+    double min;
+    double max;
+    bool min_exclusive = false;
+    bool max_exclusive = false;
+};
+
+/// Every limit the validator and the JSON Schema enforce, in one place.
+namespace limits {
+inline constexpr IntegerRange kImageSize{1, 16384};            // image.width, image.height
+inline constexpr int64_t kImagePixelsMax = int64_t{64} << 20;  // width * height: 64 Mpixel
+inline constexpr IntegerRange kTileSize{8, 256};
+inline constexpr IntegerRange kSamplesPerPixel{1, 65536};
+inline constexpr IntegerRange kPhotonCount{0, 50'000'000};  // photons.global, photons.caustic
+// k nearest photons of a radiance estimate: below about 8 the density estimate is mostly noise.
+inline constexpr IntegerRange kPhotonNeighbours{8, 1000};
+inline constexpr IntegerRange kSeed{0, std::numeric_limits<uint64_t>::max()};
+inline constexpr IntegerRange kGatherRays{1, 16384};
+// Ward's accuracy a (the largest allowed error estimate of a cached irradiance record).
+inline constexpr NumberRange kCacheAccuracy{0.0, 1.0, true, false};
+// Record spacing in pixels (Tabellion & Lamorlette 2004); also min_spacing_px <= max_spacing_px.
+inline constexpr NumberRange kCacheSpacingPx{0.0, 1024.0, true, false};
+inline constexpr IntegerRange kPriority{0, 100};
+inline constexpr IntegerRange kGltfCameraIndex{0, std::numeric_limits<int32_t>::max()};
+inline constexpr NumberRange kVerticalFovDeg{0.0, 180.0, true, true};
+// Camera coordinates must survive the conversion to the renderer's 32-bit floats.
+inline constexpr NumberRange kCoordinate{-std::numeric_limits<float>::max(),
+                                         std::numeric_limits<float>::max()};
+inline constexpr std::string_view kSceneIdPrefix = "sha256:";
+inline constexpr size_t kSceneIdHexDigits = 64;
+}  // namespace limits
+
+inline constexpr std::array<std::string_view, 3> kPresetNames{"preview", "final", "reference"};
+inline constexpr std::string_view kDefaultPreset = "final";
+inline constexpr std::array<std::string_view, 3> kIntegratorNames{"photon-map", "path", "direct"};
+inline constexpr std::array<std::string_view, 2> kPixelTypeNames{"half", "float"};
+inline constexpr std::array<std::string_view, 6> kAovNames{"direct", "indirect", "caustic",
+                                                           "albedo", "normal",   "depth"};
+
+/// Which scene to render: {"builtin": name} | {"path": relative to --scene-root} | {"id": content}.
+struct SceneRef {
+    enum class Kind { Builtin, Path, Id };
+    Kind kind = Kind::Builtin;
+    std::string value;  // the name, the relative path, or "sha256:<64 lowercase hex digits>"
+
+    bool operator==(const SceneRef&) const = default;
+};
+
+/// {"gltf_camera": index}: a camera of the scene's glTF file.
+struct GltfCamera {
+    int index = 0;
+
+    bool operator==(const GltfCamera&) const = default;
+};
+
+/// {"look_from", "look_at", "up", "vfov_deg"}: a pinhole camera in world coordinates.
+struct LookAtCamera {
+    std::array<double, 3> look_from{};
+    std::array<double, 3> look_at{};
+    std::array<double, 3> up{0.0, 1.0, 0.0};  // default when the document leaves it out
+    double vfov_deg = 40.0;                   // default when the document leaves it out
+
+    bool operator==(const LookAtCamera&) const = default;
+};
+
+using CameraSpec = std::variant<GltfCamera, LookAtCamera>;
+
+struct ImageSpec {
+    int width = 0;
+    int height = 0;
+    int tile_size = 0;
+    int spp = 0;
+    // Pixels [x0, x1) x [y0, y1), origin at the top left; absent = the whole image. The image
+    // keeps its full size (display window); only the region is rendered.
+    std::optional<std::array<int, 4>> region;
+
+    bool operator==(const ImageSpec&) const = default;
+};
+
+struct PhotonSpec {
+    uint32_t global = 0;
+    uint32_t caustic = 0;
+    uint32_t k_global = 0;
+    uint32_t k_caustic = 0;
+    uint64_t seed = 0;
+
+    bool operator==(const PhotonSpec&) const = default;
+};
+
+struct GatherSpec {
+    uint32_t rays = 0;
+
+    bool operator==(const GatherSpec&) const = default;
+};
+
+struct IrradianceCacheSpec {
+    bool enabled = false;
+    double a = 0.0;
+    bool gradients = false;
+    double min_spacing_px = 0.0;
+    double max_spacing_px = 0.0;
+
+    bool operator==(const IrradianceCacheSpec&) const = default;
+};
+
+struct OutputSpec {
+    std::string pixel_type;         // one of kPixelTypeNames
+    std::vector<std::string> aovs;  // from kAovNames, no duplicates, in the order asked
+
+    bool operator==(const OutputSpec&) const = default;
+};
+
+/// A whole job with every default filled. A default-constructed Job is NOT valid (zero sizes):
+/// start from preset_defaults() (presets.h) or parse_job().
+struct Job {
+    SceneRef scene;
+    // Absent: the scene's first glTF camera if it has one, else the scene's default view.
+    std::optional<CameraSpec> camera;
+    ImageSpec image;
+    std::string preset;      // one of kPresetNames
+    std::string integrator;  // one of kIntegratorNames
+    PhotonSpec photons;
+    GatherSpec gather;
+    IrradianceCacheSpec irradiance_cache;
+    OutputSpec output;
+    int priority = 0;
+    uint64_t seed = 0;  // the render's random streams (photons.seed drives photon tracing)
+
+    bool operator==(const Job&) const = default;
+};
+
+/// A validation failure: the field's path ("irradiance_cache.a", "image.region[2]", "scene";
+/// empty for the document itself) and what is wrong with it.
+struct FieldError {
+    std::string path;
+    std::string message;
+
+    bool operator==(const FieldError&) const = default;
+};
+
+/// "path: message" (just the message when the path is empty).
+std::string describe(const FieldError& error);
+
+/// Reads and validates a job document; the error names the field ("image.sppp: unknown field").
+std::variant<Job, FieldError> parse_job_detailed(const nlohmann::json& document);
+/// As parse_job_detailed, from text; malformed JSON gives an error with an empty path and the
+/// message "malformed JSON at line L column C: ...".
+std::variant<Job, FieldError> parse_job_text_detailed(std::string_view text);
+/// As the _detailed forms, with the error as describe(field_error).
+Expected<Job> parse_job(const nlohmann::json& document);
+Expected<Job> parse_job_text(std::string_view text);
+
+/// The job with every field written out (camera and image.region only when set);
+/// parse_job(to_json(job)) gives back the same job.
+nlohmann::json to_json(const Job& job);
+
+/// Sets one field of a job document from "dotted.path=value", e.g. "image.spp=16",
+/// "output.aovs=[\"direct\"]", "scene.builtin=cornell-box". The value is read as JSON when it
+/// parses as JSON, else taken as a string. Missing intermediate objects are created; a null
+/// document becomes an object. Only the named field changes: "scene.builtin=x" on a document with
+/// {"scene": {"path": ...}} leaves both keys (parse_job then rejects it); use "scene={...}" to
+/// replace a whole object. Unknown paths are not checked here but by parse_job.
+Status apply_override(nlohmann::json& document, std::string_view assignment);
+
+/// A JSON Schema (draft 2020-12) of the job document, built from the same limits as the
+/// validator: every field with its type, range, allowed values and description. Preset-dependent
+/// defaults are listed per preset under the annotation "x-preset-defaults"; "default" is the
+/// value of the default preset.
+nlohmann::json job_json_schema();
+
+}  // namespace photond::protocol

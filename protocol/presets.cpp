@@ -1,0 +1,77 @@
+#include "protocol/presets.h"
+
+namespace photond::protocol {
+namespace {
+
+// These values are initial guesses (PRODUCT.md's placeholders and ALGORITHMS.md's ranges: 50 to
+// 2000 gather rays, a in 0.1 to 0.35). They are to be tuned with the benchmark of run time
+// against error; README records the chosen values and the measurements behind them.
+
+Job make_preset(std::string_view name, std::string integrator, ImageSpec image, PhotonSpec photons,
+                GatherSpec gather, IrradianceCacheSpec irradiance_cache) {
+    Job job;
+    job.preset = std::string(name);
+    job.integrator = std::move(integrator);
+    job.image = image;
+    job.photons = photons;
+    job.gather = gather;
+    job.irradiance_cache = irradiance_cache;
+    job.output = OutputSpec{.pixel_type = "half", .aovs = {}};
+    job.priority = 50;
+    job.seed = 1;
+    return job;
+}
+
+// Fast feedback: one sample per pixel, a quarter of the photons, a coarser irradiance cache.
+Job preview_preset() {
+    return make_preset(
+        "preview", "photon-map", ImageSpec{.width = 512, .height = 512, .tile_size = 32, .spp = 1},
+        PhotonSpec{
+            .global = 50'000, .caustic = 25'000, .k_global = 50, .k_caustic = 100, .seed = 1},
+        GatherSpec{.rays = 128},
+        IrradianceCacheSpec{.enabled = true,
+                            .a = 0.3,
+                            .gradients = true,
+                            .min_spacing_px = 1.5,
+                            .max_spacing_px = 24.0});
+}
+
+Job final_preset() {
+    return make_preset(
+        "final", "photon-map", ImageSpec{.width = 512, .height = 512, .tile_size = 32, .spp = 4},
+        PhotonSpec{
+            .global = 200'000, .caustic = 100'000, .k_global = 50, .k_caustic = 100, .seed = 1},
+        GatherSpec{.rays = 512},
+        IrradianceCacheSpec{.enabled = true,
+                            .a = 0.15,
+                            .gradients = true,
+                            .min_spacing_px = 1.5,
+                            .max_spacing_px = 24.0});
+}
+
+// The unbiased path tracer, for measuring error. The photon, gather and cache values only matter
+// when a job selects this preset with "integrator": "photon-map"; they are then the most accurate
+// of the three presets.
+Job reference_preset() {
+    return make_preset(
+        "reference", "path", ImageSpec{.width = 512, .height = 512, .tile_size = 32, .spp = 1024},
+        PhotonSpec{
+            .global = 1'000'000, .caustic = 500'000, .k_global = 50, .k_caustic = 100, .seed = 1},
+        GatherSpec{.rays = 2048},
+        IrradianceCacheSpec{.enabled = true,
+                            .a = 0.1,
+                            .gradients = true,
+                            .min_spacing_px = 1.0,
+                            .max_spacing_px = 16.0});
+}
+
+}  // namespace
+
+std::optional<Job> preset_defaults(std::string_view preset) {
+    if (preset == "preview") return preview_preset();
+    if (preset == "final") return final_preset();
+    if (preset == "reference") return reference_preset();
+    return std::nullopt;
+}
+
+}  // namespace photond::protocol

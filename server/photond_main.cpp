@@ -1,0 +1,33 @@
+// photond: the render service. `photond render` renders offline; `photond serve` runs the daemon.
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "server/render_command.h"
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: photond <command> [options]\n"
+    "commands:\n"
+    "  render    render one job offline and write an OpenEXR (photond render --help)\n"
+    "  version   print the version\n";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    std::vector<std::string> args(argv + 1, argv + argc);
+    if (args.empty() || args[0] == "-h" || args[0] == "--help" || args[0] == "help") {
+        std::fputs(kUsage, args.empty() ? stderr : stdout);
+        return args.empty() ? 2 : 0;
+    }
+    const std::string command = args[0];
+    const std::span<const std::string> rest(args.data() + 1, args.size() - 1);
+    if (command == "render") return photond::service::run_render_command(rest);
+    if (command == "version" || command == "--version") {
+        std::puts("photond 0.1.0");
+        return 0;
+    }
+    std::fprintf(stderr, "photond: unknown command '%s'\n%s", command.c_str(), kUsage);
+    return 2;
+}

@@ -1,0 +1,265 @@
+#include "server/render_command.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <mutex>
+#include <sstream>
+
+#include "core/image/exr_io.h"
+#include "core/image/png_preview.h"
+#include "protocol/job.h"
+#include "protocol/statistics.h"
+#include "server/render_pipeline.h"
+
+namespace photond::service {
+namespace {
+
+constexpr const char* kUsage =
+    "usage: photond render SCENE|--job job.json -o OUT.exr [options]\n"
+    "  SCENE                   a glTF file (.gltf/.glb) or builtin:NAME\n"
+    "  --job FILE              a job description (JSON); SCENE and options override it\n"
+    "  --integrator NAME       photon-map | path | direct\n"
+    "  --preset NAME           preview | final | reference\n"
+    "  --width W --height H    image size in pixels\n"
+    "  --spp N                 samples per pixel\n"
+    "  --seed S                the render's random seed\n"
+    "  --set key=value         any job field by its path, e.g. --set image.tile_size=16\n"
+    "  --threads N             worker threads (default: every core)\n"
+    "  --scene-root DIR        directory that {\"path\": ...} scenes of --job are relative to\n"
+    "  -o, --output OUT.exr    the tiled OpenEXR to write\n"
+    "  --preview OUT.png       also write an sRGB PNG preview\n"
+    "  --stats-json FILE       write the render statistics as JSON\n"
+    "  --quiet                 no progress bar and no statistics on stderr\n";
+
+struct Arguments {
+    std::string scene;
+    std::string job_file;
+    std::vector<std::string> overrides;
+    int threads = 0;
+    std::string scene_root;
+    std::string output;
+    std::string preview;
+    std::string stats_json;
+    bool quiet = false;
+};
+
+Expected<Arguments> parse_arguments(std::span<const std::string> args) {
+    Arguments a;
+    for (size_t i = 0; i < args.size(); ++i) {
+        const std::string& arg = args[i];
+        auto value = [&](const char* flag) -> Expected<std::string> {
+            if (i + 1 >= args.size()) return Error{std::string(flag) + ": missing value"};
+            return args[++i];
+        };
+        auto as_override = [&](const char* flag, const char* field) -> Status {
+            auto v = value(flag);
+            if (!v) return v.error();
+            a.overrides.push_back(std::string(field) + "=" + *v);
+            return Status::ok();
+        };
+        Status status;
+        if (arg == "--job") {
+            auto v = value("--job");
+            if (!v) return v.error();
+            a.job_file = *v;
+        } else if (arg == "--integrator") {
+            status = as_override("--integrator", "integrator");
+        } else if (arg == "--preset") {
+            status = as_override("--preset", "preset");
+        } else if (arg == "--width") {
+            status = as_override("--width", "image.width");
+        } else if (arg == "--height") {
+            status = as_override("--height", "image.height");
+        } else if (arg == "--spp") {
+            status = as_override("--spp", "image.spp");
+        } else if (arg == "--seed") {
+            status = as_override("--seed", "seed");
+        } else if (arg == "--set") {
+            auto v = value("--set");
+            if (!v) return v.error();
+            a.overrides.push_back(*v);
+        } else if (arg == "--threads") {
+            auto v = value("--threads");
+            if (!v) return v.error();
+            try {
+                size_t used = 0;
+                a.threads = std::stoi(*v, &used);
+                if (used != v->size() || a.threads < 0) throw std::invalid_argument("");
+            } catch (const std::exception&) {
+                return Error{"--threads: expected a non-negative integer, got '" + *v + "'"};
+            }
+        } else if (arg == "--scene-root") {
+            auto v = value("--scene-root");
+            if (!v) return v.error();
+            a.scene_root = *v;
+        } else if (arg == "-o" || arg == "--output") {
+            auto v = value("-o");
+            if (!v) return v.error();
+            a.output = *v;
+        } else if (arg == "--preview") {
+            auto v = value("--preview");
+            if (!v) return v.error();
+            a.preview = *v;
+        } else if (arg == "--stats-json") {
+            auto v = value("--stats-json");
+            if (!v) return v.error();
+            a.stats_json = *v;
+        } else if (arg == "--quiet") {
+            a.quiet = true;
+        } else if (!arg.empty() && arg[0] == '-') {
+            return Error{"unknown option '" + arg + "'"};
+        } else if (a.scene.empty()) {
+            a.scene = arg;
+        } else {
+            return Error{"unexpected argument '" + arg + "' (the scene is already '" + a.scene + "')"};
+        }
+        if (!status) return status.error();
+    }
+    if (a.output.empty()) return Error{"missing -o OUT.exr"};
+    if (a.scene.empty() && a.job_file.empty()) return Error{"missing SCENE or --job FILE"};
+    return a;
+}
+
+Expected<std::string> read_text_file(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return Error{path + ": cannot be read"};
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+
+/// A one-line progress bar on stderr, redrawn in place (only on a terminal).
+class ProgressBar {
+public:
+    explicit ProgressBar(bool enabled) : enabled_(enabled) {}
+    void update(size_t done, size_t total) {
+        if (!enabled_ || total == 0) return;
+        std::lock_guard lock(mutex_);
+        const int width = 40;
+        const int filled = static_cast<int>(width * done / total);
+        const int percent = static_cast<int>(100 * done / total);
+        if (percent == last_percent_ && done != total) return;
+        last_percent_ = percent;
+        std::fprintf(stderr, "\r[%s%s] %3d%%  %zu/%zu tiles", std::string(filled, '#').c_str(),
+                     std::string(width - filled, ' ').c_str(), percent, done, total);
+        if (done == total) std::fprintf(stderr, "\n");
+        std::fflush(stderr);
+    }
+
+private:
+    bool enabled_;
+    std::mutex mutex_;
+    int last_percent_ = -1;
+};
+
+void print_statistics(const RenderStatistics& s) {
+    std::fprintf(stderr, "%s, %dx%d, %d spp, %d threads\n", s.integrator.c_str(), s.width, s.height,
+                 s.samples_per_pixel, s.threads);
+    for (const PassTiming& p : s.passes) std::fprintf(stderr, "  %-14s %9.3f s\n", p.name.c_str(), p.seconds);
+    std::fprintf(stderr, "  %-14s %9.3f s\n", "total", s.total_seconds);
+    std::fprintf(stderr, "  rays %llu + shadow rays %llu, %.2f Mrays/s\n",
+                 static_cast<unsigned long long>(s.rays), static_cast<unsigned long long>(s.shadow_rays),
+                 s.rays_per_second() * 1e-6);
+}
+
+}  // namespace
+
+int run_render_command(std::span<const std::string> args) {
+    for (const std::string& a : args) {
+        if (a == "-h" || a == "--help") {
+            std::fputs(kUsage, stdout);
+            return 0;
+        }
+    }
+    auto parsed = parse_arguments(args);
+    if (!parsed) {
+        std::fprintf(stderr, "photond render: %s\n%s", parsed.error().message.c_str(), kUsage);
+        return 2;
+    }
+    const Arguments& a = *parsed;
+
+    nlohmann::json document = nlohmann::json::object();
+    if (!a.job_file.empty()) {
+        auto text = read_text_file(a.job_file);
+        if (!text) {
+            std::fprintf(stderr, "photond render: %s\n", text.error().message.c_str());
+            return 2;
+        }
+        document = nlohmann::json::parse(*text, nullptr, false);
+        if (document.is_discarded()) {
+            auto job = protocol::parse_job_text(*text);  // for its line/column message
+            std::fprintf(stderr, "photond render: %s: %s\n", a.job_file.c_str(),
+                         job ? "malformed JSON" : job.error().message.c_str());
+            return 2;
+        }
+    }
+    std::filesystem::path scene_root = a.scene_root.empty() ? std::filesystem::current_path()
+                                                             : std::filesystem::path(a.scene_root);
+    if (!a.scene.empty()) {
+        if (a.scene.rfind("builtin:", 0) == 0) {
+            document["scene"] = {{"builtin", a.scene.substr(8)}};
+        } else {
+            const std::filesystem::path file = std::filesystem::absolute(a.scene);
+            scene_root = file.parent_path();
+            document["scene"] = {{"path", file.filename().string()}};
+        }
+    }
+    for (const std::string& assignment : a.overrides) {
+        if (Status st = protocol::apply_override(document, assignment); !st) {
+            std::fprintf(stderr, "photond render: --set %s: %s\n", assignment.c_str(), st.error().message.c_str());
+            return 2;
+        }
+    }
+    auto job = protocol::parse_job(document);
+    if (!job) {
+        std::fprintf(stderr, "photond render: invalid job: %s\n", job.error().message.c_str());
+        return 2;
+    }
+
+    auto device = EmbreeDevice::create();
+    if (!device) {
+        std::fprintf(stderr, "photond render: %s\n", device.error().message.c_str());
+        return 1;
+    }
+    ProgressBar progress(!a.quiet && isatty(STDERR_FILENO));
+    PipelineOptions options;
+    options.threads = a.threads;
+    options.scene_root = scene_root;
+    options.callbacks.on_tile = [&](const TileEvent& e, const Image&) { progress.update(e.tiles_done, e.tiles_total); };
+    auto result = run_job(*job, *device, options);
+    if (!result) {
+        std::fprintf(stderr, "photond render: %s\n", result.error().message.c_str());
+        return 1;
+    }
+
+    ExrWriteOptions exr;
+    exr.pixel_type = job->output.pixel_type == "float" ? ExrPixelType::Float : ExrPixelType::Half;
+    exr.tile_size = job->image.tile_size;
+    if (Status st = write_exr(a.output, result->layers, exr); !st) {
+        std::fprintf(stderr, "photond render: %s\n", st.error().message.c_str());
+        return 1;
+    }
+    if (!a.preview.empty()) {
+        if (Status st = write_png_preview(a.preview, result->layers.beauty); !st) {
+            std::fprintf(stderr, "photond render: %s\n", st.error().message.c_str());
+            return 1;
+        }
+    }
+    if (!a.stats_json.empty()) {
+        nlohmann::json stats = protocol::to_json(result->statistics);
+        stats["job"] = protocol::to_json(*job);
+        std::ofstream out(a.stats_json);
+        out << stats.dump(2) << "\n";
+        if (!out) {
+            std::fprintf(stderr, "photond render: %s: cannot be written\n", a.stats_json.c_str());
+            return 1;
+        }
+    }
+    if (!a.quiet) print_statistics(result->statistics);
+    return 0;
+}
+
+}  // namespace photond::service

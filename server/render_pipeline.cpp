@@ -1,0 +1,144 @@
+#include "server/render_pipeline.h"
+
+#include <tbb/info.h>
+
+#include <chrono>
+
+#include "core/camera/camera.h"
+#include "core/integrators/direct.h"
+#include "core/integrators/path.h"
+#include "core/render/render_scene.h"
+#include "core/scene/builtin_scenes.h"
+#include "core/scene/gltf_loader.h"
+
+namespace photond::service {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+Vec3 to_vec3(const std::array<double, 3>& a) {
+    return Vec3(static_cast<float>(a[0]), static_cast<float>(a[1]), static_cast<float>(a[2]));
+}
+
+Expected<std::unique_ptr<Integrator>> make_integrator(const protocol::Job& job,
+                                                      std::shared_ptr<const RenderScene> scene) {
+    if (job.integrator == "path") return std::unique_ptr<Integrator>(new PathIntegrator(scene));
+    if (job.integrator == "direct") return std::unique_ptr<Integrator>(new DirectIntegrator(scene));
+    return Error{"integrator: '" + job.integrator + "' is not available in this build"};
+}
+
+}  // namespace
+
+Expected<std::shared_ptr<const Scene>> load_job_scene(const protocol::SceneRef& ref,
+                                                      const std::filesystem::path& scene_root) {
+    switch (ref.kind) {
+        case protocol::SceneRef::Kind::Builtin: {
+            auto scene = make_builtin_scene(ref.value);
+            if (!scene) return scene.error();
+            return std::make_shared<const Scene>(std::move(scene).value());
+        }
+        case protocol::SceneRef::Kind::Path: {
+            if (scene_root.empty()) return Error{"scene.path: no scene root is configured"};
+            const std::filesystem::path root = std::filesystem::weakly_canonical(scene_root);
+            const std::filesystem::path file = std::filesystem::weakly_canonical(root / ref.value);
+            const auto [root_end, file_it] = std::mismatch(root.begin(), root.end(), file.begin(), file.end());
+            if (root_end != root.end())
+                return Error{"scene.path: '" + ref.value + "' lies outside the scene root"};
+            GltfLoadOptions options;
+            options.bundle_root = file.parent_path();
+            auto scene = load_gltf_file(file, options);
+            if (!scene) return scene.error();
+            return std::make_shared<const Scene>(std::move(scene).value());
+        }
+        case protocol::SceneRef::Kind::Id:
+            return Error{"scene.id: uploaded scenes are served by the daemon only"};
+    }
+    return Error{"scene: unknown kind"};
+}
+
+Expected<CameraDesc> resolve_camera(const protocol::Job& job, const Scene& scene) {
+    if (job.camera) {
+        if (const auto* gltf = std::get_if<protocol::GltfCamera>(&*job.camera)) {
+            if (gltf->index < 0 || static_cast<size_t>(gltf->index) >= scene.cameras.size())
+                return Error{"camera.gltf_camera: the scene has " + std::to_string(scene.cameras.size()) +
+                             " camera(s); index " + std::to_string(gltf->index) + " does not exist"};
+            return scene.cameras[static_cast<size_t>(gltf->index)];
+        }
+        const auto& look = std::get<protocol::LookAtCamera>(*job.camera);
+        CameraDesc desc;
+        desc.name = "job";
+        desc.position = to_vec3(look.look_from);
+        desc.look_at = to_vec3(look.look_at);
+        desc.up = to_vec3(look.up);
+        desc.vfov_deg = static_cast<float>(look.vfov_deg);
+        return desc;
+    }
+    if (!scene.cameras.empty()) return scene.cameras.front();
+    // No camera anywhere: look at the scene's bounds from the +z side, framing them.
+    CameraDesc desc;
+    desc.name = "default";
+    const Vec3 center = scene.bounds.center();
+    const float radius = std::max(scene.bounds.radius(), 1e-3f);
+    desc.vfov_deg = 40.0f;
+    desc.look_at = center;
+    desc.position = center + Vec3(0.0f, 0.0f, radius / std::tan(0.5f * desc.vfov_deg * kPi / 180.0f) * 1.1f);
+    return desc;
+}
+
+Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<EmbreeDevice> device,
+                                 const PipelineOptions& options) {
+    const Clock::time_point start = Clock::now();
+    PipelineResult result;
+    RenderStatistics& stats = result.statistics;
+    stats.integrator = job.integrator;
+    stats.width = job.image.width;
+    stats.height = job.image.height;
+    stats.samples_per_pixel = job.image.spp;
+    stats.threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
+
+    if (!job.output.aovs.empty())
+        return Error{"output.aovs: the " + job.integrator + " integrator does not produce AOVs yet"};
+
+    Clock::time_point pass_start = Clock::now();
+    auto scene = load_job_scene(job.scene, options.scene_root);
+    if (!scene) return scene.error();
+    stats.passes.push_back({"scene", seconds_since(pass_start)});
+
+    pass_start = Clock::now();
+    auto render_scene = RenderScene::create(device, *scene);
+    if (!render_scene) return render_scene.error();
+    stats.passes.push_back({"acceleration", seconds_since(pass_start)});
+
+    auto camera_desc = resolve_camera(job, **scene);
+    if (!camera_desc) return camera_desc.error();
+    auto camera = Camera::create(*camera_desc, job.image.width, job.image.height);
+    if (!camera) return camera.error();
+    auto integrator = make_integrator(job, *render_scene);
+    if (!integrator) return integrator.error();
+
+    TileSettings tiles;
+    tiles.tile_size = job.image.tile_size;
+    tiles.samples_per_pixel = job.image.spp;
+    tiles.seed = job.seed;
+    tiles.threads = options.threads;
+    if (job.image.region) {
+        const auto& r = *job.image.region;
+        tiles.region = PixelRect{r[0], r[1], r[2], r[3]};
+    }
+    pass_start = Clock::now();
+    TileRenderResult rendered = render_tiles(**integrator, *camera, tiles, options.callbacks);
+    stats.render_seconds = seconds_since(pass_start);
+    stats.passes.push_back({"render", stats.render_seconds});
+    stats.rays = rendered.counters.rays;
+    stats.shadow_rays = rendered.counters.shadow_rays;
+    stats.cancelled = rendered.cancelled;
+    stats.total_seconds = seconds_since(start);
+    result.layers.beauty = std::move(rendered.image);
+    return result;
+}
+
+}  // namespace photond::service

@@ -1,0 +1,431 @@
+#!/usr/bin/env python3
+"""Writes the hand-made glTF test files of tests/scene/gltf_loader_test.cpp.
+
+Standard library only. The generated files are committed; rerun this script (from any directory)
+only when a test file has to change, and keep the expected values in the test in step.
+"""
+import base64
+import json
+import math
+import os
+import struct
+import zlib
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+FLOAT, U8, U16, U32 = 5126, 5121, 5123, 5125
+
+
+class Builder:
+    """Accumulates one binary buffer, its bufferViews and accessors, and the rest of the JSON."""
+
+    def __init__(self):
+        self.data = bytearray()
+        self.doc = {"asset": {"version": "2.0", "generator": "photond tests/data/gltf/generate.py"},
+                    "bufferViews": [], "accessors": []}
+
+    def view(self, payload, stride=None):
+        while len(self.data) % 4:
+            self.data.append(0)
+        view = {"buffer": 0, "byteOffset": len(self.data), "byteLength": len(payload)}
+        if stride:
+            view["byteStride"] = stride
+        self.data += payload
+        self.doc["bufferViews"].append(view)
+        return len(self.doc["bufferViews"]) - 1
+
+    def accessor(self, view, component_type, count, type_, byte_offset=0, normalized=False,
+                 **extra):
+        acc = {"bufferView": view, "componentType": component_type, "count": count, "type": type_}
+        if byte_offset:
+            acc["byteOffset"] = byte_offset
+        if normalized:
+            acc["normalized"] = True
+        acc.update(extra)
+        self.doc["accessors"].append(acc)
+        return len(self.doc["accessors"]) - 1
+
+    def floats(self, values, type_, count=None):
+        n = {"SCALAR": 1, "VEC2": 2, "VEC3": 3}[type_]
+        v = self.view(struct.pack("<%df" % len(values), *values))
+        return self.accessor(v, FLOAT, count if count is not None else len(values) // n, type_)
+
+    def indices(self, values, component_type):
+        fmt = {U8: "B", U16: "H", U32: "I"}[component_type]
+        v = self.view(struct.pack("<%d%s" % (len(values), fmt), *values))
+        return self.accessor(v, component_type, len(values), "SCALAR")
+
+    def finish(self, uri=None):
+        while len(self.data) % 4:
+            self.data.append(0)
+        if uri is None:
+            uri = "data:application/octet-stream;base64," + base64.b64encode(self.data).decode()
+        self.doc["buffers"] = [{"byteLength": len(self.data), "uri": uri}]
+        return self.doc
+
+    def glb(self):
+        doc = dict(self.doc)
+        while len(self.data) % 4:
+            self.data.append(0)
+        doc["buffers"] = [{"byteLength": len(self.data)}]
+        js = json.dumps(doc, separators=(",", ":")).encode()
+        js += b" " * ((4 - len(js) % 4) % 4)
+        total = 12 + 8 + len(js) + 8 + len(self.data)
+        return (struct.pack("<4sII", b"glTF", 2, total) +
+                struct.pack("<I4s", len(js), b"JSON") + js +
+                struct.pack("<I4s", len(self.data), b"BIN\0") + bytes(self.data))
+
+
+def write(name, doc):
+    path = os.path.join(HERE, name)
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, "w") as f:
+        json.dump(doc, f, indent=1)
+        f.write("\n")
+
+
+def png(width, height, rows, bit_depth=8):
+    """rows: list of rows of (r, g, b) tuples; RGB colour type."""
+    def chunk(kind, payload):
+        return (struct.pack(">I", len(payload)) + kind + payload +
+                struct.pack(">I", zlib.crc32(kind + payload) & 0xffffffff))
+    fmt = ">%d%s" % (width * 3, "B" if bit_depth == 8 else "H")
+    raw = b"".join(b"\0" + struct.pack(fmt, *[c for px in row for c in px]) for row in rows)
+    ihdr = struct.pack(">IIBBBBB", width, height, bit_depth, 2, 0, 0, 0)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(raw)) +
+            chunk(b"IEND", b""))
+
+
+def png_data_uri(data):
+    return "data:image/png;base64," + base64.b64encode(data).decode()
+
+
+QUAD_POSITIONS = [0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0]
+QUAD_INDICES = [0, 1, 2, 0, 2, 3]
+QUAD_UVS = [0, 0, 1, 0, 1, 1, 0, 1]
+
+
+def single_mesh_scene(b, primitives, mesh_name="Mesh"):
+    b.doc["meshes"] = [{"name": mesh_name, "primitives": primitives}]
+    b.doc["nodes"] = [{"name": "Node", "mesh": 0}]
+    b.doc["scenes"] = [{"nodes": [0]}]
+    b.doc["scene"] = 0
+
+
+def quad_indexed(index_type):
+    """A unit quad in z = 0 facing +Z, two triangles, indices of the given width."""
+    b = Builder()
+    if index_type == U16:
+        # Interleaved POSITION + NORMAL, byteStride 24, NORMAL at byteOffset 12.
+        inter = []
+        for i in range(4):
+            inter += QUAD_POSITIONS[3 * i:3 * i + 3] + [0, 0, 1]
+        v = b.view(struct.pack("<24f", *inter), stride=24)
+        pos = b.accessor(v, FLOAT, 4, "VEC3", min=[0, 0, 0], max=[1, 1, 0])
+        nrm = b.accessor(v, FLOAT, 4, "VEC3", byte_offset=12)
+    else:
+        pos = b.floats(QUAD_POSITIONS, "VEC3")
+        nrm = b.floats([0, 0, 1] * 4, "VEC3")
+    if index_type == U8:  # UNSIGNED_BYTE normalized texture coordinates
+        uv_view = b.view(bytes(int(c * 255) for c in QUAD_UVS))
+        uv = b.accessor(uv_view, U8, 4, "VEC2", normalized=True)
+    elif index_type == U32:  # UNSIGNED_SHORT normalized texture coordinates
+        uv_view = b.view(struct.pack("<8H", *[int(c * 65535) for c in QUAD_UVS]))
+        uv = b.accessor(uv_view, U16, 4, "VEC2", normalized=True)
+    else:
+        uv = b.floats(QUAD_UVS, "VEC2")
+    idx = b.indices(QUAD_INDICES, index_type)
+    single_mesh_scene(b, [{"attributes": {"POSITION": pos, "NORMAL": nrm, "TEXCOORD_0": uv},
+                           "indices": idx, "mode": 4}], "Quad")
+    return b
+
+
+def quad_non_indexed():
+    b = Builder()
+    flat = []
+    for i in QUAD_INDICES:
+        flat += QUAD_POSITIONS[3 * i:3 * i + 3]
+    pos = b.floats(flat, "VEC3")
+    nrm = b.floats([0, 0, 1] * 6, "VEC3")
+    single_mesh_scene(b, [{"attributes": {"POSITION": pos, "NORMAL": nrm}}], "Quad")
+    return b
+
+
+def strip_and_fan():
+    # Strip: zig-zag of 5 vertices -> 3 triangles, all facing +Z (non-indexed).
+    b = Builder()
+    strip = [0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 0, 2, 0]
+    pos = b.floats(strip, "VEC3")
+    single_mesh_scene(b, [{"attributes": {"POSITION": pos}, "mode": 5}], "Strip")
+    write("strip.gltf", b.finish())
+    # Fan: centre plus 4 rim vertices -> 3 triangles facing +Z (indexed, u16).
+    b = Builder()
+    fan = [0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, -1, 1, 0]
+    pos = b.floats(fan, "VEC3")
+    idx = b.indices([0, 1, 2, 3, 4], U16)
+    single_mesh_scene(b, [{"attributes": {"POSITION": pos}, "indices": idx, "mode": 6}], "Fan")
+    write("fan.gltf", b.finish())
+
+
+def triangle(b, with_normals=True):
+    pos = b.floats([0, 0, 0, 1, 0, 0, 0, 1, 0], "VEC3")
+    attrs = {"POSITION": pos}
+    if with_normals:
+        attrs["NORMAL"] = b.floats([0, 0, 1] * 3, "VEC3")
+    return attrs
+
+
+def hierarchy():
+    """Scene 1 (the default) instances one triangle three times through TRS and matrix nodes."""
+    b = Builder()
+    b.doc["meshes"] = [{"name": "Tri", "primitives": [{"attributes": triangle(b)}]}]
+    s = math.sqrt(0.5)
+    b.doc["nodes"] = [
+        # 0: TRS parent: translate (10,0,0), rotate 90 deg about +Z, uniform scale 2.
+        {"name": "Parent", "translation": [10, 0, 0], "rotation": [0, 0, s, s], "scale": [2, 2, 2],
+         "mesh": 0, "children": [1]},
+        # 1: matrix child: translate (0,0,5) (column-major).
+        {"name": "Child", "matrix": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 5, 1], "mesh": 0},
+        # 2: a root with a matrix only: translate (0,-3,0).
+        {"name": "Other", "matrix": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -3, 0, 1], "mesh": 0},
+        # 3: only in scene 0, which is not the default scene.
+        {"name": "NotInDefaultScene", "translation": [100, 100, 100], "mesh": 0},
+    ]
+    b.doc["scenes"] = [{"name": "Unused", "nodes": [3]}, {"name": "Main", "nodes": [0, 2]}]
+    b.doc["scene"] = 1
+    write("hierarchy.gltf", b.finish())
+
+
+def negative_scale():
+    b = Builder()
+    b.doc["meshes"] = [{"name": "Mirrored", "primitives": [{"attributes": triangle(b)},
+                                                            {"attributes": triangle(b, False)}]}]
+    b.doc["nodes"] = [{"name": "Mirror", "scale": [-1, 1, 1], "mesh": 0}]
+    b.doc["scenes"] = [{"nodes": [0]}]
+    write("negative_scale.gltf", b.finish())
+
+
+def flat_normals():
+    b = Builder()
+    pos = b.floats(QUAD_POSITIONS, "VEC3")
+    idx = b.indices(QUAD_INDICES, U16)
+    single_mesh_scene(b, [{"attributes": {"POSITION": pos}, "indices": idx}], "NoNormals")
+    write("flat_normals.gltf", b.finish())
+
+
+def camera():
+    b = Builder()
+    b.doc["meshes"] = [{"name": "Tri", "primitives": [{"attributes": triangle(b)}]}]
+    s = math.sqrt(0.5)
+    b.doc["cameras"] = [
+        {"name": "Persp", "type": "perspective",
+         "perspective": {"yfov": 0.8, "aspectRatio": 1.5, "znear": 0.1, "zfar": 100}},
+        {"name": "Ortho", "type": "orthographic",
+         "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 100}},
+    ]
+    b.doc["nodes"] = [
+        {"name": "Geometry", "mesh": 0},
+        # Rotation of 90 deg about +Y: the camera's -Z axis becomes world -X.
+        {"name": "CameraNode", "translation": [1, 2, 3], "rotation": [0, s, 0, s], "camera": 0},
+        {"name": "OrthoNode", "camera": 1},
+    ]
+    b.doc["scenes"] = [{"nodes": [0, 1, 2]}]
+    write("camera.gltf", b.finish())
+
+
+def lights():
+    b = Builder()
+    b.doc["meshes"] = [{"name": "Tri", "primitives": [{"attributes": triangle(b)}]}]
+    s = math.sqrt(0.5)
+    b.doc["extensionsUsed"] = ["KHR_lights_punctual"]
+    b.doc["extensionsRequired"] = ["KHR_lights_punctual"]
+    b.doc["extensions"] = {"KHR_lights_punctual": {"lights": [
+        {"name": "Bulb", "type": "point", "color": [1, 0.5, 0.25], "intensity": 10},
+        {"name": "Spot", "type": "spot", "intensity": 2,
+         "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.6}},
+        {"name": "Sun", "type": "directional", "color": [1, 1, 1], "intensity": 3},
+    ]}}
+    b.doc["nodes"] = [
+        {"name": "Geometry", "mesh": 0},
+        {"name": "BulbNode", "translation": [0, 5, 0],
+         "extensions": {"KHR_lights_punctual": {"light": 0}}},
+        # -90 deg about +X: the light's -Z axis points down (-Y).
+        {"name": "SpotNode", "translation": [1, 2, 3], "rotation": [-s, 0, 0, s],
+         "extensions": {"KHR_lights_punctual": {"light": 1}}},
+        # +90 deg about +Y: the light travels along -X.
+        {"name": "SunNode", "rotation": [0, s, 0, s],
+         "extensions": {"KHR_lights_punctual": {"light": 2}}},
+    ]
+    b.doc["scenes"] = [{"nodes": [0, 1, 2, 3]}]
+    write("lights.gltf", b.finish())
+
+
+def materials():
+    b = Builder()
+    exts = ["KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_materials_ior",
+            "KHR_materials_specular"]
+    b.doc["extensionsUsed"] = exts
+    b.doc["extensionsRequired"] = ["KHR_materials_ior"]
+    b.doc["materials"] = [
+        {"name": "Everything",
+         "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.25, 0.125, 0.5], "metallicFactor": 0.3,
+                                  "roughnessFactor": 0.7},
+         "emissiveFactor": [1, 0.5, 0.25], "doubleSided": True,
+         "extensions": {
+             "KHR_materials_emissive_strength": {"emissiveStrength": 4},
+             "KHR_materials_transmission": {"transmissionFactor": 0.9},
+             "KHR_materials_ior": {"ior": 1.33},
+             "KHR_materials_specular": {"specularFactor": 0.6,
+                                        "specularColorFactor": [0.9, 0.8, 0.7]},
+         }},
+        {"name": "Bare"},
+    ]
+    prims = [{"attributes": triangle(b), "material": 0},
+             {"attributes": triangle(b)},  # no material: the glTF default material
+             {"attributes": triangle(b), "material": 1}]
+    b.doc["meshes"] = [{"name": "Tris", "primitives": prims}]
+    b.doc["nodes"] = [{"mesh": 0}]
+    b.doc["scenes"] = [{"nodes": [0]}]
+    write("materials.gltf", b.finish())
+
+
+TEXTURE_ROWS = [[(255, 0, 0), (0, 128, 0)], [(0, 0, 64), (188, 188, 188)]]
+
+
+def textured_quad(b, image):
+    pos = b.floats(QUAD_POSITIONS, "VEC3")
+    uv = b.floats(QUAD_UVS, "VEC2")
+    idx = b.indices(QUAD_INDICES, U16)
+    b.doc["images"] = [image]
+    b.doc["textures"] = [{"source": 0}]
+    b.doc["materials"] = [{"name": "Textured", "pbrMetallicRoughness": {
+        "baseColorFactor": [0.5, 1, 1, 1], "baseColorTexture": {"index": 0}}}]
+    single_mesh_scene(b, [{"attributes": {"POSITION": pos, "TEXCOORD_0": uv}, "indices": idx,
+                           "material": 0}], "TexturedQuad")
+
+
+def textures():
+    b = Builder()
+    data = png(2, 2, TEXTURE_ROWS)
+    textured_quad(b, {"name": "checker", "uri": png_data_uri(data)})
+    write("texture.gltf", b.finish())
+    # 16-bit: 32768 / 65535 in every channel of the first texel.
+    b = Builder()
+    rows16 = [[(32768, 32768, 32768), (65535, 0, 0)], [(0, 65535, 0), (0, 0, 65535)]]
+    data = png(2, 2, rows16, bit_depth=16)
+    textured_quad(b, {"name": "deep", "uri": png_data_uri(data)})
+    write("texture16.gltf", b.finish())
+    # GLB: the same textured quad, the PNG stored in a bufferView of the binary chunk.
+    b = Builder()
+    image_view = b.view(png(2, 2, TEXTURE_ROWS))
+    textured_quad(b, {"name": "checker", "bufferView": image_view, "mimeType": "image/png"})
+    glb = b.glb()
+    with open(os.path.join(HERE, "textured_quad.glb"), "wb") as f:
+        f.write(glb)
+    with open(os.path.join(HERE, "broken", "truncated.glb"), "wb") as f:
+        f.write(glb[:len(glb) // 2])
+
+
+def sparse():
+    """Quad whose vertex 2 is moved to (2, 2, 0) by a sparse substitution."""
+    b = Builder()
+    base = b.view(struct.pack("<12f", *QUAD_POSITIONS))
+    sparse_idx = b.view(struct.pack("<H", 2))
+    sparse_val = b.view(struct.pack("<3f", 2, 2, 0))
+    pos = b.accessor(base, FLOAT, 4, "VEC3", sparse={
+        "count": 1, "indices": {"bufferView": sparse_idx, "componentType": U16},
+        "values": {"bufferView": sparse_val}})
+    idx = b.indices(QUAD_INDICES, U8)
+    single_mesh_scene(b, [{"attributes": {"POSITION": pos}, "indices": idx}], "SparseQuad")
+    write("sparse.gltf", b.finish())
+
+
+def broken():
+    with open(os.path.join(HERE, "broken", "invalid_json.gltf"), "w") as f:
+        f.write('{"asset": {"version": "2.0"}, "meshes": [ {"primitives": [\n')
+
+    b = quad_indexed(U16)
+    write("broken/missing_buffer.gltf", b.finish(uri="does_not_exist.bin"))
+
+    # POSITION claims 100 elements in a 48-byte bufferView.
+    b = Builder()
+    pos = b.floats(QUAD_POSITIONS, "VEC3", count=100)
+    idx = b.indices(QUAD_INDICES, U16)
+    single_mesh_scene(b, [{"attributes": {"POSITION": pos}, "indices": idx}], "TooLong")
+    write("broken/accessor_out_of_bounds.gltf", b.finish())
+
+    b = Builder()
+    pos = b.floats(QUAD_POSITIONS, "VEC3")
+    idx = b.indices([0, 1, 2, 0, 2, 7], U16)
+    single_mesh_scene(b, [{"attributes": {"POSITION": pos}, "indices": idx}], "BadIndex")
+    write("broken/index_out_of_range.gltf", b.finish())
+
+    b = Builder()
+    pos = b.floats([0, 0, 0, 1, 0, 0, 0, float("nan"), 0], "VEC3")
+    single_mesh_scene(b, [{"attributes": {"POSITION": pos}}], "Chair")
+    write("broken/nan_position.gltf", b.finish())
+
+    # The referenced file exists (tests/data/gltf/broken/outside.bin) but lies above the bundle.
+    b = Builder()
+    pos = b.floats([0, 0, 0, 1, 0, 0, 0, 1, 0], "VEC3")
+    single_mesh_scene(b, [{"attributes": {"POSITION": pos}}], "Escape")
+    data = bytes(b.data)
+    write("broken/traversal/traversal.gltf", b.finish(uri="../outside.bin"))
+    with open(os.path.join(HERE, "broken", "outside.bin"), "wb") as f:
+        f.write(data)
+
+    b = Builder()
+    pos = b.floats([0, 0, 0, 1, 0, 0, 0, 1, 0], "VEC3")
+    single_mesh_scene(b, [{"attributes": {"POSITION": pos}}], "Absolute")
+    write("broken/absolute_uri.gltf", b.finish(uri="/etc/passwd"))
+
+    b = quad_indexed(U8)
+    b.doc["extensionsUsed"] = ["KHR_draco_mesh_compression"]
+    b.doc["extensionsRequired"] = ["KHR_draco_mesh_compression"]
+    write("broken/unsupported_extension.gltf", b.finish())
+
+    b = Builder()
+    pos = b.floats([0, 0, 0, 1, 0, 0, 0, 1, 0], "VEC3")
+    single_mesh_scene(b, [{"attributes": {"POSITION": pos}, "mode": 0},
+                          {"attributes": {"POSITION": pos}, "mode": 1}], "PointsAndLines")
+    write("broken/no_triangles.gltf", b.finish())
+
+    b = Builder()
+    b.doc["meshes"] = [{"name": "Tri", "primitives": [{"attributes": triangle(b)}]}]
+    b.doc["nodes"] = [{"name": "A", "mesh": 0, "children": [1]}, {"name": "B", "children": [0]}]
+    b.doc["scenes"] = [{"nodes": [0]}]
+    write("broken/cycle.gltf", b.finish())
+
+    b = Builder()
+    pos = b.floats([0, 0, 0, 1, 0, 0, 0, 1, 0], "VEC3")
+    nrm = b.floats([0, 0, 0, 0, 0, 0], "VEC2")
+    single_mesh_scene(b, [{"attributes": {"POSITION": pos, "NORMAL": nrm}}], "Vec2Normals")
+    write("broken/wrong_normal_type.gltf", b.finish())
+
+    # A self-contained-looking file whose buffer is external: refused by load_gltf_memory.
+    b = quad_non_indexed()
+    write("broken/external_buffer.gltf", b.finish(uri="external_buffer.bin"))
+    with open(os.path.join(HERE, "broken", "external_buffer.bin"), "wb") as f:
+        f.write(bytes(b.data))
+
+
+def main():
+    os.makedirs(os.path.join(HERE, "broken"), exist_ok=True)
+    write("indexed_u8.gltf", quad_indexed(U8).finish())
+    write("indexed_u16.gltf", quad_indexed(U16).finish())
+    write("indexed_u32.gltf", quad_indexed(U32).finish())
+    write("non_indexed.gltf", quad_non_indexed().finish())
+    strip_and_fan()
+    hierarchy()
+    negative_scale()
+    flat_normals()
+    camera()
+    lights()
+    materials()
+    textures()
+    sparse()
+    broken()
+
+
+if __name__ == "__main__":
+    main()

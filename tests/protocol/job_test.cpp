@@ -1,0 +1,823 @@
+// The job description v1: presets, JSON round trip, every validation rule with its field path,
+// overrides, malformed JSON, and the JSON Schema built from the same limits.
+#include "protocol/job.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <regex>
+#include <set>
+
+#include "protocol/presets.h"
+
+namespace photond::protocol {
+namespace {
+
+using nlohmann::json;
+
+json base_job() { return {{"scene", {{"builtin", "cornell-box"}}}}; }
+
+/// The base job with "field=value" overrides applied.
+json job_with(std::initializer_list<std::string_view> overrides) {
+    json document = base_job();
+    for (std::string_view assignment : overrides) {
+        Status status = apply_override(document, assignment);
+        EXPECT_TRUE(status) << status.error().message;
+    }
+    return document;
+}
+
+/// The document is refused with an error at exactly `path` whose text contains `fragment`, both
+/// through parse_job_detailed and as the "path: message" of parse_job.
+::testing::AssertionResult rejects(const json& document, const std::string& path,
+                                   const std::string& fragment = "") {
+    auto result = parse_job_detailed(document);
+    if (std::holds_alternative<Job>(result)) {
+        return ::testing::AssertionFailure() << "accepted " << document.dump();
+    }
+    const FieldError& error = std::get<FieldError>(result);
+    std::string text = describe(error);
+    if (error.path != path) {
+        return ::testing::AssertionFailure()
+               << "path \"" << error.path << "\", expected \"" << path << "\": " << text;
+    }
+    if (text.find(fragment) == std::string::npos) {
+        return ::testing::AssertionFailure() << "\"" << text << "\" lacks \"" << fragment << "\"";
+    }
+    Expected<Job> plain = parse_job(document);
+    if (plain || plain.error().message != text ||
+        (!path.empty() && !plain.error().message.starts_with(path + ": "))) {
+        return ::testing::AssertionFailure() << "parse_job disagrees: " << text;
+    }
+    return ::testing::AssertionSuccess() << text;
+}
+
+::testing::AssertionResult accepts(const json& document) {
+    Expected<Job> job = parse_job(document);
+    if (!job) return ::testing::AssertionFailure() << job.error().message;
+    return ::testing::AssertionSuccess();
+}
+
+Job parsed(const json& document) {
+    Expected<Job> job = parse_job(document);
+    EXPECT_TRUE(job) << (job ? "" : job.error().message);
+    return job ? *job : Job{};
+}
+
+std::string repeat(char c, size_t n) { return std::string(n, c); }
+
+// ------------------------------------------------------------------------------- presets
+
+TEST(JobPresets, FinalIsTheDefaultPresetWithItsValues) {
+    Job job = parsed(base_job());
+    Job expected = *preset_defaults("final");
+    expected.scene = {SceneRef::Kind::Builtin, "cornell-box"};
+    EXPECT_EQ(job, expected);
+
+    EXPECT_EQ(job.preset, "final");
+    EXPECT_EQ(job.integrator, "photon-map");
+    EXPECT_FALSE(job.camera.has_value());
+    EXPECT_EQ(job.image.width, 512);
+    EXPECT_EQ(job.image.height, 512);
+    EXPECT_EQ(job.image.tile_size, 32);
+    EXPECT_EQ(job.image.spp, 4);
+    EXPECT_FALSE(job.image.region.has_value());
+    EXPECT_EQ(job.photons.global, 200000u);
+    EXPECT_EQ(job.photons.caustic, 100000u);
+    EXPECT_EQ(job.photons.k_global, 50u);
+    EXPECT_EQ(job.photons.k_caustic, 100u);
+    EXPECT_EQ(job.photons.seed, 1u);
+    EXPECT_EQ(job.gather.rays, 512u);
+    EXPECT_TRUE(job.irradiance_cache.enabled);
+    EXPECT_DOUBLE_EQ(job.irradiance_cache.a, 0.15);
+    EXPECT_TRUE(job.irradiance_cache.gradients);
+    EXPECT_DOUBLE_EQ(job.irradiance_cache.min_spacing_px, 1.5);
+    EXPECT_DOUBLE_EQ(job.irradiance_cache.max_spacing_px, 24.0);
+    EXPECT_EQ(job.output.pixel_type, "half");
+    EXPECT_TRUE(job.output.aovs.empty());
+    EXPECT_EQ(job.priority, 50);
+    EXPECT_EQ(job.seed, 1u);
+}
+
+TEST(JobPresets, PreviewIsCheaper) {
+    Job job = parsed(job_with({"preset=preview"}));
+    EXPECT_EQ(job.preset, "preview");
+    EXPECT_EQ(job.integrator, "photon-map");
+    EXPECT_EQ(job.image.width, 512);
+    EXPECT_EQ(job.image.spp, 1);
+    EXPECT_EQ(job.photons.global, 50000u);
+    EXPECT_EQ(job.photons.caustic, 25000u);
+    EXPECT_EQ(job.gather.rays, 128u);
+    EXPECT_DOUBLE_EQ(job.irradiance_cache.a, 0.3);
+}
+
+TEST(JobPresets, ReferenceUsesThePathTracer) {
+    Job job = parsed(job_with({"preset=reference"}));
+    EXPECT_EQ(job.preset, "reference");
+    EXPECT_EQ(job.integrator, "path");
+    EXPECT_EQ(job.image.spp, 1024);
+    EXPECT_EQ(job.image.width, 512);
+}
+
+TEST(JobPresets, EveryPresetIsValidAndUnknownNamesHaveNone) {
+    for (std::string_view name : kPresetNames) {
+        std::optional<Job> defaults = preset_defaults(name);
+        ASSERT_TRUE(defaults) << name;
+        defaults->scene = {SceneRef::Kind::Builtin, "cornell-box"};
+        EXPECT_EQ(parsed(to_json(*defaults)), *defaults) << name;
+    }
+    EXPECT_FALSE(preset_defaults("draft"));
+    EXPECT_FALSE(preset_defaults(""));
+}
+
+TEST(JobPresets, JobFieldsOverrideThePresetFieldByField) {
+    Job job = parsed(
+        job_with({"preset=preview", "image.spp=8", "photons.global=1000", "integrator=direct"}));
+    Job preview = *preset_defaults("preview");
+    EXPECT_EQ(job.image.spp, 8);
+    EXPECT_EQ(job.image.width, preview.image.width);
+    EXPECT_EQ(job.image.tile_size, preview.image.tile_size);
+    EXPECT_EQ(job.photons.global, 1000u);
+    EXPECT_EQ(job.photons.caustic, preview.photons.caustic);
+    EXPECT_EQ(job.gather, preview.gather);
+    EXPECT_EQ(job.irradiance_cache, preview.irradiance_cache);
+    EXPECT_EQ(job.integrator, "direct");
+}
+
+// ---------------------------------------------------------------------------- round trip
+
+Job full_job() {
+    Job job = *preset_defaults("preview");
+    job.scene = {SceneRef::Kind::Path, "city/block 7.glb"};
+    job.camera = LookAtCamera{{1.25, -2.0, 3e5}, {0.1, 0.2, 0.3}, {0.0, 1.0, 0.1}, 55.5};
+    job.image = ImageSpec{.width = 640,
+                          .height = 360,
+                          .tile_size = 16,
+                          .spp = 7,
+                          .region = std::array<int, 4>{10, 20, 630, 350}};
+    job.integrator = "path";
+    job.photons = PhotonSpec{123, 456, 9, 999, 0xfedcba9876543210ull};
+    job.gather.rays = 333;
+    job.irradiance_cache = IrradianceCacheSpec{false, 0.1234567890123, false, 0.1, 1024.0};
+    job.output = OutputSpec{"float", {"depth", "direct", "normal"}};
+    job.priority = 100;
+    job.seed = std::numeric_limits<uint64_t>::max();
+    return job;
+}
+
+TEST(JobRoundTrip, EveryFieldSurvivesJsonAndText) {
+    Job job = full_job();
+    EXPECT_EQ(parsed(to_json(job)), job);
+    Expected<Job> from_text = parse_job_text(to_json(job).dump(2));
+    ASSERT_TRUE(from_text) << from_text.error().message;
+    EXPECT_EQ(*from_text, job);
+}
+
+TEST(JobRoundTrip, GltfCameraAndSceneIdAndDefaults) {
+    Job job = *preset_defaults("reference");
+    job.scene = {SceneRef::Kind::Id, "sha256:" + repeat('a', 64)};
+    job.camera = GltfCamera{3};
+    EXPECT_EQ(parsed(to_json(job)), job);
+
+    json document = to_json(job);
+    EXPECT_EQ(document["camera"], json({{"gltf_camera", 3}}));
+    EXPECT_EQ(document["scene"], json({{"id", job.scene.value}}));
+    EXPECT_FALSE(document["image"].contains("region"));
+}
+
+TEST(JobRoundTrip, ToJsonFillsEveryDefault) {
+    json document = to_json(parsed(base_job()));
+    for (std::string_view key : {"scene", "image", "preset", "integrator", "photons", "gather",
+                                 "irradiance_cache", "output", "priority", "seed"}) {
+        EXPECT_TRUE(document.contains(key)) << key;
+    }
+    EXPECT_FALSE(document.contains("camera"));  // absent means "the scene decides"
+    EXPECT_EQ(document["image"]["spp"], 4);
+    EXPECT_EQ(document["irradiance_cache"]["max_spacing_px"], 24.0);
+}
+
+TEST(JobRoundTrip, LookAtCameraDefaultsUpAndFieldOfView) {
+    Job job = parsed(job_with({"camera={\"look_from\": [0, 1, 5], \"look_at\": [0, 1, 0]}"}));
+    ASSERT_TRUE(job.camera);
+    const auto& camera = std::get<LookAtCamera>(*job.camera);
+    EXPECT_EQ(camera.look_from, (std::array<double, 3>{0, 1, 5}));
+    EXPECT_EQ(camera.up, (std::array<double, 3>{0, 1, 0}));
+    EXPECT_EQ(camera.vfov_deg, 40.0);
+}
+
+// ------------------------------------------------------------------------ unknown fields
+
+TEST(JobValidation, UnknownTopLevelFieldIsNamed) {
+    EXPECT_TRUE(rejects(job_with({"colour=red"}), "colour", "colour: unknown field"));
+}
+
+TEST(JobValidation, UnknownNestedFieldsAreNamed) {
+    EXPECT_TRUE(rejects(job_with({"image.sppp=4"}), "image.sppp", "image.sppp: unknown field"));
+    EXPECT_TRUE(rejects(job_with({"scene.extra=1"}), "scene.extra", "unknown field"));
+    EXPECT_TRUE(rejects(job_with({"camera.fov=40"}), "camera.fov", "unknown field"));
+    EXPECT_TRUE(rejects(job_with({"photons.count=4"}), "photons.count", "unknown field"));
+    EXPECT_TRUE(rejects(job_with({"gather.ray=4"}), "gather.ray", "unknown field"));
+    EXPECT_TRUE(
+        rejects(job_with({"irradiance_cache.A=0.1"}), "irradiance_cache.A", "unknown field"));
+    EXPECT_TRUE(rejects(job_with({"output.format=exr"}), "output.format", "unknown field"));
+}
+
+// ----------------------------------------------------------------------- types and shape
+
+TEST(JobValidation, DocumentMustBeAnObject) {
+    EXPECT_TRUE(rejects(json::array({1, 2}), "", "the job must be a JSON object"));
+    EXPECT_TRUE(rejects(json("job"), "", "the job must be a JSON object"));
+}
+
+TEST(JobValidation, SectionsMustBeObjects) {
+    EXPECT_TRUE(rejects(job_with({"image=5"}), "image", "must be an object"));
+    EXPECT_TRUE(rejects(job_with({"photons=[]"}), "photons", "must be an object"));
+    EXPECT_TRUE(rejects(job_with({"camera=null"}), "camera", "must be an object"));
+}
+
+TEST(JobValidation, IntegersMustBeJsonIntegers) {
+    EXPECT_TRUE(rejects(job_with({"image.spp=16.0"}), "image.spp", "must be an integer"));
+    EXPECT_TRUE(rejects(job_with({"image.width=\"512\""}), "image.width", "must be an integer"));
+    EXPECT_TRUE(rejects(job_with({"image.width=true"}), "image.width", "must be an integer"));
+}
+
+TEST(JobValidation, NanLikeStringsAreNotNumbers) {
+    EXPECT_TRUE(
+        rejects(job_with({"irradiance_cache.a=NaN"}), "irradiance_cache.a", "must be a number"));
+    EXPECT_TRUE(rejects(job_with({"image.width=Infinity"}), "image.width", "must be an integer"));
+    json document = job_with({});
+    document["irradiance_cache"]["a"] = std::nan("");
+    EXPECT_TRUE(rejects(document, "irradiance_cache.a", "must be in (0, 1]"));
+}
+
+TEST(JobValidation, HugeNumbersAreOutOfRange) {
+    EXPECT_TRUE(rejects(job_with({"image.width=99999999999999999999999"}), "image.width",
+                        "must be an integer in [1, 16384]"));
+    EXPECT_TRUE(
+        rejects(job_with({"image.height=4294967808"}), "image.height", "must be in [1, 16384]"));
+    // Beyond double: the JSON reader itself refuses it, with its position.
+    Expected<Job> job = parse_job_text(
+        "{\"scene\": {\"builtin\": \"cornell-box\"},\n \"irradiance_cache\": {\"a\": 1e400}}");
+    ASSERT_FALSE(job);
+    EXPECT_TRUE(job.error().message.starts_with("malformed JSON at line 2 column "))
+        << job.error().message;
+    EXPECT_NE(job.error().message.find("1e400"), std::string::npos) << job.error().message;
+    // As an override value it does not parse as JSON, so it stays a string.
+    EXPECT_TRUE(
+        rejects(job_with({"irradiance_cache.a=1e400"}), "irradiance_cache.a", "must be a number"));
+}
+
+TEST(JobValidation, NegativeNumbersForCountsAreOutOfRange) {
+    EXPECT_TRUE(
+        rejects(job_with({"photons.global=-1"}), "photons.global", "must be in [0, 50000000]"));
+    EXPECT_TRUE(rejects(job_with({"seed=-1"}), "seed", "must be in [0, 18446744073709551615]"));
+}
+
+// ----------------------------------------------------------------------------- the scene
+
+TEST(JobValidation, SceneIsRequired) { EXPECT_TRUE(rejects(json::object(), "scene", "required")); }
+
+TEST(JobValidation, SceneHasExactlyOneForm) {
+    EXPECT_TRUE(rejects(job_with({"scene.path=a.glb"}), "scene", "exactly one of"));
+    EXPECT_TRUE(rejects(job_with({"scene={}"}), "scene", "exactly one of"));
+    EXPECT_TRUE(rejects(job_with({"scene=cornell-box"}), "scene", "must be an object"));
+}
+
+TEST(JobValidation, SceneBuiltinIsAName) {
+    EXPECT_TRUE(rejects(job_with({"scene={\"builtin\": \"a b\"}"}), "scene.builtin",
+                        "built-in scene name"));
+    EXPECT_TRUE(rejects(job_with({"scene={\"builtin\": 5}"}), "scene.builtin", "must be a string"));
+    EXPECT_TRUE(rejects(job_with({"scene={\"builtin\": \"\"}"}), "scene.builtin"));
+}
+
+TEST(JobValidation, ScenePathStaysUnderTheSceneRoot) {
+    for (std::string path : {"/etc/passwd.glb", "../x.glb", "a/../../x.glb", "a/..", "..",
+                             "a\\..\\x.glb", "\\\\server\\x.glb", "C:/x.glb", "", "a\nb.glb"}) {
+        json document = {{"scene", {{"path", path}}}};
+        EXPECT_TRUE(rejects(document, "scene.path",
+                            path.empty() || path.find('\n') != path.npos
+                                ? ""
+                                : "scene.path: must be relative to the scene root, without '..'"))
+            << path;
+    }
+    for (std::string path :
+         {"x.glb", "city/block 7.gltf", "a..b/c.glb", "a/..b/.c/x.glb", "./x.glb"}) {
+        Job job = parsed({{"scene", {{"path", path}}}});
+        EXPECT_EQ(job.scene, (SceneRef{SceneRef::Kind::Path, path}));
+    }
+}
+
+TEST(JobValidation, SceneIdIsASha256ContentId) {
+    std::string good = "sha256:" + repeat('0', 32) + repeat('f', 32);
+    EXPECT_EQ(parsed({{"scene", {{"id", good}}}}).scene, (SceneRef{SceneRef::Kind::Id, good}));
+    for (std::string id :
+         {"sha256:" + repeat('a', 63), "sha256:" + repeat('a', 65), "sha256:" + repeat('A', 64),
+          "md5:" + repeat('a', 64), "sha256:" + repeat('g', 64), repeat('a', 64)}) {
+        EXPECT_TRUE(rejects({{"scene", {{"id", id}}}}, "scene.id", "64 lowercase hex")) << id;
+    }
+}
+
+// ---------------------------------------------------------------------------- the camera
+
+TEST(JobValidation, CameraHasExactlyOneForm) {
+    EXPECT_TRUE(rejects(
+        job_with({"camera.gltf_camera=0", "camera.look_from=[0,0,1]", "camera.look_at=[0,0,0]"}),
+        "camera", "not both"));
+    EXPECT_TRUE(
+        rejects(job_with({"camera.gltf_camera=0", "camera.vfov_deg=30"}), "camera", "not both"));
+    EXPECT_TRUE(rejects(job_with({"camera={}"}), "camera", "gltf_camera"));
+}
+
+TEST(JobValidation, CameraLookAtNeedsBothPoints) {
+    EXPECT_TRUE(rejects(job_with({"camera.look_at=[0,0,0]"}), "camera.look_from", "required"));
+    EXPECT_TRUE(rejects(job_with({"camera.look_from=[0,0,1]", "camera.up=[0,1,0]"}),
+                        "camera.look_at", "required"));
+}
+
+TEST(JobValidation, CameraGltfIndexIsANonNegativeInteger) {
+    EXPECT_TRUE(rejects(job_with({"camera.gltf_camera=-1"}), "camera.gltf_camera",
+                        "must be in [0, 2147483647]"));
+    EXPECT_TRUE(
+        rejects(job_with({"camera.gltf_camera=1.0"}), "camera.gltf_camera", "must be an integer"));
+    EXPECT_TRUE(accepts(job_with({"camera.gltf_camera=2"})));
+}
+
+TEST(JobValidation, CameraVectorsAreThreeFiniteNumbers) {
+    EXPECT_TRUE(rejects(job_with({"camera.look_from=[0,0]", "camera.look_at=[0,0,0]"}),
+                        "camera.look_from", "array of 3 numbers"));
+    EXPECT_TRUE(rejects(job_with({"camera.look_from=[0,0,1]", "camera.look_at=[0,0,0,0]"}),
+                        "camera.look_at", "array of 3 numbers"));
+    EXPECT_TRUE(rejects(job_with({"camera.look_from=[0,\"x\",1]", "camera.look_at=[0,0,0]"}),
+                        "camera.look_from[1]", "must be a number"));
+    EXPECT_TRUE(rejects(job_with({"camera.look_from=[1e39,0,1]", "camera.look_at=[0,0,0]"}),
+                        "camera.look_from[0]", "must be in"));
+    EXPECT_TRUE(rejects(
+        job_with({"camera.look_from=[0,0,1]", "camera.look_at=[0,0,0]", "camera.up={\"y\": 1}"}),
+        "camera.up", "array of 3 numbers"));
+}
+
+TEST(JobValidation, CameraLookFromDiffersFromLookAt) {
+    EXPECT_TRUE(rejects(job_with({"camera.look_from=[1,2,3]", "camera.look_at=[1,2,3]"}),
+                        "camera.look_at", "must differ from camera.look_from"));
+}
+
+TEST(JobValidation, CameraUpIsNotParallelToTheViewDirection) {
+    EXPECT_TRUE(rejects(job_with({"camera.look_from=[0,5,0]", "camera.look_at=[0,0,0]"}),
+                        "camera.up", "parallel"));  // the default up [0, 1, 0]
+    EXPECT_TRUE(rejects(
+        job_with({"camera.look_from=[0,0,1]", "camera.look_at=[0,0,0]", "camera.up=[0,0,-2]"}),
+        "camera.up", "parallel"));
+    EXPECT_TRUE(rejects(
+        job_with({"camera.look_from=[0,0,1]", "camera.look_at=[0,0,0]", "camera.up=[0,0,0]"}),
+        "camera.up", "zero"));
+    EXPECT_TRUE(accepts(
+        job_with({"camera.look_from=[0,0,1]", "camera.look_at=[0,0,0]", "camera.up=[0.01,0,1]"})));
+}
+
+TEST(JobValidation, CameraFieldOfViewIsInsideZeroTo180) {
+    for (std::string_view fov : {"0", "180", "-5", "200"}) {
+        json document = job_with({"camera.look_from=[0,0,1]", "camera.look_at=[0,0,0]"});
+        document["camera"]["vfov_deg"] = json::parse(fov);
+        EXPECT_TRUE(rejects(document, "camera.vfov_deg", "must be in (0, 180)")) << fov;
+    }
+    EXPECT_TRUE(accepts(
+        job_with({"camera.look_from=[0,0,1]", "camera.look_at=[0,0,0]", "camera.vfov_deg=179.5"})));
+}
+
+// ----------------------------------------------------------------------------- the image
+
+TEST(JobValidation, ImageWidthAndHeightLimits) {
+    EXPECT_TRUE(rejects(job_with({"image.width=0"}), "image.width", "must be in [1, 16384]"));
+    EXPECT_TRUE(rejects(job_with({"image.width=16385"}), "image.width", "[1, 16384]"));
+    EXPECT_TRUE(rejects(job_with({"image.height=0"}), "image.height", "[1, 16384]"));
+    EXPECT_TRUE(rejects(job_with({"image.height=16385"}), "image.height", "[1, 16384]"));
+    EXPECT_TRUE(accepts(job_with({"image.width=1", "image.height=16384"})));
+}
+
+TEST(JobValidation, ImageHasAtMost64Megapixels) {
+    EXPECT_TRUE(accepts(job_with({"image.width=16384", "image.height=4096"})));
+    EXPECT_TRUE(rejects(job_with({"image.width=16384", "image.height=4097"}), "image",
+                        "at most 67108864 pixels"));
+}
+
+TEST(JobValidation, ImageTileSizeLimits) {
+    EXPECT_TRUE(rejects(job_with({"image.tile_size=7"}), "image.tile_size", "[8, 256]"));
+    EXPECT_TRUE(rejects(job_with({"image.tile_size=257"}), "image.tile_size", "[8, 256]"));
+    EXPECT_TRUE(accepts(job_with({"image.tile_size=8"})));
+}
+
+TEST(JobValidation, ImageSamplesPerPixelLimits) {
+    EXPECT_TRUE(rejects(job_with({"image.spp=0"}), "image.spp", "[1, 65536]"));
+    EXPECT_TRUE(rejects(job_with({"image.spp=65537"}), "image.spp", "[1, 65536]"));
+    EXPECT_TRUE(accepts(job_with({"image.spp=65536"})));
+}
+
+TEST(JobValidation, ImageRegionIsFourIntegers) {
+    EXPECT_TRUE(rejects(job_with({"image.region=[0,0,8]"}), "image.region", "4 integers"));
+    EXPECT_TRUE(rejects(job_with({"image.region=\"0,0,8,8\""}), "image.region", "4 integers"));
+    EXPECT_TRUE(
+        rejects(job_with({"image.region=[0,0,8.5,8]"}), "image.region[2]", "must be an integer"));
+    EXPECT_TRUE(rejects(job_with({"image.region=[0,-1,8,8]"}), "image.region[1]", "must be in"));
+}
+
+TEST(JobValidation, ImageRegionLiesInsideTheImageWithPositiveSize) {
+    EXPECT_TRUE(accepts(job_with({"image.region=[0,0,512,512]"})));
+    EXPECT_TRUE(accepts(job_with({"image.region=[511,511,512,512]"})));
+    EXPECT_EQ(parsed(job_with({"image.region=[1,2,3,4]"})).image.region,
+              (std::array<int, 4>{1, 2, 3, 4}));
+    EXPECT_TRUE(rejects(job_with({"image.region=[512,0,513,8]"}), "image.region[0]",
+                        "inside the 512 x 512 image"));
+    EXPECT_TRUE(rejects(job_with({"image.region=[0,512,8,513]"}), "image.region[1]"));
+    EXPECT_TRUE(rejects(job_with({"image.region=[8,0,8,8]"}), "image.region[2]", "x1 > x0"));
+    EXPECT_TRUE(rejects(job_with({"image.region=[0,0,513,8]"}), "image.region[2]"));
+    EXPECT_TRUE(rejects(job_with({"image.region=[0,9,8,9]"}), "image.region[3]", "y1 > y0"));
+    EXPECT_TRUE(rejects(job_with({"image.region=[0,0,8,513]"}), "image.region[3]"));
+    // Checked against the merged size, not the preset's.
+    EXPECT_TRUE(rejects(job_with({"image.width=100", "image.region=[0,0,101,10]"}),
+                        "image.region[2]", "inside the 100 x 512 image"));
+}
+
+// ------------------------------------------------------------------ photons, gather, cache
+
+TEST(JobValidation, PhotonCountLimits) {
+    for (std::string_view field : {"global", "caustic"}) {
+        std::string path = "photons." + std::string(field);
+        EXPECT_TRUE(rejects(job_with({path + "=50000001"}), path, "[0, 50000000]"));
+        EXPECT_TRUE(rejects(job_with({path + "=-1"}), path, "[0, 50000000]"));
+        EXPECT_TRUE(accepts(job_with({path + "=0"})));
+        EXPECT_TRUE(accepts(job_with({path + "=50000000"})));
+    }
+}
+
+TEST(JobValidation, PhotonNeighbourCountLimits) {
+    for (std::string_view field : {"k_global", "k_caustic"}) {
+        std::string path = "photons." + std::string(field);
+        EXPECT_TRUE(rejects(job_with({path + "=7"}), path, "[8, 1000]"));
+        EXPECT_TRUE(rejects(job_with({path + "=1001"}), path, "[8, 1000]"));
+        EXPECT_TRUE(accepts(job_with({path + "=8"})));
+    }
+}
+
+TEST(JobValidation, SeedsAreUnsigned64BitIntegers) {
+    for (std::string path : {"seed", "photons.seed"}) {
+        EXPECT_TRUE(rejects(job_with({path + "=-1"}), path, "must be in")) << path;
+        EXPECT_TRUE(rejects(job_with({path + "=1.5"}), path, "must be an integer")) << path;
+        EXPECT_TRUE(rejects(job_with({path + "=\"7\""}), path, "must be an integer")) << path;
+        // One more than UINT64_MAX: only representable as a float by the JSON reader.
+        EXPECT_TRUE(rejects(job_with({path + "=18446744073709551616"}), path, "must be an integer"))
+            << path;
+    }
+    Job job = parsed(job_with({"seed=18446744073709551615", "photons.seed=0"}));
+    EXPECT_EQ(job.seed, std::numeric_limits<uint64_t>::max());
+    EXPECT_EQ(job.photons.seed, 0u);
+}
+
+TEST(JobValidation, GatherRayLimits) {
+    EXPECT_TRUE(rejects(job_with({"gather.rays=0"}), "gather.rays", "[1, 16384]"));
+    EXPECT_TRUE(rejects(job_with({"gather.rays=16385"}), "gather.rays", "[1, 16384]"));
+    EXPECT_TRUE(accepts(job_with({"gather.rays=1"})));
+}
+
+TEST(JobValidation, CacheAccuracyIsInZeroToOne) {
+    EXPECT_TRUE(rejects(job_with({"irradiance_cache.a=0"}), "irradiance_cache.a",
+                        "irradiance_cache.a: must be in (0, 1]"));
+    EXPECT_TRUE(rejects(job_with({"irradiance_cache.a=1.0001"}), "irradiance_cache.a",
+                        "must be in (0, 1]"));
+    EXPECT_TRUE(rejects(job_with({"irradiance_cache.a=-0.1"}), "irradiance_cache.a"));
+    EXPECT_EQ(parsed(job_with({"irradiance_cache.a=1"})).irradiance_cache.a, 1.0);
+}
+
+TEST(JobValidation, CacheSpacingIsPositiveOrderedAndBounded) {
+    EXPECT_TRUE(rejects(job_with({"irradiance_cache.min_spacing_px=0"}),
+                        "irradiance_cache.min_spacing_px", "must be in (0, 1024]"));
+    EXPECT_TRUE(rejects(job_with({"irradiance_cache.max_spacing_px=1025"}),
+                        "irradiance_cache.max_spacing_px", "must be in (0, 1024]"));
+    EXPECT_TRUE(rejects(job_with({"irradiance_cache.min_spacing_px=30"}),
+                        "irradiance_cache.max_spacing_px", "at least"));
+    EXPECT_TRUE(accepts(job_with({"irradiance_cache.min_spacing_px=24"})));
+    EXPECT_TRUE(accepts(job_with(
+        {"irradiance_cache.min_spacing_px=1024", "irradiance_cache.max_spacing_px=1024"})));
+}
+
+TEST(JobValidation, CacheSwitchesAreBooleans) {
+    EXPECT_TRUE(rejects(job_with({"irradiance_cache.enabled=yes"}), "irradiance_cache.enabled",
+                        "must be true or false"));
+    EXPECT_TRUE(rejects(job_with({"irradiance_cache.gradients=1"}), "irradiance_cache.gradients",
+                        "must be true or false"));
+    EXPECT_FALSE(parsed(job_with({"irradiance_cache.enabled=false"})).irradiance_cache.enabled);
+}
+
+// ----------------------------------------------------------------- output and the choices
+
+TEST(JobValidation, PixelTypeIsHalfOrFloat) {
+    EXPECT_TRUE(rejects(job_with({"output.pixel_type=double"}), "output.pixel_type",
+                        "one of \"half\", \"float\""));
+    EXPECT_EQ(parsed(job_with({"output.pixel_type=float"})).output.pixel_type, "float");
+}
+
+TEST(JobValidation, AovsAreKnownAndDistinct) {
+    EXPECT_TRUE(rejects(job_with({"output.aovs=[\"direct\", \"beauty\"]"}), "output.aovs[1]",
+                        "must be one of"));
+    EXPECT_TRUE(rejects(job_with({"output.aovs=[\"direct\", \"depth\", \"direct\"]"}),
+                        "output.aovs[2]", "duplicate AOV \"direct\""));
+    EXPECT_TRUE(rejects(job_with({"output.aovs=direct"}), "output.aovs", "array"));
+    EXPECT_TRUE(rejects(job_with({"output.aovs=[1]"}), "output.aovs[0]"));
+    std::vector<std::string> all(kAovNames.begin(), kAovNames.end());
+    json document = base_job();
+    document["output"]["aovs"] = all;
+    EXPECT_EQ(parsed(document).output.aovs, all);
+    EXPECT_TRUE(parsed(job_with({"output.aovs=[]"})).output.aovs.empty());
+}
+
+TEST(JobValidation, PriorityLimits) {
+    EXPECT_TRUE(rejects(job_with({"priority=-1"}), "priority", "[0, 100]"));
+    EXPECT_TRUE(rejects(job_with({"priority=101"}), "priority", "[0, 100]"));
+    EXPECT_EQ(parsed(job_with({"priority=0"})).priority, 0);
+}
+
+TEST(JobValidation, IntegratorIsKnown) {
+    EXPECT_TRUE(rejects(job_with({"integrator=bdpt"}), "integrator",
+                        "one of \"photon-map\", \"path\", \"direct\""));
+    for (std::string_view name : kIntegratorNames) {
+        EXPECT_EQ(parsed(job_with({"integrator=" + std::string(name)})).integrator, name);
+    }
+}
+
+TEST(JobValidation, PresetIsKnown) {
+    EXPECT_TRUE(rejects(job_with({"preset=draft"}), "preset",
+                        "one of \"preview\", \"final\", \"reference\""));
+    EXPECT_TRUE(rejects(job_with({"preset=3"}), "preset"));
+}
+
+// ------------------------------------------------------------------------ apply_override
+
+TEST(JobOverride, ValuesAreJsonWhenTheyParse) {
+    json document = base_job();
+    ASSERT_TRUE(apply_override(document, "image.spp=16"));
+    ASSERT_TRUE(apply_override(document, "photons.seed=3"));
+    ASSERT_TRUE(apply_override(document, "irradiance_cache.enabled=false"));
+    ASSERT_TRUE(apply_override(document, "output.aovs=[\"direct\"]"));
+    ASSERT_TRUE(apply_override(document, "irradiance_cache.a=0.25"));
+    EXPECT_TRUE(document["image"]["spp"].is_number_integer());
+    EXPECT_TRUE(document["irradiance_cache"]["enabled"].is_boolean());
+    Job job = parsed(document);
+    EXPECT_EQ(job.image.spp, 16);
+    EXPECT_EQ(job.photons.seed, 3u);
+    EXPECT_FALSE(job.irradiance_cache.enabled);
+    EXPECT_EQ(job.irradiance_cache.a, 0.25);
+    EXPECT_EQ(job.output.aovs, std::vector<std::string>{"direct"});
+}
+
+TEST(JobOverride, OtherValuesAreStrings) {
+    json document;  // null: becomes an object
+    ASSERT_TRUE(apply_override(document, "scene.builtin=cornell-box"));
+    ASSERT_TRUE(apply_override(document, " preset = preview "));
+    ASSERT_TRUE(apply_override(document, "output.pixel_type=\"float\""));
+    EXPECT_EQ(document, json::parse(R"({"scene": {"builtin": "cornell-box"},
+        "preset": "preview", "output": {"pixel_type": "float"}})"));
+    ASSERT_TRUE(apply_override(document, "output.pixel_type="));
+    EXPECT_EQ(document["output"]["pixel_type"], "");
+}
+
+TEST(JobOverride, ReplacesWholeObjectsAndCreatesIntermediates) {
+    json document = job_with(
+        {"scene={\"path\": \"a.glb\"}", "camera.look_from=[0,0,1]", "camera.look_at=[0,0,0]"});
+    EXPECT_EQ(document["scene"], json({{"path", "a.glb"}}));
+    Job job = parsed(document);
+    EXPECT_EQ(job.scene.kind, SceneRef::Kind::Path);
+    ASSERT_TRUE(job.camera);
+    EXPECT_EQ(std::get<LookAtCamera>(*job.camera).look_from, (std::array<double, 3>{0, 0, 1}));
+}
+
+TEST(JobOverride, MalformedAssignmentsAreErrors) {
+    json document = base_job();
+    for (std::string_view bad : {"image.spp", "=5", "image..spp=1", "image.=1", ".spp=1"}) {
+        Status status = apply_override(document, bad);
+        ASSERT_FALSE(status) << bad;
+        EXPECT_NE(status.error().message.find(std::string(bad)), std::string::npos)
+            << status.error().message;
+    }
+    EXPECT_EQ(document, base_job());  // nothing changed
+
+    ASSERT_TRUE(apply_override(document, "image=5"));
+    Status status = apply_override(document, "image.spp=16");
+    ASSERT_FALSE(status);
+    EXPECT_NE(status.error().message.find("\"image\" is not an object"), std::string::npos)
+        << status.error().message;
+
+    json array = json::array();
+    EXPECT_FALSE(apply_override(array, "image.spp=1"));
+}
+
+TEST(JobOverride, UnknownPathsAreCaughtByParseJob) {
+    json document = base_job();
+    ASSERT_TRUE(apply_override(document, "image.sppp=4"));
+    EXPECT_TRUE(rejects(document, "image.sppp", "unknown field"));
+}
+
+// ------------------------------------------------------------------------ malformed JSON
+
+TEST(JobText, MalformedJsonNamesLineAndColumn) {
+    std::string text =
+        "{\n  \"scene\": {\"builtin\": \"cornell-box\"},\n  \"image\": {\"spp\": 4,}\n}";
+    auto result = parse_job_text_detailed(text);
+    ASSERT_TRUE(std::holds_alternative<FieldError>(result));
+    const FieldError& error = std::get<FieldError>(result);
+    EXPECT_EQ(error.path, "");
+    EXPECT_TRUE(error.message.starts_with("malformed JSON at line 3 column 22: ")) << error.message;
+    Expected<Job> job = parse_job_text(text);
+    ASSERT_FALSE(job);
+    EXPECT_EQ(job.error().message, error.message);
+}
+
+TEST(JobText, TruncatedAndEmptyTextAreMalformed) {
+    Expected<Job> truncated = parse_job_text("{\"scene\": ");
+    ASSERT_FALSE(truncated);
+    EXPECT_TRUE(truncated.error().message.starts_with("malformed JSON at line 1 column 1"))
+        << truncated.error().message;
+    Expected<Job> empty = parse_job_text("");
+    ASSERT_FALSE(empty);
+    EXPECT_TRUE(empty.error().message.starts_with("malformed JSON at line 1 column 1:"))
+        << empty.error().message;
+}
+
+TEST(JobText, ValidTextIsValidated) {
+    Expected<Job> job = parse_job_text(R"({"scene": {"builtin": "cornell-box"}, "priority": 7})");
+    ASSERT_TRUE(job) << job.error().message;
+    EXPECT_EQ(job->priority, 7);
+    Expected<Job> bad = parse_job_text(R"({"scene": {"builtin": "cornell-box"}, "priorty": 7})");
+    ASSERT_FALSE(bad);
+    EXPECT_TRUE(bad.error().message.starts_with("priorty: unknown field")) << bad.error().message;
+}
+
+// -------------------------------------------------------------------------------- schema
+
+/// The schema nodes for a document path such as "image.region" or "camera.gltf_camera": object
+/// properties, looking inside "oneOf" alternatives.
+std::vector<json> schema_nodes(const json& schema, const std::string& path) {
+    std::vector<json> nodes{schema};
+    size_t start = 0;
+    while (start < path.size()) {
+        size_t end = std::min(path.find('.', start), path.size());
+        std::string key = path.substr(start, end - start);
+        std::vector<json> next;
+        for (const json& node : nodes) {
+            std::vector<json> candidates{node};
+            if (node.contains("oneOf"))
+                candidates.assign(node["oneOf"].begin(), node["oneOf"].end());
+            for (const json& candidate : candidates) {
+                if (candidate.contains("properties") && candidate["properties"].contains(key)) {
+                    next.push_back(candidate["properties"][key]);
+                }
+            }
+        }
+        nodes = std::move(next);
+        start = end + 1;
+    }
+    return nodes;
+}
+
+/// "image.width", "camera.look_from", ...: every field of a document (arrays are leaves).
+void collect_fields(const json& value, const std::string& prefix, std::set<std::string>& out) {
+    for (const auto& [key, child] : value.items()) {
+        std::string path = prefix.empty() ? key : prefix + "." + key;
+        out.insert(path);
+        if (child.is_object()) collect_fields(child, path, out);
+    }
+}
+
+/// Every property path the schema declares, through "oneOf" alternatives.
+void collect_schema_fields(const json& node, const std::string& prefix,
+                           std::set<std::string>& out) {
+    std::vector<json> candidates{node};
+    if (node.contains("oneOf")) candidates.assign(node["oneOf"].begin(), node["oneOf"].end());
+    for (const json& candidate : candidates) {
+        if (!candidate.contains("properties")) continue;
+        for (const auto& [key, child] : candidate["properties"].items()) {
+            std::string path = prefix.empty() ? key : prefix + "." + key;
+            out.insert(path);
+            collect_schema_fields(child, path, out);
+        }
+    }
+}
+
+std::set<std::string> every_document_field() {
+    std::set<std::string> fields;
+    collect_fields(to_json(full_job()), "", fields);
+    Job other = full_job();
+    other.camera = GltfCamera{0};
+    collect_fields(to_json(other), "", fields);
+    for (std::string_view form : {"builtin", "id"}) fields.insert("scene." + std::string(form));
+    return fields;
+}
+
+TEST(JobSchema, IsADraft2020ObjectRequiringTheScene) {
+    json schema = job_json_schema();
+    EXPECT_EQ(schema["$schema"], "https://json-schema.org/draft/2020-12/schema");
+    EXPECT_EQ(schema["type"], "object");
+    EXPECT_EQ(schema["required"], json({"scene"}));
+    EXPECT_EQ(schema["additionalProperties"], false);
+}
+
+TEST(JobSchema, ListsEveryFieldAndNoOther) {
+    json schema = job_json_schema();
+    std::set<std::string> document_fields = every_document_field();
+    std::set<std::string> schema_fields;
+    collect_schema_fields(schema, "", schema_fields);
+    EXPECT_EQ(schema_fields, document_fields);
+    for (const std::string& field : document_fields) {
+        std::vector<json> nodes = schema_nodes(schema, field);
+        ASSERT_EQ(nodes.size(), 1u) << field;
+        EXPECT_TRUE(nodes[0].contains("description")) << field;
+    }
+}
+
+TEST(JobSchema, CarriesTheLimitsAndPresetDefaults) {
+    json schema = job_json_schema();
+    json width = schema_nodes(schema, "image.width").at(0);
+    EXPECT_EQ(width["type"], "integer");
+    EXPECT_EQ(width["minimum"], limits::kImageSize.min);
+    EXPECT_EQ(width["maximum"], limits::kImageSize.max);
+    json a = schema_nodes(schema, "irradiance_cache.a").at(0);
+    EXPECT_EQ(a["exclusiveMinimum"], 0.0);
+    EXPECT_EQ(a["maximum"], 1.0);
+    EXPECT_EQ(schema_nodes(schema, "seed").at(0)["maximum"], std::numeric_limits<uint64_t>::max());
+    EXPECT_EQ(schema_nodes(schema, "output.aovs").at(0)["items"]["enum"].size(), kAovNames.size());
+
+    json spp = schema_nodes(schema, "image.spp").at(0);
+    EXPECT_EQ(spp["default"], 4);
+    EXPECT_EQ(spp["x-preset-defaults"], json({{"preview", 1}, {"final", 4}, {"reference", 1024}}));
+    EXPECT_EQ(schema_nodes(schema, "integrator").at(0)["x-preset-defaults"]["reference"], "path");
+    EXPECT_EQ(schema_nodes(schema, "preset").at(0)["default"], "final");
+}
+
+/// Every numeric bound the schema states is the validator's bound: just outside is refused with
+/// that field's path, the bound itself (when inclusive) is accepted.
+TEST(JobSchema, NumericBoundsAgreeWithTheValidator) {
+    json schema = job_json_schema();
+    int checked = 0;
+    for (const std::string& field : every_document_field()) {
+        if (field.starts_with("camera.")) continue;  // needs a whole camera; tested above
+        json node = schema_nodes(schema, field).at(0);
+        if (node["type"] != "integer" && node["type"] != "number") continue;
+        bool integer = node["type"] == "integer";
+        bool spacing = field.find("spacing") != std::string::npos;  // also min <= max
+        auto document_with = [&](const json& value) {
+            json document = base_job();
+            document[json::json_pointer("/" + std::regex_replace(field, std::regex("\\."), "/"))] =
+                value;
+            return document;
+        };
+        for (bool lower : {true, false}) {
+            std::string inclusive = lower ? "minimum" : "maximum";
+            std::string exclusive = lower ? "exclusiveMinimum" : "exclusiveMaximum";
+            if (node.contains(exclusive)) {
+                EXPECT_TRUE(rejects(document_with(node[exclusive]), field)) << exclusive;
+                ++checked;
+                continue;
+            }
+            ASSERT_TRUE(node.contains(inclusive)) << field;
+            json bound = node[inclusive];
+            if (!spacing && !(field == "image.height" && !lower)) {
+                EXPECT_TRUE(accepts(document_with(bound))) << field << " = " << bound;
+            }
+            json outside;
+            if (integer && bound.is_number_unsigned() &&
+                bound.get<uint64_t>() == std::numeric_limits<uint64_t>::max()) {
+                continue;  // nothing beyond UINT64_MAX is an integer
+            }
+            if (integer) {
+                outside = lower ? json(bound.get<int64_t>() - 1) : json(bound.get<int64_t>() + 1);
+            } else {
+                double b = bound.get<double>();
+                outside = std::nextafter(b, lower ? -INFINITY : INFINITY);
+            }
+            EXPECT_TRUE(rejects(document_with(outside), field)) << field << " = " << outside;
+            ++checked;
+        }
+    }
+    EXPECT_GE(checked, 2 * 12);  // width .. seed: every numeric field of the job
+}
+
+TEST(JobSchema, ScenePathPatternMatchesTheValidator) {
+    json schema = job_json_schema();
+    std::regex pattern(schema_nodes(schema, "scene.path").at(0)["pattern"].get<std::string>(),
+                       std::regex::ECMAScript);
+    for (std::string path : {"x.glb", "a/b/c.gltf", "a..b/x.glb", "./x", "/x", "../x", "a/../x",
+                             "a/..", "a\\..\\x", "C:x", "x\ty", ""}) {
+        bool valid = accepts({{"scene", {{"path", path}}}});
+        EXPECT_EQ(std::regex_match(path, pattern), valid) << path;
+    }
+}
+
+TEST(JobErrors, DescribeJoinsPathAndMessage) {
+    EXPECT_EQ(describe({"irradiance_cache.a", "must be in (0, 1]"}),
+              "irradiance_cache.a: must be in (0, 1]");
+    EXPECT_EQ(describe({"", "malformed JSON at line 1 column 1: x"}),
+              "malformed JSON at line 1 column 1: x");
+}
+
+}  // namespace
+}  // namespace photond::protocol

@@ -1,0 +1,114 @@
+// `photond render` as a user runs it: real processes, real files.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "core/image/exr_io.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kPhotond = std::string(PHOTOND_BINARY_DIR) + "/server/photond";
+
+struct CommandResult {
+    int exit_code;
+    std::string output;  // stdout and stderr
+};
+
+CommandResult run(const std::string& arguments) {
+    const std::string command = kPhotond + " " + arguments + " 2>&1";
+    FILE* pipe = popen(command.c_str(), "r");
+    std::string output;
+    char buffer[4096];
+    while (size_t n = fread(buffer, 1, sizeof buffer, pipe)) output.append(buffer, n);
+    const int status = pclose(pipe);
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
+std::string read_file(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+class PhotondRender : public ::testing::Test {
+protected:
+    void SetUp() override {
+        dir_ = fs::temp_directory_path() /
+               ("photond_render_test_" + std::to_string(::getpid()) + "_" +
+                ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        fs::create_directories(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+    fs::path dir_;
+};
+
+TEST_F(PhotondRender, SameBytesForOneAndTwoThreads) {
+    const std::string common = "render builtin:cornell-box --integrator path --spp 2 --width 64 --height 48 --quiet ";
+    const auto one = run(common + "--threads 1 -o " + (dir_ / "one.exr").string());
+    const auto two = run(common + "--threads 2 -o " + (dir_ / "two.exr").string() + " --preview " +
+                         (dir_ / "two.png").string() + " --stats-json " + (dir_ / "stats.json").string());
+    ASSERT_EQ(one.exit_code, 0) << one.output;
+    ASSERT_EQ(two.exit_code, 0) << two.output;
+    const std::string a = read_file(dir_ / "one.exr"), b = read_file(dir_ / "two.exr");
+    ASSERT_FALSE(a.empty());
+    EXPECT_EQ(a, b);
+    EXPECT_TRUE(fs::file_size(dir_ / "two.png") > 100);
+
+    const auto image = photond::read_exr(dir_ / "one.exr");
+    ASSERT_TRUE(image.has_value()) << image.error().message;
+    EXPECT_EQ(image->beauty.width(), 64);
+    EXPECT_EQ(image->beauty.height(), 48);
+    for (const auto& c : image->beauty.pixels()) ASSERT_TRUE(photond::is_finite(c));
+
+    const auto stats = nlohmann::json::parse(read_file(dir_ / "stats.json"));
+    EXPECT_EQ(stats.at("integrator"), "path");
+    EXPECT_EQ(stats.at("threads"), 2);
+    EXPECT_GT(stats.at("rays").get<uint64_t>(), 64u * 48u * 2u);
+    EXPECT_EQ(stats.at("job").at("image").at("spp"), 2);
+}
+
+TEST_F(PhotondRender, JobFileAndSetOverrides) {
+    std::ofstream(dir_ / "job.json") << R"({"scene": {"builtin": "furnace"}, "integrator": "direct",
+        "image": {"width": 16, "height": 8, "spp": 1}})";
+    const auto r = run("render --job " + (dir_ / "job.json").string() + " --set image.width=24 --quiet " +
+                       "--stats-json " + (dir_ / "s.json").string() + " -o " + (dir_ / "f.exr").string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const auto stats = nlohmann::json::parse(read_file(dir_ / "s.json"));
+    EXPECT_EQ(stats.at("width"), 24);
+    EXPECT_EQ(stats.at("integrator"), "direct");
+}
+
+TEST_F(PhotondRender, BadInputGetsAClearErrorNamingTheField) {
+    const std::string out = " -o " + (dir_ / "x.exr").string();
+    auto r = run("render builtin:cornell-box --set image.sppp=3" + out);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.output.find("image.sppp"), std::string::npos) << r.output;
+
+    r = run("render builtin:no-such-scene" + out);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_NE(r.output.find("no-such-scene"), std::string::npos) << r.output;
+
+    r = run("render builtin:cornell-box --width -5" + out);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.output.find("image.width"), std::string::npos) << r.output;
+
+    std::ofstream(dir_ / "broken.json") << "{\"scene\": ";
+    r = run("render --job " + (dir_ / "broken.json").string() + out);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.output.find("malformed JSON"), std::string::npos) << r.output;
+
+    r = run("render " + (dir_ / "missing.gltf").string() + out);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_NE(r.output.find("missing.gltf"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir_ / "x.exr"));
+}
+
+}  // namespace
