@@ -5,7 +5,7 @@ namespace photond::protocol {
 nlohmann::json to_json(const RenderStatistics& s) {
     nlohmann::json passes = nlohmann::json::array();
     for (const PassTiming& p : s.passes) passes.push_back({{"name", p.name}, {"seconds", p.seconds}});
-    return {
+    nlohmann::json result = {
         {"integrator", s.integrator},
         {"width", s.width},
         {"height", s.height},
@@ -19,6 +19,29 @@ nlohmann::json to_json(const RenderStatistics& s) {
         {"total_seconds", s.total_seconds},
         {"cancelled", s.cancelled},
     };
+    if (!s.plan.empty()) {
+        nlohmann::json plan = nlohmann::json::array();
+        for (const PassDecision& d : s.plan)
+            plan.push_back({{"pass", d.pass}, {"enabled", d.enabled}, {"reason", d.reason}});
+        result["plan"] = plan;
+    }
+    if (s.photons) {
+        const PhotonTracingStatistics& p = *s.photons;
+        result["photons"] = {
+            {"emitted", p.emitted},
+            {"emitted_global", p.emitted_global},
+            {"emitted_caustic", p.emitted_caustic},
+            {"stored_global", p.stored_global},
+            {"stored_caustic", p.stored_caustic},
+            {"rays", p.rays},
+            {"tracing_seconds", p.tracing_seconds},
+            {"build_seconds", p.build_seconds},
+            {"global_complete", p.global_complete},
+            {"caustic_complete", p.caustic_complete},
+            {"map_bytes", s.photon_map_bytes},
+        };
+    }
+    return result;
 }
 
 }  // namespace photond::protocol

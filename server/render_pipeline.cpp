@@ -7,6 +7,8 @@
 #include "core/camera/camera.h"
 #include "core/integrators/direct.h"
 #include "core/integrators/path.h"
+#include "core/integrators/photon_mapping.h"
+#include "core/render/render_plan.h"
 #include "core/render/render_scene.h"
 #include "core/scene/builtin_scenes.h"
 #include "core/scene/gltf_loader.h"
@@ -24,11 +26,47 @@ Vec3 to_vec3(const std::array<double, 3>& a) {
     return Vec3(static_cast<float>(a[0]), static_cast<float>(a[1]), static_cast<float>(a[2]));
 }
 
+/// Plans and runs the photon pass of a photon-map job, recording it in the statistics.
+Expected<std::shared_ptr<const PhotonMaps>> build_photon_maps(const protocol::Job& job, const RenderScene& scene,
+                                                              const PipelineOptions& options,
+                                                              RenderStatistics& stats) {
+    const RenderPlan plan = plan_photon_passes(*scene.scene, *scene.lights,
+                                               {job.photons.global, job.photons.caustic});
+    stats.plan = plan.decisions;
+    PhotonTracingSettings settings;
+    settings.global_photons = plan.global_map ? job.photons.global : 0;
+    settings.caustic_photons = plan.caustic_map ? job.photons.caustic : 0;
+    settings.seed = job.photons.seed;
+    settings.threads = options.threads;
+    settings.cancel = options.callbacks.cancel;
+    if (settings.global_photons == 0 && settings.caustic_photons == 0) {
+        stats.photons = PhotonTracingStatistics{};
+        return std::make_shared<const PhotonMaps>();
+    }
+    auto maps = trace_photons(scene, settings);
+    if (!maps) return maps.error();
+    stats.photons = maps->statistics;
+    stats.photon_map_bytes = maps->bytes();
+    stats.passes.push_back({"photon_tracing", maps->statistics.tracing_seconds});
+    stats.passes.push_back({"photon_kdtree", maps->statistics.build_seconds});
+    return std::make_shared<const PhotonMaps>(std::move(maps).value());
+}
+
 Expected<std::unique_ptr<Integrator>> make_integrator(const protocol::Job& job,
-                                                      std::shared_ptr<const RenderScene> scene) {
+                                                      std::shared_ptr<const RenderScene> scene,
+                                                      const PipelineOptions& options,
+                                                      RenderStatistics& stats) {
     if (job.integrator == "path") return std::unique_ptr<Integrator>(new PathIntegrator(scene));
     if (job.integrator == "direct") return std::unique_ptr<Integrator>(new DirectIntegrator(scene));
-    return Error{"integrator: '" + job.integrator + "' is not available in this build"};
+    if (job.integrator == "photon-map") {
+        auto maps = build_photon_maps(job, *scene, options, stats);
+        if (!maps) return maps.error();
+        PhotonMapIntegratorSettings settings;
+        settings.k_global = job.photons.k_global;
+        settings.k_caustic = job.photons.k_caustic;
+        return std::unique_ptr<Integrator>(new PhotonMapIntegrator(scene, *maps, settings));
+    }
+    return Error{"integrator: unknown integrator '" + job.integrator + "'"};
 }
 
 }  // namespace
@@ -117,7 +155,7 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     if (!camera_desc) return camera_desc.error();
     auto camera = Camera::create(*camera_desc, job.image.width, job.image.height);
     if (!camera) return camera.error();
-    auto integrator = make_integrator(job, *render_scene);
+    auto integrator = make_integrator(job, *render_scene, options, stats);
     if (!integrator) return integrator.error();
 
     TileSettings tiles;

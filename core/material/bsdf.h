@@ -136,6 +136,8 @@ private:
     LobeKind specular_kind_;  // kind of the metal/layer reflection lobe
     LobeKind glass_kind_;     // kind of the dielectric reflection/transmission lobe
     LobeMask lobes_ = 0;
+    int albedo_cell_ = -1;            // roughness cell of the layer albedo table; -1: mirror
+    float albedo_cell_weight_ = 0.0f;  // interpolation weight within that cell
 };
 
 }  // namespace photond

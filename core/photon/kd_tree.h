@@ -62,7 +62,7 @@ struct KnnResult {
 /// the input vector.
 class PhotonKdTree {
 public:
-    static constexpr uint32_t kLeafSize = 8;
+    static constexpr uint32_t kLeafSize = 16;
 
     /// An empty tree: every query returns nothing.
     PhotonKdTree() = default;

@@ -3,7 +3,11 @@
 
 #include <cstdint>
 #include <string>
+#include <optional>
 #include <vector>
+
+#include "core/photon/photon_tracer.h"
+#include "core/render/render_plan.h"
 
 namespace photond {
 
@@ -24,6 +28,11 @@ struct RenderStatistics {
     double render_seconds = 0.0;  // the tile pass alone
     double total_seconds = 0.0;
     bool cancelled = false;
+    /// The passes decided for this render, each with its reason (photon-map integrator).
+    std::vector<PassDecision> plan;
+    /// The photon pass, when one ran or its maps came from the cache.
+    std::optional<PhotonTracingStatistics> photons;
+    size_t photon_map_bytes = 0;
 
     double rays_per_second() const {
         return render_seconds > 0.0 ? static_cast<double>(rays + shadow_rays) / render_seconds : 0.0;

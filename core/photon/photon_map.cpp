@@ -1,0 +1,65 @@
+#include "core/photon/photon_map.h"
+
+namespace photond {
+
+namespace {
+constexpr double kPiDouble = 3.14159265358979323846;
+}  // namespace
+
+PhotonMap::PhotonMap(std::vector<Photon> photons, uint64_t emitted)
+    : tree_(std::move(photons)), emitted_(emitted) {}
+
+namespace {
+
+/// One reusable neighbour list per thread: queries never allocate after warm-up.
+KnnResult& thread_scratch() {
+    thread_local KnnResult scratch;
+    return scratch;
+}
+
+}  // namespace
+
+Color PhotonMap::estimate_radiance(const Vec3& p, const Vec3& normal, const Bsdf& bsdf,
+                                   const Vec3& wo, const RadianceEstimateOptions& options) const {
+    if (tree_.empty()) return Color(0.0f);
+    KnnResult& found = thread_scratch();
+    const float max_radius = options.max_radius > 0.0f ? options.max_radius
+                                                       : std::numeric_limits<float>::infinity();
+    tree_.k_nearest(p, options.k, max_radius, found);
+    if (found.size() < kMinPhotonsPerEstimate || !(found.radius2 > 0.0f)) return Color(0.0f);
+    const double r = std::sqrt(static_cast<double>(found.radius2));
+    // Cone filter weight w = 1 - d / (k_cone r), normalised by 1 - 2 / (3 k_cone) (Jensen 2001).
+    constexpr double kCone = 1.1;
+    DVec3 sum(0.0);
+    for (const KnnNeighbor& n : found.neighbors) {
+        const Photon& photon = tree_.photon(n.index);
+        if (photon.user_flags() & options.exclude_flags) continue;
+        const Vec3 wi = -photon.direction();
+        if (glm::dot(wi, normal) <= 0.0f) continue;
+        const Color f = bsdf.eval(wo, wi, TransportMode::Radiance, options.lobes);
+        DVec3 contribution = DVec3(f) * DVec3(photon.flux());
+        if (options.cone_filter) contribution *= 1.0 - std::sqrt(static_cast<double>(n.dist2)) / (kCone * r);
+        sum += contribution;
+    }
+    double area = kPiDouble * static_cast<double>(found.radius2);
+    if (options.cone_filter) area *= 1.0 - 2.0 / (3.0 * kCone);
+    return Color(sum / area);
+}
+
+Color PhotonMap::estimate_irradiance(const Vec3& p, const Vec3& normal, uint32_t k, float max_radius,
+                                     uint8_t exclude_flags) const {
+    if (tree_.empty()) return Color(0.0f);
+    KnnResult& found = thread_scratch();
+    tree_.k_nearest(p, k, max_radius > 0.0f ? max_radius : std::numeric_limits<float>::infinity(), found);
+    if (found.size() < kMinPhotonsPerEstimate || !(found.radius2 > 0.0f)) return Color(0.0f);
+    DVec3 sum(0.0);
+    for (const KnnNeighbor& n : found.neighbors) {
+        const Photon& photon = tree_.photon(n.index);
+        if (photon.user_flags() & exclude_flags) continue;
+        if (glm::dot(-photon.direction(), normal) <= 0.0f) continue;
+        sum += DVec3(photon.flux());
+    }
+    return Color(sum / (kPiDouble * static_cast<double>(found.radius2)));
+}
+
+}  // namespace photond

@@ -1,0 +1,208 @@
+#include "core/photon/photon_tracer.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+#include <tbb/task_arena.h>
+
+#include <chrono>
+
+#include "core/integrators/integrator.h"
+
+namespace photond {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr uint64_t kPhotonStreamTag = 0x70686f746f6e73ull;  // separates photon streams from pixels
+constexpr uint32_t kChunkSize = 1024;                       // photons per parallel task
+
+/// A stored photon before its map is complete: full-precision flux, scaled once at the end by
+/// 1 / (photons emitted for its map), then packed.
+struct TracedPhoton {
+    Vec3 position;
+    Vec3 direction;
+    Color flux;
+    uint32_t path;  // emission index within the batch, to cut the map at the photon that fills it
+    uint8_t flags;
+};
+
+struct ChunkOutput {
+    std::vector<TracedPhoton> global;
+    std::vector<TracedPhoton> caustic;
+    uint64_t rays = 0;
+};
+
+struct MapBuilder {
+    uint32_t target = 0;
+    uint64_t cap = 0;         // emission cap for this map
+    bool active = false;      // still collecting
+    bool complete = true;
+    uint64_t emitted = 0;     // photons emitted for this map (set when it fills or stops)
+    std::vector<TracedPhoton> photons;
+
+    /// Appends a batch's photons in order; stops at the one that fills the map.
+    void append(const std::vector<ChunkOutput>& chunks, std::vector<TracedPhoton> ChunkOutput::*member,
+                uint64_t batch_start) {
+        if (!active) return;
+        for (const ChunkOutput& chunk : chunks) {
+            for (const TracedPhoton& p : chunk.*member) {
+                photons.push_back(p);
+                if (photons.size() >= target) {
+                    emitted = batch_start + p.path + 1;
+                    active = false;
+                    return;
+                }
+            }
+        }
+    }
+};
+
+/// Traces photon `index` and appends what it stores to `out`.
+void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settings, uint64_t index,
+                      uint32_t path_in_batch, bool want_global, bool want_caustic, ChunkOutput& out) {
+    Rng rng = Rng::for_stream(settings.seed, kPhotonStreamTag, index);
+    const float u_select = rng.next_float();
+    const Vec2 u_position = rng.next_vec2();
+    const Vec2 u_direction = rng.next_vec2();
+    const std::optional<EmissionSample> emission = rs.lights->sample_emission(u_select, u_position, u_direction);
+    if (!emission || is_black(emission->flux_weight)) return;
+
+    Color flux = emission->flux_weight;
+    Ray ray{emission->origin, emission->direction};
+    if (glm::dot(emission->normal, emission->normal) > 0.0f)
+        ray.origin = rs.tracer->offset_origin(emission->origin, emission->normal, emission->direction);
+    int specular_bounces = 0;
+    bool diffuse_seen = false;
+
+    for (int bounce = 0; bounce < settings.max_bounces; ++bounce) {
+        ++out.rays;
+        const std::optional<Hit> hit = rs.tracer->intersect(ray);
+        if (!hit) return;
+        const SurfaceInteraction si = make_interaction(*rs.scene, *hit, ray.direction);
+        const Vec3 wo = -ray.direction;  // towards where the photon came from
+        const Bsdf bsdf = make_bsdf(*rs.scene, si, wo);
+        if (bsdf.has_non_delta()) {
+            const bool caustic_path = specular_bounces > 0 && !diffuse_seen;
+            const uint8_t flags = static_cast<uint8_t>((bounce == 0 ? photon_flags::kDirect : 0) |
+                                                       (caustic_path ? photon_flags::kCaustic : 0));
+            const TracedPhoton photon{si.p, ray.direction, flux, path_in_batch, flags};
+            if (want_global) out.global.push_back(photon);
+            if (want_caustic && caustic_path) out.caustic.push_back(photon);
+        }
+        const float u_lobe = rng.next_float();
+        const Vec2 u = rng.next_vec2();
+        const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Importance);
+        if (!s || !(s->pdf > 0.0f)) return;
+        if (s->kind == LobeKind::Diffuse) {
+            diffuse_seen = true;
+            if (!want_global) return;  // only caustic paths are wanted, and this is none any more
+        } else {
+            ++specular_bounces;
+        }
+        // Russian roulette on the reflectivity of the chosen component: survive with the ratio of
+        // the new flux to the old, so that surviving photons keep about the same flux.
+        const Color next_flux = flux * s->weight;
+        const float survive = std::min(1.0f, max_component(next_flux) / max_component(flux));
+        if (!(survive > 0.0f) || rng.next_float() >= survive) return;
+        flux = next_flux / survive;
+        if (!is_finite(flux)) return;
+        ray = spawn_ray(rs, si, s->wi);
+    }
+}
+
+std::shared_ptr<const PhotonMap> finish_map(MapBuilder& builder) {
+    std::vector<Photon> packed;
+    packed.reserve(builder.photons.size());
+    const double scale = builder.emitted > 0 ? 1.0 / static_cast<double>(builder.emitted) : 0.0;
+    for (const TracedPhoton& p : builder.photons) {
+        packed.push_back(make_photon(p.position, p.direction, Color(DVec3(p.flux) * scale), p.flags));
+    }
+    builder.photons = {};
+    return std::make_shared<const PhotonMap>(std::move(packed), builder.emitted);
+}
+
+}  // namespace
+
+Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSettings& settings) {
+    if (rs.lights->empty())
+        return Error{"photon pass: the scene has no light with positive power, so no photon can be emitted"};
+    const Clock::time_point start = Clock::now();
+    MapBuilder global, caustic;
+    global.target = settings.global_photons;
+    caustic.target = settings.caustic_photons;
+    global.active = global.target > 0;
+    caustic.active = caustic.target > 0;
+    global.cap = static_cast<uint64_t>(global.target) * settings.max_emitted_per_stored;
+    caustic.cap = static_cast<uint64_t>(caustic.target) * settings.max_emitted_per_stored;
+
+    PhotonMaps maps;
+    PhotonTracingStatistics& stats = maps.statistics;
+    tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
+    uint64_t emitted = 0;
+    bool cancelled = false;
+    while ((global.active || caustic.active) && !cancelled) {
+        // Size the next batch from the store rate so far (deterministic: it depends only on the
+        // maps' contents), within [16K, 1M] photons.
+        uint64_t batch = 16384;
+        for (const MapBuilder* m : {&global, &caustic}) {
+            if (!m->active || emitted == 0) continue;
+            const double rate = static_cast<double>(m->photons.size()) / static_cast<double>(emitted);
+            const double remaining = static_cast<double>(m->target - m->photons.size());
+            const double needed = rate > 0.0 ? 1.1 * remaining / rate : 1e18;
+            batch = std::max<uint64_t>(batch, static_cast<uint64_t>(std::min(needed, 1048576.0)));
+        }
+        batch = std::min<uint64_t>(batch, 1048576);
+        const bool want_global = global.active, want_caustic = caustic.active;
+        const size_t chunk_count = (batch + kChunkSize - 1) / kChunkSize;
+        std::vector<ChunkOutput> chunks(chunk_count);
+        arena.execute([&] {
+            tbb::parallel_for(size_t(0), chunk_count, [&](size_t c) {
+                if (settings.cancel && settings.cancel->load(std::memory_order_relaxed)) return;
+                enable_flush_denormals();
+                const uint64_t first = c * kChunkSize;
+                const uint64_t last = std::min<uint64_t>(first + kChunkSize, batch);
+                for (uint64_t i = first; i < last; ++i) {
+                    trace_one_photon(rs, settings, emitted + i, static_cast<uint32_t>(i), want_global,
+                                     want_caustic, chunks[c]);
+                }
+            });
+        });
+        if (settings.cancel && settings.cancel->load()) cancelled = true;
+        for (const ChunkOutput& c : chunks) stats.rays += c.rays;
+        global.append(chunks, &ChunkOutput::global, emitted);
+        caustic.append(chunks, &ChunkOutput::caustic, emitted);
+        emitted += batch;
+        for (MapBuilder* m : {&global, &caustic}) {
+            if (m->active && emitted >= m->cap) {  // the cap: keep what arrived, say so
+                m->active = false;
+                m->complete = false;
+                m->emitted = emitted;
+            }
+        }
+    }
+    if (cancelled) return Error{"photon pass: cancelled"};
+    stats.emitted = emitted;
+    stats.tracing_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    for (const auto& [builder, name] : {std::pair{&global, "global"}, std::pair{&caustic, "caustic"}}) {
+        if (builder->target > 0 && builder->photons.empty()) {
+            return Error{std::string("photon pass: no photon reached a surface that stores it for the ") + name +
+                         " map after " + std::to_string(emitted) +
+                         " photons were emitted (lights facing away from the scene, or nothing reflects)"};
+        }
+    }
+    stats.emitted_global = global.emitted;
+    stats.emitted_caustic = caustic.emitted;
+    stats.stored_global = global.photons.size();
+    stats.stored_caustic = caustic.photons.size();
+    stats.global_complete = global.complete;
+    stats.caustic_complete = caustic.complete;
+
+    const Clock::time_point build_start = Clock::now();
+    arena.execute([&] {
+        tbb::parallel_invoke([&] { if (global.target > 0) maps.global = finish_map(global); },
+                             [&] { if (caustic.target > 0) maps.caustic = finish_map(caustic); });
+    });
+    stats.build_seconds = std::chrono::duration<double>(Clock::now() - build_start).count();
+    return maps;
+}
+
+}  // namespace photond

@@ -1,0 +1,63 @@
+// Pass 1 of photon mapping: photons emitted from the lights by power and traced through the
+// scene (ALGORITHMS.md section 2; Jensen 2001, ch. 5). Russian roulette on the BSDF's
+// reflectivities, importance-sampled directions, no flux change at refraction, storage at every
+// non-delta interaction. Paths are classified by the light-path grammar: the global map gets
+// L[S|D]*D, the caustic map L S+ D.
+//
+// Deterministic in parallel: photon i draws from the random stream (seed, i), photons are traced
+// in batches, and each batch's stored photons are appended in photon order, so the maps do not
+// depend on the thread count.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "core/photon/photon_map.h"
+#include "core/render/render_scene.h"
+
+namespace photond {
+
+struct PhotonTracingSettings {
+    uint32_t global_photons = 200000;   // photons to store in the global map (0: no global map)
+    uint32_t caustic_photons = 100000;  // photons to store in the caustic map (0: no caustic map)
+    uint64_t seed = 1;
+    int max_bounces = 64;               // safety net; Russian roulette ends paths first
+    /// Emission stops after this many photons per requested stored photon, and the pass fails
+    /// with a message if a map received no photon at all by then (lights facing away, black
+    /// scene). Maps that are partly filled are kept with what they have.
+    uint32_t max_emitted_per_stored = 1000;
+    int threads = 0;                    // 0 = every core
+    const std::atomic<bool>* cancel = nullptr;
+};
+
+struct PhotonTracingStatistics {
+    uint64_t emitted = 0;            // photons emitted in total
+    uint64_t emitted_global = 0;     // emitted when the global map was filled
+    uint64_t emitted_caustic = 0;    // emitted when the caustic map was filled
+    uint64_t stored_global = 0;
+    uint64_t stored_caustic = 0;
+    uint64_t rays = 0;
+    double tracing_seconds = 0.0;
+    double build_seconds = 0.0;      // kd-trees
+    bool global_complete = true;     // false: the emission cap stopped it short
+    bool caustic_complete = true;
+};
+
+/// Both maps of a scene; a map not asked for is null.
+struct PhotonMaps {
+    std::shared_ptr<const PhotonMap> global;
+    std::shared_ptr<const PhotonMap> caustic;
+    PhotonTracingStatistics statistics;
+
+    size_t bytes() const {
+        return (global ? global->bytes() : 0) + (caustic ? caustic->bytes() : 0);
+    }
+};
+
+/// Traces the photons and builds the maps. Fails (with a message naming the reason) when the
+/// scene has no light with power, or when a requested map received no photon within the cap.
+Expected<PhotonMaps> trace_photons(const RenderScene& scene, const PhotonTracingSettings& settings);
+
+}  // namespace photond

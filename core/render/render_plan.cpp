@@ -1,0 +1,67 @@
+#include "core/render/render_plan.h"
+
+#include "core/material/bsdf.h"
+
+namespace photond {
+
+const PassDecision* RenderPlan::find(std::string_view pass) const {
+    for (const PassDecision& d : decisions) {
+        if (d.pass == pass) return &d;
+    }
+    return nullptr;
+}
+
+SceneLightPaths analyse_light_paths(const Scene& scene, const LightSet& lights) {
+    SceneLightPaths paths;
+    paths.has_light = !lights.empty() && max_component(lights.total_power()) > 0.0f;
+    std::vector<bool> used(scene.materials.size(), false);
+    for (uint32_t t = 0; t < scene.triangles.size(); ++t) {
+        if (scene.triangle_area(t) > 0.0f) used[scene.triangle_materials[t]] = true;
+    }
+    for (size_t i = 0; i < scene.materials.size(); ++i) {
+        if (!used[i]) continue;
+        const Material& m = scene.materials[i];
+        // Lobes from a representative BSDF of the material (its texture can only scale colours).
+        const Color colour = m.base_color_texture >= 0 ? Color(1.0f) : m.base_color;
+        const Bsdf bsdf(m, colour, Frame(Vec3(0, 0, 1)), Vec3(0, 0, 1));
+        const LobeMask lobes = bsdf.lobes();
+        if (lobes & (mask_of(LobeKind::Delta) | mask_of(LobeKind::Glossy))) paths.has_specular = true;
+        if (lobes & kNonDeltaLobes) paths.has_receiver = true;
+        // Diffuse-class lobes: the Lambertian one and microfacet lobes too rough to count as glossy.
+        if ((lobes & mask_of(LobeKind::Diffuse)) && max_component(m.base_color) > 0.0f) paths.has_diffuse = true;
+    }
+    return paths;
+}
+
+RenderPlan plan_photon_passes(const Scene& scene, const LightSet& lights, const PhotonPassRequest& request) {
+    const SceneLightPaths paths = analyse_light_paths(scene, lights);
+    RenderPlan plan;
+    auto decide = [&](const std::string& pass, bool enabled, std::string reason) {
+        plan.decisions.push_back({pass, enabled, std::move(reason)});
+        return enabled;
+    };
+    if (!paths.has_light) {
+        decide("caustic_map", false, "the scene has no light with positive power");
+        decide("global_map", false, "the scene has no light with positive power");
+        return plan;
+    }
+    if (request.caustic_photons == 0) {
+        plan.caustic_map = decide("caustic_map", false, "the job asks for 0 caustic photons");
+    } else if (!paths.has_specular) {
+        plan.caustic_map = decide("caustic_map", false, "no surface is specular or glossy, so no L S+ D path exists");
+    } else if (!paths.has_receiver) {
+        plan.caustic_map = decide("caustic_map", false, "no surface stores photons (every surface is ideal specular)");
+    } else {
+        plan.caustic_map = decide("caustic_map", true, "specular or glossy surfaces can focus light onto surfaces that store photons");
+    }
+    if (request.global_photons == 0) {
+        plan.global_map = decide("global_map", false, "the job asks for 0 global photons");
+    } else if (!paths.has_diffuse) {
+        plan.global_map = decide("global_map", false, "no surface reflects light diffusely, so there is no indirect diffuse light");
+    } else {
+        plan.global_map = decide("global_map", true, "diffuse surfaces reflect light: indirect illumination");
+    }
+    return plan;
+}
+
+}  // namespace photond
