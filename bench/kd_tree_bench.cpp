@@ -28,11 +28,16 @@ Vec3 scene_point(int scene, Rng& rng) {
     const float u = rng.next_float(), v = rng.next_float();
     if (scene == 0) return {u, v, rng.next_float()};
     switch (rng.next_u32() % 5) {
-        case 0: return {u, 0.0f, v};
-        case 1: return {u, 1.0f, v};
-        case 2: return {u, v, 0.0f};
-        case 3: return {0.0f, u, v};
-        default: return {1.0f, u, v};
+        case 0:
+            return {u, 0.0f, v};
+        case 1:
+            return {u, 1.0f, v};
+        case 2:
+            return {u, v, 0.0f};
+        case 3:
+            return {0.0f, u, v};
+        default:
+            return {1.0f, u, v};
     }
 }
 

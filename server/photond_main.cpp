@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "server/image_commands.h"
 #include "server/render_command.h"
 
 namespace {
@@ -11,6 +12,8 @@ constexpr const char* kUsage =
     "usage: photond <command> [options]\n"
     "commands:\n"
     "  render    render one job offline and write an OpenEXR (photond render --help)\n"
+    "  compare   error of an EXR against a reference EXR (relMSE, RMSE, p99, bias)\n"
+    "  average   mean of several EXRs (independent renders), for converged references\n"
     "  version   print the version\n";
 
 }  // namespace
@@ -24,6 +27,8 @@ int main(int argc, char** argv) {
     const std::string command = args[0];
     const std::span<const std::string> rest(args.data() + 1, args.size() - 1);
     if (command == "render") return photond::service::run_render_command(rest);
+    if (command == "compare") return photond::service::run_compare_command(rest);
+    if (command == "average") return photond::service::run_average_command(rest);
     if (command == "version" || command == "--version") {
         std::puts("photond 0.1.0");
         return 0;

@@ -116,8 +116,8 @@ public:
     /// row. Builds the cell if needed.
     std::pair<int, float> locate_roughness(float roughness) {
         roughness = std::clamp(roughness, kDeltaRoughness, 1.0f);
-        const float x = std::log(roughness / kDeltaRoughness) /
-                        std::log(1.0f / kDeltaRoughness) * kRoughnessCells;
+        const float x = std::log(roughness / kDeltaRoughness) / std::log(1.0f / kDeltaRoughness) *
+                        kRoughnessCells;
         int j = std::clamp(static_cast<int>(x), 0, kRoughnessCells - 1);
         const float r0 = row_roughness(j), r1 = row_roughness(j + 1);
         std::call_once(built_[j], [&] { build_cell(j); });
@@ -137,8 +137,7 @@ public:
         const Cell& c = cells_[cell];
         auto interpolate = [&](const std::array<float, 2 * kCosNodes>& v) {
             return std::lerp(std::lerp(v[k], v[k + 1], w_mu),
-                             std::lerp(v[kCosNodes + k], v[kCosNodes + k + 1], w_mu),
-                             w_roughness);
+                             std::lerp(v[kCosNodes + k], v[kCosNodes + k + 1], w_mu), w_roughness);
         };
         return {interpolate(c.total), interpolate(c.schlick)};
     }
@@ -167,9 +166,9 @@ private:
 
     AlbedoTable() {
         for (int k = 0; k < kCosNodes; ++k) {
-            node_cos_[k] = static_cast<float>(
-                std::expm1(static_cast<double>(kBeta) * k / (kCosNodes - 1)) /
-                std::expm1(static_cast<double>(kBeta)));
+            node_cos_[k] =
+                static_cast<float>(std::expm1(static_cast<double>(kBeta) * k / (kCosNodes - 1)) /
+                                   std::expm1(static_cast<double>(kBeta)));
         }
         node_cos_[kCosNodes - 1] = 1.0f;
     }
@@ -217,10 +216,9 @@ void AlbedoTable::build_cell(int j) {
                 for (int db = 0; db <= kRefine; ++db) {
                     const float wr = static_cast<float>(a) / kRefine;
                     const float wm = static_cast<float>(db) / kRefine;
-                    const float interpolated =
-                        std::lerp(std::lerp(nodes[k], nodes[k + 1], wm),
-                                  std::lerp(nodes[kCosNodes + k], nodes[kCosNodes + k + 1], wm),
-                                  wr);
+                    const float interpolated = std::lerp(
+                        std::lerp(nodes[k], nodes[k + 1], wm),
+                        std::lerp(nodes[kCosNodes + k], nodes[kCosNodes + k + 1], wm), wr);
                     const SpecularAlbedo& e = fine[a * kFine + k * kRefine + db];
                     deficit = std::max(deficit, e.*member - interpolated);
                 }
@@ -230,8 +228,8 @@ void AlbedoTable::build_cell(int j) {
             }
         }
         for (size_t n = 0; n < nodes.size(); ++n) {
-            nodes[n] = std::min(1.0f, (nodes[n] + raise[n]) * (1.0f + kRelativeMargin) +
-                                          kAbsoluteMargin);
+            nodes[n] =
+                std::min(1.0f, (nodes[n] + raise[n]) * (1.0f + kRelativeMargin) + kAbsoluteMargin);
         }
     };
     bound(cell.total, &SpecularAlbedo::total);
@@ -251,6 +249,13 @@ void AlbedoTable::build_cell(int j) {
     for (int row = 0; row < 2; ++row) {
         cell.average[row] = {row_average(cell.total, row), row_average(cell.schlick, row)};
     }
+}
+
+/// Albedo of the GGX lobe without Fresnel and with the Schlick term: exact for the ideal
+/// mirror (1 and (1 - mu)^5; cell < 0), tabulated upper bounds for rough lobes.
+SpecularAlbedo specular_albedo_terms(int cell, float w_roughness, float mu) {
+    if (cell < 0) return {1.0f, schlick_weight(mu)};
+    return AlbedoTable::instance().lookup(cell, w_roughness, mu);
 }
 
 }  // namespace
@@ -304,13 +309,6 @@ Bsdf::Bsdf(const Material& material, const Color& base_color, const Frame& shadi
         lobes_ |= mask_of(specular_kind_);
     }
     if (glass_weight_ > 0.0f) lobes_ |= mask_of(glass_kind_);
-}
-
-/// Albedo of the GGX lobe without Fresnel and with the Schlick term: exact for the ideal
-/// mirror (1 and (1 - mu)^5; cell < 0), tabulated upper bounds for rough lobes.
-SpecularAlbedo specular_albedo_terms(int cell, float w_roughness, float mu) {
-    if (cell < 0) return {1.0f, schlick_weight(mu)};
-    return AlbedoTable::instance().lookup(cell, w_roughness, mu);
 }
 
 Color Bsdf::layer_albedo(float cos_theta) const {
@@ -386,8 +384,7 @@ Color Bsdf::eval_local(const Vec3& wo, const Vec3& wi, bool outside, TransportMo
             const float common = ggx.d(h) * ggx.g2(wo, wi) / (4.0f * wo.z * wi.z);
             if (specular) {
                 const Color metal = fresnel_schlick(base_color_, Color(1.0f), cos_oh);
-                const Color layer =
-                    fresnel_schlick(specular_f0_, Color(specular_f90_), cos_oh);
+                const Color layer = fresnel_schlick(specular_f0_, Color(specular_f90_), cos_oh);
                 f += (metallic_ * metal + layer_weight_ * layer) * common;
             }
             if (glass) {
@@ -395,8 +392,7 @@ Color Bsdf::eval_local(const Vec3& wo, const Vec3& wi, bool outside, TransportMo
                            common);
             }
         }
-    } else if (wi.z < 0.0f && !glass_delta_ && glass_weight_ > 0.0f &&
-               in_mask(mask, glass_kind_)) {
+    } else if (wi.z < 0.0f && !glass_delta_ && glass_weight_ > 0.0f && in_mask(mask, glass_kind_)) {
         // Rough dielectric transmission (Walter et al. 2007, eq. 21) with the generalized half
         // vector h ~ wo + eta wi, eta = n_i / n_o (wi's side over wo's side).
         const float eta = relative_ior(outside);
@@ -407,8 +403,8 @@ Color Bsdf::eval_local(const Vec3& wo, const Vec3& wi, bool outside, TransportMo
         const float cos_oh = glm::dot(wo, h), cos_ih = glm::dot(wi, h);
         if (cos_oh <= 0.0f || cos_ih >= 0.0f) return f;  // back-facing microfacet
         const float denom = cos_oh + eta * cos_ih;
-        float value = (1.0f - fresnel_dielectric(cos_oh, eta)) * ggx.d(h) * ggx.g2(wo, wi) *
-                      eta * eta * -cos_ih * cos_oh / (wo.z * -wi.z * denom * denom);
+        float value = (1.0f - fresnel_dielectric(cos_oh, eta)) * ggx.d(h) * ggx.g2(wo, wi) * eta *
+                      eta * -cos_ih * cos_oh / (wo.z * -wi.z * denom * denom);
         // Radiance is scaled by (n_o / n_i)^2 crossing the interface (Veach 1997, eq. 5.13).
         if (mode == TransportMode::Radiance) value /= eta * eta;
         f += glass_weight_ * value * base_color_;
@@ -444,8 +440,8 @@ float Bsdf::pdf_local(const Vec3& wo, const Vec3& wi, bool outside,
         const float cos_oh = glm::dot(wo, h), cos_ih = glm::dot(wi, h);
         if (cos_oh <= 0.0f || cos_ih >= 0.0f) return pdf;
         const float denom = cos_oh + eta * cos_ih;
-        pdf += p_glass * (1.0f - fresnel_dielectric(cos_oh, eta)) *
-               ggx.visible_normal_pdf(wo, h) * eta * eta * -cos_ih / (denom * denom);
+        pdf += p_glass * (1.0f - fresnel_dielectric(cos_oh, eta)) * ggx.visible_normal_pdf(wo, h) *
+               eta * eta * -cos_ih / (denom * denom);
     }
     return pdf;
 }
@@ -498,8 +494,7 @@ std::optional<BsdfSample> Bsdf::sample(const Vec3& wo, float u_lobe, const Vec2&
 
     BsdfSample s;
     Vec3 i;
-    const bool delta =
-        (slot == kSlotSpecular && smooth_) || (slot == kSlotGlass && glass_delta_);
+    const bool delta = (slot == kSlotSpecular && smooth_) || (slot == kSlotGlass && glass_delta_);
     if (delta) {
         // All delta lobes share the mirror direction: its weight is their total reflectance over
         // the total probability of choosing it.

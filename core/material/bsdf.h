@@ -82,6 +82,8 @@ public:
                                      LobeMask mask = kAllLobes) const;
     /// Every delta lobe at once (ideal mirror and ideal refraction), for deterministic recursion:
     /// weight = reflectance or transmittance (pdf = 1). Returns how many were written.
+    /// The mirror entry sums every smooth reflection (metal, layer, dielectric); the refraction
+    /// entry includes the 1/eta^2 radiance factor in Radiance mode. Nothing for rough materials.
     int delta_lobes(const Vec3& wo, std::array<BsdfSample, 2>& out,
                     TransportMode mode = TransportMode::Radiance) const;
 

@@ -58,9 +58,15 @@ void build_subtree(BuildItem* items, uint8_t* axes, uint32_t lo, uint32_t hi) {
     const uint8_t axis = widest_axis(items, lo, hi);
     const uint32_t mid = lo + (hi - lo) / 2;
     switch (axis) {
-        case 0: select_median<0>(items + lo, items + mid, items + hi); break;
-        case 1: select_median<1>(items + lo, items + mid, items + hi); break;
-        default: select_median<2>(items + lo, items + mid, items + hi); break;
+        case 0:
+            select_median<0>(items + lo, items + mid, items + hi);
+            break;
+        case 1:
+            select_median<1>(items + lo, items + mid, items + hi);
+            break;
+        default:
+            select_median<2>(items + lo, items + mid, items + hi);
+            break;
     }
     axes[mid] = axis;
     if (hi - lo >= kParallelThreshold) {

@@ -17,6 +17,14 @@ KnnResult& thread_scratch() {
     return scratch;
 }
 
+/// The squared radius of the disc the photons were gathered from: the farthest photon's when k
+/// were found, else the whole search ball (fewer than k photons within max_radius means the
+/// density is known over the full ball, not only up to the farthest photon).
+double estimate_radius2(const KnnResult& found, uint32_t k, float max_radius) {
+    if (found.size() < k && std::isfinite(max_radius)) return static_cast<double>(max_radius) * max_radius;
+    return static_cast<double>(found.radius2);
+}
+
 }  // namespace
 
 Color PhotonMap::estimate_radiance(const Vec3& p, const Vec3& normal, const Bsdf& bsdf,
@@ -27,7 +35,7 @@ Color PhotonMap::estimate_radiance(const Vec3& p, const Vec3& normal, const Bsdf
                                                        : std::numeric_limits<float>::infinity();
     tree_.k_nearest(p, options.k, max_radius, found);
     if (found.size() < kMinPhotonsPerEstimate || !(found.radius2 > 0.0f)) return Color(0.0f);
-    const double r = std::sqrt(static_cast<double>(found.radius2));
+    const double r = std::sqrt(estimate_radius2(found, options.k, max_radius));
     // Cone filter weight w = 1 - d / (k_cone r), normalised by 1 - 2 / (3 k_cone) (Jensen 2001).
     constexpr double kCone = 1.1;
     DVec3 sum(0.0);
@@ -41,7 +49,7 @@ Color PhotonMap::estimate_radiance(const Vec3& p, const Vec3& normal, const Bsdf
         if (options.cone_filter) contribution *= 1.0 - std::sqrt(static_cast<double>(n.dist2)) / (kCone * r);
         sum += contribution;
     }
-    double area = kPiDouble * static_cast<double>(found.radius2);
+    double area = kPiDouble * r * r;
     if (options.cone_filter) area *= 1.0 - 2.0 / (3.0 * kCone);
     return Color(sum / area);
 }
@@ -50,8 +58,10 @@ Color PhotonMap::estimate_irradiance(const Vec3& p, const Vec3& normal, uint32_t
                                      uint8_t exclude_flags) const {
     if (tree_.empty()) return Color(0.0f);
     KnnResult& found = thread_scratch();
-    tree_.k_nearest(p, k, max_radius > 0.0f ? max_radius : std::numeric_limits<float>::infinity(), found);
+    max_radius = max_radius > 0.0f ? max_radius : std::numeric_limits<float>::infinity();
+    tree_.k_nearest(p, k, max_radius, found);
     if (found.size() < kMinPhotonsPerEstimate || !(found.radius2 > 0.0f)) return Color(0.0f);
+    const double radius2 = estimate_radius2(found, k, max_radius);
     DVec3 sum(0.0);
     for (const KnnNeighbor& n : found.neighbors) {
         const Photon& photon = tree_.photon(n.index);
@@ -59,7 +69,7 @@ Color PhotonMap::estimate_irradiance(const Vec3& p, const Vec3& normal, uint32_t
         if (glm::dot(-photon.direction(), normal) <= 0.0f) continue;
         sum += DVec3(photon.flux());
     }
-    return Color(sum / (kPiDouble * static_cast<double>(found.radius2)));
+    return Color(sum / (kPiDouble * radius2));
 }
 
 }  // namespace photond

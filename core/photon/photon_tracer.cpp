@@ -14,6 +14,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 constexpr uint64_t kPhotonStreamTag = 0x70686f746f6e73ull;  // separates photon streams from pixels
 constexpr uint32_t kChunkSize = 1024;                       // photons per parallel task
+constexpr uint64_t kEmptyMapTrial = 1u << 20;               // emissions before an empty map is given up
 
 /// A stored photon before its map is complete: full-precision flux, scaled once at the end by
 /// 1 / (photons emitted for its map), then packed.
@@ -172,7 +173,9 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
         caustic.append(chunks, &ChunkOutput::caustic, emitted);
         emitted += batch;
         for (MapBuilder* m : {&global, &caustic}) {
-            if (m->active && emitted >= m->cap) {  // the cap: keep what arrived, say so
+            // A map that nothing reached after a fair trial will not fill: stop early.
+            const bool hopeless = m->photons.empty() && emitted >= std::max<uint64_t>(kEmptyMapTrial, m->target);
+            if (m->active && (emitted >= m->cap || hopeless)) {  // keep what arrived, say so
                 m->active = false;
                 m->complete = false;
                 m->emitted = emitted;

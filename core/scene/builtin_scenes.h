@@ -68,7 +68,7 @@ inline constexpr Color kCornellDiffuseLightRadiance{90.0f, 68.5f, 33.0f};
 inline constexpr Vec3 kCausticLightPosition{-3.0f, 6.0f, -2.0f};
 inline constexpr float kCausticLightIntensity = 240.0f;
 /// "caustic-area": side of the square light replacing the point light.
-inline constexpr float kCausticAreaLightSide = 0.1f;
+inline constexpr float kCausticAreaLightSide = 0.5f;
 
 /// The names make_builtin_scene accepts, in a fixed order.
 std::vector<std::string> builtin_scene_names();

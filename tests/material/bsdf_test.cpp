@@ -2,12 +2,16 @@
 // pdf(), sample weights against eval(), white-furnace energy bounds, reciprocity, the smooth
 // dielectric's Fresnel and Snell behaviour, lobe classification and shading-normal leaks.
 #include "core/material/bsdf.h"
+#include "tests/support/chi_square.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <numeric>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -18,9 +22,8 @@ namespace {
 
 constexpr double kPiD = 3.14159265358979323846;
 
-Material make_material(float metallic, float roughness, float transmission = 0.0f,
-                       float ior = 1.5f, float specular = 1.0f,
-                       Color specular_color = Color(1.0f)) {
+Material make_material(float metallic, float roughness, float transmission = 0.0f, float ior = 1.5f,
+                       float specular = 1.0f, Color specular_color = Color(1.0f)) {
     Material m;
     m.metallic = metallic;
     m.roughness = roughness;
@@ -42,40 +45,8 @@ Vec3 direction(double theta_deg, double phi = 0.0) {
                 static_cast<float>(std::sin(t) * std::sin(phi)), static_cast<float>(std::cos(t)));
 }
 
-/// Regularised upper incomplete gamma function Q(a, x) (Numerical Recipes 6.2: series below
-/// a + 1, Lentz's continued fraction above).
-double gamma_q(double a, double x) {
-    if (x <= 0.0) return 1.0;
-    const double log_prefix = -x + a * std::log(x) - std::lgamma(a);
-    if (x < a + 1.0) {
-        double ap = a, del = 1.0 / a, sum = del;
-        for (int n = 0; n < 10000; ++n) {
-            ap += 1.0;
-            del *= x / ap;
-            sum += del;
-            if (std::abs(del) < std::abs(sum) * 1e-15) break;
-        }
-        return 1.0 - sum * std::exp(log_prefix);
-    }
-    constexpr double kTiny = 1e-300;
-    double b = x + 1.0 - a, c = 1.0 / kTiny, d = 1.0 / b, h = d;
-    for (int i = 1; i < 10000; ++i) {
-        const double an = -i * (i - a);
-        b += 2.0;
-        d = an * d + b;
-        if (std::abs(d) < kTiny) d = kTiny;
-        c = b + an / c;
-        if (std::abs(c) < kTiny) c = kTiny;
-        d = 1.0 / d;
-        const double del = d * c;
-        h *= del;
-        if (std::abs(del - 1.0) < 1e-15) break;
-    }
-    return std::exp(log_prefix) * h;
-}
-
-/// P(X >= x) for X ~ chi-square with `dof` degrees of freedom.
-double chi2_survival(double x, int dof) { return gamma_q(0.5 * dof, 0.5 * x); }
+using test_support::chi2_survival;
+using test_support::gamma_q;
 
 TEST(Chi2Helper, SurvivalMatchesClosedForms) {
     // dof 2: exp(-x/2); dof 1: erfc(sqrt(x/2)).
@@ -133,18 +104,22 @@ const Chi2Case kChi2Cases[] = {
 };
 constexpr int kChi2CaseCount = static_cast<int>(std::size(kChi2Cases));
 
+void PrintTo(const Chi2Case& c, std::ostream* os) { *os << c.name; }
+
 class BsdfChi2Test : public ::testing::TestWithParam<Chi2Case> {};
 
 TEST_P(BsdfChi2Test, SampleMatchesPdf) {
     const Chi2Case& tc = GetParam();
     const Bsdf bsdf = make_bsdf(tc.material, tc.base_color);
     const Vec3 wo = direction(tc.theta_o_deg, 0.3);
-    constexpr int kThetaBins = 20, kPhiBins = 40, kSamples = 1'000'000, kSub = 16;
+    constexpr int kThetaBins = 20, kPhiBins = 40, kSamples = 1'000'000;
     const double d_theta = kPiD / kThetaBins, d_phi = 2.0 * kPiD / kPhiBins;
 
     // Observed frequencies; sample() checked against eval() and pdf() along the way.
     std::vector<double> observed(kThetaBins * kPhiBins, 0.0);
-    Rng rng = Rng::for_stream(0xb5dfu, static_cast<uint64_t>(&tc - kChi2Cases));
+    uint64_t name_hash = 0xcbf29ce484222325ull;  // FNV-1a: a stable stream per case
+    for (const char* c = tc.name; *c; ++c) name_hash = (name_hash ^ uint8_t(*c)) * 0x100000001b3ull;
+    Rng rng = Rng::for_stream(0xb5dfu, name_hash);
     int delta_samples = 0, checked = 0, weight_mismatches = 0;
     for (int n = 0; n < kSamples; ++n) {
         const float u_lobe = rng.next_float();
@@ -181,25 +156,35 @@ TEST_P(BsdfChi2Test, SampleMatchesPdf) {
     EXPECT_EQ(weight_mismatches, 0);
     EXPECT_GT(checked, 1000);
 
-    // Expected frequencies: midpoint rule on kSub x kSub sub-cells, with the sin(theta) Jacobian.
+    // Expected frequencies: midpoint rule on sub x sub sub-cells with the sin(theta) Jacobian,
+    // refined (8, 24, 72, 216) until the integration error is well below the sampling noise.
+    auto integrate_bin = [&](int ti, int pi, int sub) {
+        double sum = 0.0;
+        for (int a = 0; a < sub; ++a) {
+            const double theta = (ti + (a + 0.5) / sub) * d_theta;
+            double row = 0.0;
+            for (int b = 0; b < sub; ++b) {
+                const double phi = (pi + (b + 0.5) / sub) * d_phi;
+                const Vec3 wi(static_cast<float>(std::sin(theta) * std::cos(phi)),
+                              static_cast<float>(std::sin(theta) * std::sin(phi)),
+                              static_cast<float>(std::cos(theta)));
+                row += bsdf.pdf(wo, wi, tc.mask);
+            }
+            sum += row * std::sin(theta);
+        }
+        return sum * (d_theta / sub) * (d_phi / sub);
+    };
     std::vector<double> expected(observed.size(), 0.0);
     double pdf_integral = 0.0;
     for (int ti = 0; ti < kThetaBins; ++ti) {
         for (int pi = 0; pi < kPhiBins; ++pi) {
-            double sum = 0.0;
-            for (int a = 0; a < kSub; ++a) {
-                const double theta = (ti + (a + 0.5) / kSub) * d_theta;
-                double row = 0.0;
-                for (int b = 0; b < kSub; ++b) {
-                    const double phi = (pi + (b + 0.5) / kSub) * d_phi;
-                    const Vec3 wi(static_cast<float>(std::sin(theta) * std::cos(phi)),
-                                  static_cast<float>(std::sin(theta) * std::sin(phi)),
-                                  static_cast<float>(std::cos(theta)));
-                    row += bsdf.pdf(wo, wi, tc.mask);
-                }
-                sum += row * std::sin(theta);
+            double integral = integrate_bin(ti, pi, 8);
+            for (int sub : {24, 72, 216}) {
+                const double finer = integrate_bin(ti, pi, sub);
+                const double change = std::abs(finer - integral) * kSamples;
+                integral = finer;
+                if (change < 0.2 * std::sqrt(std::max(integral * kSamples, 1.0))) break;
             }
-            const double integral = sum * (d_theta / kSub) * (d_phi / kSub);
             pdf_integral += integral;
             expected[ti * kPhiBins + pi] = integral * kSamples;
         }
@@ -231,7 +216,8 @@ TEST_P(BsdfChi2Test, SampleMatchesPdf) {
             pooled_observed += observed[cell];
             pooled_expected += expected[cell];
         } else {
-            chi2 += (observed[cell] - expected[cell]) * (observed[cell] - expected[cell]) / expected[cell];
+            chi2 += (observed[cell] - expected[cell]) * (observed[cell] - expected[cell]) /
+                    expected[cell];
             ++dof;
         }
     }
@@ -243,6 +229,20 @@ TEST_P(BsdfChi2Test, SampleMatchesPdf) {
     dof -= 1;
     ASSERT_GT(dof, 0);
     const double p_value = chi2_survival(chi2, dof);
+    if (std::getenv("PHOTOND_BSDF_CHI2_DEBUG")) {  // the summary and the worst cells
+        std::printf("%s: chi2 %.1f dof %d p %.4f pdf integral %.5f\n", tc.name, chi2, dof, p_value,
+                    pdf_integral);
+        auto contribution = [&](int c) {
+            return expected[c] > 0.0 ? sqr(float(observed[c] - expected[c])) / expected[c] : 0.0;
+        };
+        std::sort(order.begin(), order.end(),
+                  [&](int a, int b) { return contribution(a) > contribution(b); });
+        for (int i = 0; i < 5; ++i) {
+            std::printf("  cell theta %d phi %d: observed %.0f expected %.1f\n",
+                        order[i] / kPhiBins, order[i] % kPhiBins, observed[order[i]],
+                        expected[order[i]]);
+        }
+    }
     const double alpha = 1.0 - std::pow(1.0 - 0.01, 1.0 / kChi2CaseCount);  // Sidak
     EXPECT_GE(p_value, alpha) << tc.name << ": chi2 = " << chi2 << ", dof = " << dof
                               << ", p = " << p_value;
@@ -287,6 +287,11 @@ Albedo estimate_albedo(const Bsdf& bsdf, const Vec3& wo, TransportMode mode, int
     return a;
 }
 
+/// 3 sigma, plus 1e-3: over ~6000 estimates many materials are exactly at albedo 1, and the
+/// sample sigma underestimates the error of heavy-tailed weights (e.g. a Lambertian lobe
+/// normalised by 1 / (1 - E_avg) under a nearly white layer). Real violations are larger.
+float furnace_tolerance(const Albedo& a, int ch) { return 3.0f * a.sigma[ch] + 1e-3f; }
+
 TEST(BsdfFurnace, NoDirectionReflectsMoreThanItReceives) {
     int configurations = 0;
     uint64_t stream = 0;
@@ -297,8 +302,8 @@ TEST(BsdfFurnace, NoDirectionReflectsMoreThanItReceives) {
                 for (float specular : {0.0f, 1.0f}) {
                     for (float ior : {1.0f, 1.5f, 3.0f}) {
                         for (Color specular_color : {Color(1.0f), Color(3.0f, 1.0f, 0.2f)}) {
-                            const Material m = make_material(metallic, roughness, transmission,
-                                                             ior, specular, specular_color);
+                            const Material m = make_material(metallic, roughness, transmission, ior,
+                                                             specular, specular_color);
                             const Bsdf bsdf = make_bsdf(m, Color(1.0f));
                             std::vector<double> angles = {0.0, 45.0, 75.0, 88.0};
                             if (transmission > 0.0f) {
@@ -317,7 +322,7 @@ TEST(BsdfFurnace, NoDirectionReflectsMoreThanItReceives) {
                                         estimate_albedo(bsdf, wo, mode, 2000, ++stream);
                                     ++configurations;
                                     for (int ch = 0; ch < 3; ++ch) {
-                                        EXPECT_LE(a.mean[ch], 1.0f + 3.0f * a.sigma[ch] + 1e-4f)
+                                        EXPECT_LE(a.mean[ch], 1.0f + furnace_tolerance(a, ch))
                                             << "metallic " << metallic << " transmission "
                                             << transmission << " roughness " << roughness
                                             << " specular " << specular << " ior " << ior
@@ -351,9 +356,9 @@ TEST(BsdfFurnace, WhiteLayeredDielectricConservesEnergy) {
     for (float roughness : {0.0f, 0.3f, 0.8f}) {
         const Bsdf bsdf = make_bsdf(make_material(0.0f, roughness), Color(1.0f));
         for (double theta : {0.0, 50.0, 80.0}) {
-            const Albedo a = estimate_albedo(bsdf, direction(theta), TransportMode::Radiance,
-                                             20000, 100 + static_cast<uint64_t>(theta));
-            EXPECT_LE(a.mean.x, 1.0f + 3.0f * a.sigma.x + 1e-4f) << roughness << " " << theta;
+            const Albedo a = estimate_albedo(bsdf, direction(theta), TransportMode::Radiance, 20000,
+                                             100 + static_cast<uint64_t>(theta));
+            EXPECT_LE(a.mean.x, 1.0f + furnace_tolerance(a, 0)) << roughness << " " << theta;
             EXPECT_GE(a.mean.x, roughness == 0.0f ? 0.99f : 0.98f) << roughness << " " << theta;
         }
     }
@@ -404,8 +409,8 @@ TEST(BsdfReciprocity, ReflectionIsSymmetricAndTransmissionAdjoint) {
         const Color c(rng.next_float(), rng.next_float(), rng.next_float());
         // A shading normal tilted away from the geometric one.
         const Vec3 ng(0, 0, 1);
-        const Vec3 ns = glm::normalize(ng + 0.3f * Vec3(rng.next_float() - 0.5f,
-                                                        rng.next_float() - 0.5f, 0.0f));
+        const Vec3 ns = glm::normalize(
+            ng + 0.3f * Vec3(rng.next_float() - 0.5f, rng.next_float() - 0.5f, 0.0f));
         const Bsdf bsdf(m, c, Frame(ns), ng);
         auto random_direction = [&] {
             const float z = 1.0f - 2.0f * rng.next_float();
@@ -458,8 +463,8 @@ TEST(BsdfSmoothDielectric, DeltaLobesFollowFresnelAndSnell) {
         double theta_deg;
         bool inside;
     };
-    for (const Case c : {Case{0.0, false}, Case{60.0, false}, Case{85.0, false},
-                         Case{30.0, true}, Case{critical_deg + 5.0, true}}) {
+    for (const Case c : {Case{0.0, false}, Case{60.0, false}, Case{85.0, false}, Case{30.0, true},
+                         Case{critical_deg + 5.0, true}}) {
         SCOPED_TRACE(testing::Message() << "theta " << c.theta_deg << " inside " << c.inside);
         const Vec3 wo = direction(c.inside ? 180.0 - c.theta_deg : c.theta_deg, 0.7);
         const double n_o = c.inside ? kIor : 1.0, n_t = c.inside ? 1.0 : kIor;

@@ -1,6 +1,8 @@
 // The photon kd-tree: k-nearest and radius queries equal a brute-force search (same photons,
 // same distances, ties by index) on random, coincident, collinear and grid points; the tree does
 // not depend on the thread count; degenerate inputs.
+#include "core/photon/kd_tree.h"
+
 #include <gtest/gtest.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -14,7 +16,6 @@
 
 #include "core/math/rng.h"
 #include "core/math/sampling.h"
-#include "core/photon/kd_tree.h"
 
 namespace photond {
 namespace {

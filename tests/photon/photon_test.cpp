@@ -1,4 +1,6 @@
 // The packed photon: size, flux and direction quantisation errors, robustness of the encoding.
+#include "core/photon/photon.h"
+
 #include <gtest/gtest.h>
 
 #include <cfloat>
@@ -8,7 +10,6 @@
 
 #include "core/math/rng.h"
 #include "core/math/sampling.h"
-#include "core/photon/photon.h"
 
 namespace photond {
 namespace {
@@ -97,13 +98,13 @@ TEST(Photon, EncodingIsIdempotent) {
 TEST(Photon, ZeroTinyHugeAndInvalidFlux) {
     EXPECT_EQ(decoded_flux(Color(0.0f)), Color(0.0f));
     EXPECT_EQ(decoded_flux(Color(-0.0f)), Color(0.0f));
-    EXPECT_EQ(decoded_flux(Color(1e-35f)), Color(0.0f));            // below 2^-101
-    EXPECT_EQ(decoded_flux(Color(FLT_TRUE_MIN)), Color(0.0f));      // denormal
+    EXPECT_EQ(decoded_flux(Color(1e-35f)), Color(0.0f));                // below 2^-101
+    EXPECT_EQ(decoded_flux(Color(FLT_TRUE_MIN)), Color(0.0f));          // denormal
     EXPECT_EQ(decoded_flux(Color(-1.0f, 2.0f, kNaN)), Color(0, 2, 0));  // invalid channels -> 0
-    EXPECT_GT(decoded_flux(Color(1e-30f)).x, 0.0f);                 // inside the range
+    EXPECT_GT(decoded_flux(Color(1e-30f)).x, 0.0f);                     // inside the range
 
-    for (const Color& extreme : {Color(FLT_MAX), Color(kInf), Color(kInf, 1.0f, kNaN),
-                                 Color(3e38f, 1e38f, 0.0f)}) {
+    for (const Color& extreme :
+         {Color(FLT_MAX), Color(kInf), Color(kInf, 1.0f, kNaN), Color(3e38f, 1e38f, 0.0f)}) {
         const Color decoded = decoded_flux(extreme);
         EXPECT_TRUE(is_finite(decoded)) << decoded.x;
         EXPECT_GT(decoded.x, 1e38f);
@@ -138,8 +139,10 @@ TEST(Photon, DirectionErrorBelowOneDegree) {
 }
 
 TEST(Photon, DirectionSpecialCases) {
-    const Vec3 axes[] = {Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0), Vec3(0, -1, 0),
-                         Vec3(0, 0, 1), Vec3(0, 0, -1), Vec3(1, -1e-7f, 0)};
+    const Vec3 axes[] = {
+        Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0),      Vec3(0, -1, 0),
+        Vec3(0, 0, 1), Vec3(0, 0, -1), Vec3(1, -1e-7f, 0),
+    };
     for (const Vec3& d : axes) {
         EXPECT_LT(angle_degrees(d, make_photon(Vec3(0), d, Color(1)).direction()), 0.8f)
             << d.x << " " << d.y << " " << d.z;

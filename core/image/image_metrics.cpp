@@ -1,0 +1,51 @@
+#include "core/image/image_metrics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace photond {
+
+Expected<ImageError> compare_images(const Image& image, const Image& reference,
+                                    std::optional<PixelRect> region, double epsilon) {
+    if (image.width() != reference.width() || image.height() != reference.height()) {
+        return Error{"compare: image is " + std::to_string(image.width()) + "x" + std::to_string(image.height()) +
+                     " but the reference is " + std::to_string(reference.width()) + "x" +
+                     std::to_string(reference.height())};
+    }
+    const PixelRect area = region ? region->intersect(image.bounds()) : image.bounds();
+    if (area.empty()) return Error{"compare: the region holds no pixel"};
+    ImageError e;
+    double sum_rel = 0.0, sum_sq = 0.0, sum = 0.0, sum_ref = 0.0;
+    std::vector<double> abs_errors;
+    abs_errors.reserve(static_cast<size_t>(area.area()));
+    for (int y = area.y0; y < area.y1; ++y) {
+        for (int x = area.x0; x < area.x1; ++x) {
+            const Color a = image.at(x, y), r = reference.at(x, y);
+            double pixel_abs = 0.0;
+            for (int c = 0; c < 3; ++c) {
+                const double d = static_cast<double>(a[c]) - static_cast<double>(r[c]);
+                sum_rel += d * d / (static_cast<double>(r[c]) * r[c] + epsilon);
+                sum_sq += d * d;
+                pixel_abs += std::abs(d) / 3.0;
+                sum += a[c];
+                sum_ref += r[c];
+            }
+            abs_errors.push_back(pixel_abs);
+        }
+    }
+    const double n = static_cast<double>(area.area());
+    e.pixels = static_cast<size_t>(area.area());
+    e.relative_mse = sum_rel / (3.0 * n);
+    e.rmse = std::sqrt(sum_sq / (3.0 * n));
+    const size_t p99 = std::min(abs_errors.size() - 1, static_cast<size_t>(0.99 * static_cast<double>(abs_errors.size())));
+    std::nth_element(abs_errors.begin(), abs_errors.begin() + static_cast<ptrdiff_t>(p99), abs_errors.end());
+    e.p99_abs_error = abs_errors[p99];
+    e.mean = sum / (3.0 * n);
+    e.reference_mean = sum_ref / (3.0 * n);
+    e.mean_bias = e.reference_mean != 0.0 ? (e.mean - e.reference_mean) / e.reference_mean : 0.0;
+    return e;
+}
+
+}  // namespace photond

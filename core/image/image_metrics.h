@@ -1,0 +1,27 @@
+// Error of an image against a reference: the figures the benchmark and the tests report.
+#pragma once
+
+#include <optional>
+
+#include "core/image/image.h"
+#include "core/util/expected.h"
+
+namespace photond {
+
+struct ImageError {
+    double relative_mse = 0.0;    // mean over pixels and channels of (x - r)^2 / (r^2 + epsilon)
+    double rmse = 0.0;            // sqrt of the mean squared difference
+    double p99_abs_error = 0.0;   // 99th percentile of the per-pixel mean absolute difference
+    double mean = 0.0;            // mean of the image (all channels)
+    double reference_mean = 0.0;  // mean of the reference
+    double mean_bias = 0.0;       // (mean - reference_mean) / reference_mean
+    size_t pixels = 0;
+};
+
+/// Compares `image` with `reference` over `region` (the whole frame by default). epsilon keeps
+/// the relative error finite where the reference is black (0.01, as in the literature).
+Expected<ImageError> compare_images(const Image& image, const Image& reference,
+                                    std::optional<PixelRect> region = std::nullopt,
+                                    double epsilon = 0.01);
+
+}  // namespace photond

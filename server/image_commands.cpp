@@ -1,0 +1,107 @@
+#include "server/image_commands.h"
+
+#include <cstdio>
+
+#include "core/image/exr_io.h"
+#include "core/image/image_metrics.h"
+
+namespace photond::service {
+
+int run_compare_command(std::span<const std::string> args) {
+    constexpr const char* kUsage =
+        "usage: photond compare IMAGE.exr REFERENCE.exr [--region x0,y0,x1,y1] [--epsilon E]\n"
+        "prints relMSE, RMSE, the 99th percentile of per-pixel absolute error, and the mean bias\n";
+    std::vector<std::string> files;
+    std::optional<PixelRect> region;
+    double epsilon = 0.01;
+    for (size_t i = 0; i < args.size(); ++i) {
+        if (args[i] == "--region" && i + 1 < args.size()) {
+            PixelRect r;
+            if (std::sscanf(args[++i].c_str(), "%d,%d,%d,%d", &r.x0, &r.y0, &r.x1, &r.y1) != 4) {
+                std::fprintf(stderr, "photond compare: --region expects x0,y0,x1,y1\n");
+                return 2;
+            }
+            region = r;
+        } else if (args[i] == "--epsilon" && i + 1 < args.size()) {
+            epsilon = std::atof(args[++i].c_str());
+        } else if (args[i] == "-h" || args[i] == "--help") {
+            std::fputs(kUsage, stdout);
+            return 0;
+        } else {
+            files.push_back(args[i]);
+        }
+    }
+    if (files.size() != 2) {
+        std::fputs(kUsage, stderr);
+        return 2;
+    }
+    auto image = read_exr(files[0]);
+    auto reference = read_exr(files[1]);
+    if (!image || !reference) {
+        std::fprintf(stderr, "photond compare: %s\n", (!image ? image.error() : reference.error()).message.c_str());
+        return 1;
+    }
+    auto e = compare_images(image->beauty, reference->beauty, region, epsilon);
+    if (!e) {
+        std::fprintf(stderr, "photond compare: %s\n", e.error().message.c_str());
+        return 1;
+    }
+    std::printf("relmse %.6g rmse %.6g p99 %.6g mean %.6g reference_mean %.6g bias %+.4f%% pixels %zu\n",
+                e->relative_mse, e->rmse, e->p99_abs_error, e->mean, e->reference_mean, 100.0 * e->mean_bias,
+                e->pixels);
+    return 0;
+}
+
+int run_average_command(std::span<const std::string> args) {
+    constexpr const char* kUsage =
+        "usage: photond average -o OUT.exr IN.exr [IN.exr ...]\n"
+        "writes the per-pixel mean of renders with equal sample counts and other seeds (float EXR)\n";
+    std::string output;
+    std::vector<std::string> inputs;
+    for (size_t i = 0; i < args.size(); ++i) {
+        if ((args[i] == "-o" || args[i] == "--output") && i + 1 < args.size()) {
+            output = args[++i];
+        } else if (args[i] == "-h" || args[i] == "--help") {
+            std::fputs(kUsage, stdout);
+            return 0;
+        } else {
+            inputs.push_back(args[i]);
+        }
+    }
+    if (output.empty() || inputs.empty()) {
+        std::fputs(kUsage, stderr);
+        return 2;
+    }
+    Image sum;
+    std::vector<DVec3> accumulated;
+    for (const std::string& input : inputs) {
+        auto image = read_exr(input);
+        if (!image) {
+            std::fprintf(stderr, "photond average: %s\n", image.error().message.c_str());
+            return 1;
+        }
+        const Image& beauty = image->beauty;
+        if (accumulated.empty()) {
+            sum = Image(beauty.width(), beauty.height());
+            accumulated.assign(beauty.pixel_count(), DVec3(0.0));
+        } else if (beauty.width() != sum.width() || beauty.height() != sum.height()) {
+            std::fprintf(stderr, "photond average: %s is %dx%d, the first input %dx%d\n", input.c_str(),
+                         beauty.width(), beauty.height(), sum.width(), sum.height());
+            return 1;
+        }
+        for (size_t p = 0; p < beauty.pixel_count(); ++p) accumulated[p] += DVec3(beauty.pixels()[p]);
+    }
+    for (size_t p = 0; p < accumulated.size(); ++p)
+        sum.pixels()[p] = Color(accumulated[p] / static_cast<double>(inputs.size()));
+    ImageLayers layers;
+    layers.beauty = std::move(sum);
+    ExrWriteOptions options;
+    options.pixel_type = ExrPixelType::Float;
+    if (Status st = write_exr(output, layers, options); !st) {
+        std::fprintf(stderr, "photond average: %s\n", st.error().message.c_str());
+        return 1;
+    }
+    return 0;
+}
+
+}  // namespace photond::service

@@ -1,0 +1,199 @@
+// The photon pass: energy bookkeeping, determinism across thread counts, the radiance estimate
+// against an analytic irradiance, and scenes where photons cannot land.
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "core/photon/photon_tracer.h"
+#include "core/render/render_plan.h"
+#include "core/scene/builtin_scenes.h"
+#include "core/scene/shapes.h"
+
+namespace photond {
+namespace {
+
+std::shared_ptr<EmbreeDevice> device() {
+    static std::shared_ptr<EmbreeDevice> d = EmbreeDevice::create().value();
+    return d;
+}
+
+std::shared_ptr<const RenderScene> make_render_scene(Scene scene) {
+    return RenderScene::create(device(), std::make_shared<const Scene>(std::move(scene))).value();
+}
+
+Material lambertian(Color albedo) {
+    Material m;
+    m.base_color = albedo;
+    m.specular = 0.0f;
+    return m;
+}
+
+/// A closed 4 x 4 x 4 room (faces inward) of albedo rho with a point light inside.
+Scene closed_room(float rho, const Vec3& light_position, const Color& intensity) {
+    SceneBuilder builder("room");
+    const uint32_t m = builder.add_material(lambertian(Color(rho)));
+    MeshData room = make_box(Vec3(-2.0f), Vec3(2.0f));
+    flip_orientation(room);
+    EXPECT_TRUE(add_mesh(builder, room, m).is_ok());
+    PunctualLight light;
+    light.position = light_position;
+    light.intensity = intensity;
+    builder.add_light(light);
+    return builder.build().value();
+}
+
+DVec3 summed_flux(const PhotonMap& map, uint8_t required_flags) {
+    DVec3 sum(0.0);
+    for (uint32_t i = 0; i < map.size(); ++i) {
+        const Photon& p = map.tree().photon(i);
+        if ((p.user_flags() & required_flags) == required_flags) sum += DVec3(p.flux());
+    }
+    return sum;
+}
+
+TEST(PhotonTracer, FirstHitsCarryTheLightsTotalPower) {
+    const Color intensity(2.0f, 1.0f, 0.5f);
+    auto rs = make_render_scene(closed_room(0.5f, Vec3(0.3f, 1.0f, -0.2f), intensity));
+    PhotonTracingSettings settings;
+    settings.global_photons = 100000;
+    settings.caustic_photons = 0;
+    const auto maps = trace_photons(*rs, settings);
+    ASSERT_TRUE(maps.has_value()) << maps.error().message;
+    ASSERT_TRUE(maps->global);
+    EXPECT_FALSE(maps->caustic);
+    // In a closed room every emitted photon's first hit is stored: their flux sums to the power.
+    const DVec3 direct = summed_flux(*maps->global, photon_flags::kDirect);
+    const Color power = 4.0f * kPi * intensity;
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(direct[c], power[c], 0.01 * power[c]);
+    // All photons: the power times the mean number of diffuse bounces 1 / (1 - rho) = 2.
+    const DVec3 all = summed_flux(*maps->global, 0);
+    EXPECT_NEAR(all.x / power.x, 2.0, 0.03);
+    EXPECT_GE(maps->global->size(), 100000u);
+    EXPECT_EQ(maps->statistics.stored_global, maps->global->size());
+}
+
+TEST(PhotonTracer, MapsAreBitIdenticalForAnyThreadCount) {
+    auto rs = make_render_scene(make_builtin_scene("cornell-box").value());
+    PhotonTracingSettings settings;
+    settings.global_photons = 30000;
+    settings.caustic_photons = 20000;
+    settings.seed = 5;
+    settings.threads = 1;
+    const auto one = trace_photons(*rs, settings);
+    settings.threads = 2;
+    const auto two = trace_photons(*rs, settings);
+    settings.threads = 5;
+    const auto five = trace_photons(*rs, settings);
+    ASSERT_TRUE(one && two && five);
+    for (const auto* other : {&two, &five}) {
+        for (const auto& [a, b] : {std::pair{(*one).global, (**other).global}, std::pair{(*one).caustic, (**other).caustic}}) {
+            ASSERT_EQ(a->size(), b->size());
+            ASSERT_EQ(a->emitted(), b->emitted());
+            ASSERT_EQ(0, std::memcmp(&a->tree().photon(0), &b->tree().photon(0), a->size() * sizeof(Photon)));
+        }
+    }
+    // Another seed gives other photons: the comparison can fail.
+    settings.seed = 6;
+    const auto other_seed = trace_photons(*rs, settings);
+    EXPECT_NE(0, std::memcmp(&one->global->tree().photon(0), &other_seed->global->tree().photon(0),
+                             std::min(one->global->size(), other_seed->global->size()) * sizeof(Photon)));
+}
+
+TEST(PhotonTracer, IrradianceEstimateOnAPlaneMatchesInverseSquareLaw) {
+    SceneBuilder builder("plane");
+    // Nothing else in the scene: reflected photons leave it, so every stored photon is a first hit.
+    const uint32_t m = builder.add_material(lambertian(Color(0.5f)));
+    const MeshData plane = make_quad(Vec3(-10, 0, 10), Vec3(20, 0, 0), Vec3(0, 0, -20));
+    ASSERT_TRUE(add_mesh(builder, plane, m).is_ok());
+    PunctualLight light;
+    light.position = Vec3(0, 2, 0);
+    light.intensity = Color(10.0f);
+    builder.add_light(light);
+    auto rs = make_render_scene(builder.build().value());
+    ASSERT_GT(rs->scene->triangle_normal(0).y, 0.99f);
+    PhotonTracingSettings settings;
+    settings.global_photons = 1000000;
+    settings.caustic_photons = 0;
+    const auto maps = trace_photons(*rs, settings);
+    ASSERT_TRUE(maps.has_value()) << maps.error().message;
+    for (const float x : {0.0f, 0.7f, 1.5f, 2.5f}) {
+        const Vec3 p(x, 0.0f, 0.3f);
+        const Vec3 d = light.position - p;
+        const float dist2 = glm::dot(d, d);
+        const float expected = 10.0f * d.y / std::sqrt(dist2) / dist2;
+        const Color e = maps->global->estimate_irradiance(p, Vec3(0, 1, 0), 1000, 0.0f);
+        std::printf("x=%.1f estimate %.4f exact %.4f\n", x, e.x, expected);
+        EXPECT_NEAR(e.x, expected, 0.05f * expected) << "x=" << x;
+    }
+}
+
+TEST(PhotonTracer, LightsFacingAwayEndWithAMessageInsteadOfLooping) {
+    SceneBuilder builder("away");
+    const uint32_t m = builder.add_material(lambertian(Color(0.8f)));
+    ASSERT_TRUE(add_mesh(builder, make_quad(Vec3(-1, 0, 1), Vec3(2, 0, 0), Vec3(0, 0, -2)), m).is_ok());
+    PunctualLight spot;
+    spot.type = PunctualLightType::Spot;
+    spot.position = Vec3(0, 1, 0);
+    spot.direction = Vec3(0, 1, 0);  // up, away from the floor
+    spot.cos_inner = std::cos(0.2f);
+    spot.cos_outer = std::cos(0.4f);
+    builder.add_light(spot);
+    auto rs = make_render_scene(builder.build().value());
+    PhotonTracingSettings settings;
+    settings.global_photons = 1000;
+    settings.caustic_photons = 0;
+    const auto maps = trace_photons(*rs, settings);
+    ASSERT_FALSE(maps.has_value());
+    EXPECT_NE(maps.error().message.find("no photon"), std::string::npos) << maps.error().message;
+    EXPECT_NE(maps.error().message.find("global"), std::string::npos) << maps.error().message;
+}
+
+TEST(PhotonTracer, SceneWithoutLightsIsRefused) {
+    SceneBuilder builder("dark");
+    const uint32_t m = builder.add_material(lambertian(Color(0.8f)));
+    ASSERT_TRUE(add_mesh(builder, make_quad(Vec3(-1, 0, 1), Vec3(2, 0, 0), Vec3(0, 0, -2)), m).is_ok());
+    auto rs = make_render_scene(builder.build().value());
+    const auto maps = trace_photons(*rs, PhotonTracingSettings{});
+    ASSERT_FALSE(maps.has_value());
+    EXPECT_NE(maps.error().message.find("no light"), std::string::npos) << maps.error().message;
+}
+
+TEST(RenderPlan, SkipsTheCausticMapWithoutSpecularSurfaces) {
+    auto diffuse = make_render_scene(make_builtin_scene("cornell-box-diffuse").value());
+    const RenderPlan plan = plan_photon_passes(*diffuse->scene, *diffuse->lights, {200000, 100000});
+    EXPECT_FALSE(plan.caustic_map);
+    EXPECT_TRUE(plan.global_map);
+    ASSERT_NE(plan.find("caustic_map"), nullptr);
+    EXPECT_NE(plan.find("caustic_map")->reason.find("specular"), std::string::npos);
+
+    auto jensen = make_render_scene(make_builtin_scene("cornell-box").value());
+    const RenderPlan full = plan_photon_passes(*jensen->scene, *jensen->lights, {200000, 100000});
+    EXPECT_TRUE(full.caustic_map);
+    EXPECT_TRUE(full.global_map);
+}
+
+TEST(RenderPlan, SkipsTheGlobalMapWhenNothingReflectsDiffusely) {
+    // A glossy metal floor and a glass sphere: caustics are possible, indirect diffuse light is not.
+    SceneBuilder builder("glossy");
+    Material metal;
+    metal.metallic = 1.0f;
+    metal.roughness = 0.3f;
+    const uint32_t black = builder.add_material(metal);
+    Material glass;
+    glass.transmission = 1.0f;
+    glass.roughness = 0.0f;
+    const uint32_t g = builder.add_material(glass);
+    ASSERT_TRUE(add_mesh(builder, make_quad(Vec3(-5, 0, 5), Vec3(10, 0, 0), Vec3(0, 0, -10)), black).is_ok());
+    ASSERT_TRUE(add_mesh(builder, make_icosphere(Vec3(0, 1, 0), 1.0f, 2), g).is_ok());
+    PunctualLight light;
+    light.position = Vec3(0, 4, 0);
+    builder.add_light(light);
+    auto rs = make_render_scene(builder.build().value());
+    const RenderPlan plan = plan_photon_passes(*rs->scene, *rs->lights, {1000, 1000});
+    EXPECT_TRUE(plan.caustic_map);
+    EXPECT_FALSE(plan.global_map);
+    EXPECT_NE(plan.find("global_map")->reason.find("diffuse"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace photond
