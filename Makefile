@@ -37,6 +37,8 @@ demo: build
 
 bench: build
 	$(BUILD)/bench/ray_throughput_bench
+	$(BUILD)/bench/photon_tracing_bench
+	$(BUILD)/bench/kd_tree_bench
 
 format:
 	find core protocol server clients tests bench -name '*.h' -o -name '*.cpp' | xargs clang-format -i

@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <bit>
+#include <cstdio>
 #include <limits>
+#include <string>
 
 namespace photond {
 namespace {
@@ -125,6 +127,80 @@ PhotonKdTree::PhotonKdTree(std::vector<Photon> photons) {
                               photons_[i].set_split_axis(axes[i]);
                           }
                       });
+}
+
+namespace {
+
+std::string format_float(float value) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "%.9g", double(value));
+    return text;
+}
+
+// Checks the subtree [lo, hi) of an adopted tree-order array and returns its bounds; stops at
+// the first violation, which it describes in `error`. Recursion depth <= 32 (balanced tree).
+Bounds3 validate_subtree(const Photon* photons, uint32_t lo, uint32_t hi, std::string& error) {
+    Bounds3 bounds;
+    if (hi - lo <= PhotonKdTree::kLeafSize) {
+        for (uint32_t i = lo; i < hi && error.empty(); ++i) {
+            if (!is_finite(photons[i].position)) {
+                error = "photon " + std::to_string(i) + " has a non-finite position";
+            } else if (photons[i].split_axis() != kLeafAxis) {
+                error = "leaf photon " + std::to_string(i) + " has split axis " +
+                        std::to_string(photons[i].split_axis()) + " (leaf photons have 3)";
+            }
+            bounds.extend(photons[i].position);
+        }
+        return bounds;
+    }
+    const uint32_t mid = lo + (hi - lo) / 2;
+    const Photon& node = photons[mid];
+    const std::string node_name = "inner node " + std::to_string(mid) + " (photons [" +
+                                  std::to_string(lo) + ", " + std::to_string(hi) + "))";
+    if (!is_finite(node.position)) {
+        error = node_name + " has a non-finite position";
+        return bounds;
+    }
+    const uint32_t axis = node.split_axis();
+    if (axis > 2) {
+        error = node_name + " has split axis " + std::to_string(axis) + " (must be 0, 1 or 2)";
+        return bounds;
+    }
+    const Bounds3 left = validate_subtree(photons, lo, mid, error);
+    if (!error.empty()) return bounds;
+    const Bounds3 right = validate_subtree(photons, mid + 1, hi, error);
+    if (!error.empty()) return bounds;
+    const float split = node.position[axis];
+    if (!(left.upper[axis] <= split)) {
+        error = node_name + " splits axis " + std::to_string(axis) + " at " +
+                format_float(split) + " but its left subtree reaches " +
+                format_float(left.upper[axis]);
+    } else if (!(right.lower[axis] >= split)) {
+        error = node_name + " splits axis " + std::to_string(axis) + " at " +
+                format_float(split) + " but its right subtree reaches " +
+                format_float(right.lower[axis]);
+    }
+    bounds = left;
+    bounds.extend(right.lower);
+    bounds.extend(right.upper);
+    bounds.extend(node.position);
+    return bounds;
+}
+
+}  // namespace
+
+Expected<PhotonKdTree> PhotonKdTree::from_tree_order(std::vector<Photon> photons) {
+    if (photons.size() > size_t(std::numeric_limits<uint32_t>::max()) - 1) {
+        return Error{"photon kd-tree: " + std::to_string(photons.size()) +
+                     " photons in tree order, more than a tree holds (2^32 - 2)"};
+    }
+    PhotonKdTree tree;
+    if (photons.empty()) return tree;
+    std::string error;
+    tree.bounds_ = validate_subtree(photons.data(), 0, uint32_t(photons.size()), error);
+    if (!error.empty()) return Error{"photon kd-tree: " + error};
+    tree.photons_ = std::move(photons);
+    return tree;
 }
 
 void PhotonKdTree::k_nearest(const Vec3& p, uint32_t k, float max_radius, KnnResult& out) const {

@@ -9,6 +9,7 @@
 
 #include "core/photon/photon.h"
 #include "core/scene/scene.h"
+#include "core/util/expected.h"
 
 namespace photond {
 
@@ -68,6 +69,13 @@ public:
     PhotonKdTree() = default;
     /// Builds the tree; takes the photons (at most 2^32 - 2 are kept).
     explicit PhotonKdTree(std::vector<Photon> photons);
+
+    /// Adopts photons already in tree order (photons() of a built tree, e.g. read back from a
+    /// file) without rebuilding. Checks in O(n) what queries rely on: finite positions, split
+    /// axes 0..2 on inner nodes and 3 on leaf photons, and every inner node's split separating
+    /// its subtrees (left <= split <= right on its axis); recomputes the bounds. The Error names
+    /// the first violation found. The result answers every query exactly as the original did.
+    static Expected<PhotonKdTree> from_tree_order(std::vector<Photon> photons);
 
     /// The (at most) k photons nearest to p within max_radius (distance <= max_radius), the
     /// nearest by (squared distance, index): ties are broken by the smaller index, so the result

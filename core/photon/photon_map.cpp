@@ -9,6 +9,9 @@ constexpr double kPiDouble = 3.14159265358979323846;
 PhotonMap::PhotonMap(std::vector<Photon> photons, uint64_t emitted)
     : tree_(std::move(photons)), emitted_(emitted) {}
 
+PhotonMap::PhotonMap(PhotonKdTree tree, uint64_t emitted)
+    : tree_(std::move(tree)), emitted_(emitted) {}
+
 namespace {
 
 /// One reusable neighbour list per thread: queries never allocate after warm-up.

@@ -39,6 +39,8 @@ public:
     PhotonMap() = default;
     /// `photons` carry their final flux (path flux / photons emitted for this map).
     PhotonMap(std::vector<Photon> photons, uint64_t emitted);
+    /// Adopts a built tree (e.g. PhotonKdTree::from_tree_order of a cached map).
+    PhotonMap(PhotonKdTree tree, uint64_t emitted);
 
     /// Reflected radiance at p towards wo; `normal` is the shading normal on wo's side. Photons
     /// arriving from behind the surface (dot(-direction, normal) <= 0) are skipped.

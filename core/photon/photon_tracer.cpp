@@ -41,7 +41,7 @@ struct MapBuilder {
     std::vector<TracedPhoton> photons;
 
     /// Appends a batch's photons in order; stops at the one that fills the map.
-    void append(const std::vector<ChunkOutput>& chunks, std::vector<TracedPhoton> ChunkOutput::*member,
+    void append(std::span<const ChunkOutput> chunks, std::vector<TracedPhoton> ChunkOutput::*member,
                 uint64_t batch_start) {
         if (!active) return;
         for (const ChunkOutput& chunk : chunks) {
@@ -140,6 +140,7 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
     uint64_t emitted = 0;
     bool cancelled = false;
+    std::vector<ChunkOutput> chunks;
     while ((global.active || caustic.active) && !cancelled) {
         // Size the next batch from the store rate so far (deterministic: it depends only on the
         // maps' contents), within [16K, 1M] photons.
@@ -154,7 +155,13 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
         batch = std::min<uint64_t>(batch, 1048576);
         const bool want_global = global.active, want_caustic = caustic.active;
         const size_t chunk_count = (batch + kChunkSize - 1) / kChunkSize;
-        std::vector<ChunkOutput> chunks(chunk_count);
+        // Chunk buffers are kept from batch to batch: their capacity is reused, not reallocated.
+        if (chunks.size() < chunk_count) chunks.resize(chunk_count);
+        for (size_t c = 0; c < chunk_count; ++c) {
+            chunks[c].global.clear();
+            chunks[c].caustic.clear();
+            chunks[c].rays = 0;
+        }
         arena.execute([&] {
             tbb::parallel_for(size_t(0), chunk_count, [&](size_t c) {
                 if (settings.cancel && settings.cancel->load(std::memory_order_relaxed)) return;
@@ -168,9 +175,10 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
             });
         });
         if (settings.cancel && settings.cancel->load()) cancelled = true;
-        for (const ChunkOutput& c : chunks) stats.rays += c.rays;
-        global.append(chunks, &ChunkOutput::global, emitted);
-        caustic.append(chunks, &ChunkOutput::caustic, emitted);
+        const std::span<const ChunkOutput> batch_chunks(chunks.data(), chunk_count);
+        for (const ChunkOutput& c : batch_chunks) stats.rays += c.rays;
+        global.append(batch_chunks, &ChunkOutput::global, emitted);
+        caustic.append(batch_chunks, &ChunkOutput::caustic, emitted);
         emitted += batch;
         for (MapBuilder* m : {&global, &caustic}) {
             // A map that nothing reached after a fair trial will not fill: stop early.

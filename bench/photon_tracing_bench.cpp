@@ -1,0 +1,118 @@
+// Photon tracing speed: photons traced per second on one core, and the ray rate inside photon
+// tracing as a share of bare Embree's rate for incoherent rays in the same scene (goal: >= 60 %).
+#include <benchmark/benchmark.h>
+
+#include <cstdio>
+#include <map>
+
+#include "core/math/rng.h"
+#include "core/math/sampling.h"
+#include "core/photon/photon_tracer.h"
+#include "core/scene/builtin_scenes.h"
+
+namespace photond {
+namespace {
+
+std::shared_ptr<const RenderScene> scene_named(const std::string& name) {
+    static std::map<std::string, std::shared_ptr<const RenderScene>> cache;
+    auto& entry = cache[name];
+    if (!entry) {
+        auto scene = std::make_shared<const Scene>(make_builtin_scene(name).value());
+        entry = RenderScene::create(EmbreeDevice::create().value(), scene).value();
+    }
+    return entry;
+}
+
+const char* kScenes[] = {"cornell-box", "cornell-box-diffuse"};
+
+void BM_PhotonTracing(benchmark::State& state) {
+    const RenderScene& rs = *scene_named(kScenes[state.range(0)]);
+    PhotonTracingSettings settings;
+    settings.global_photons = 200000;
+    settings.caustic_photons = state.range(0) == 0 ? 50000 : 0;
+    settings.threads = 1;
+    uint64_t emitted = 0, rays = 0;
+    for (auto _ : state) {
+        const PhotonMaps maps = trace_photons(rs, settings).value();
+        emitted += maps.statistics.emitted;
+        rays += maps.statistics.rays;
+        // Only tracing counts here; the kd-tree build has its own benchmark.
+        state.SetIterationTime(maps.statistics.tracing_seconds);
+    }
+    state.counters["photons_per_s"] = benchmark::Counter(static_cast<double>(emitted), benchmark::Counter::kIsRate);
+    state.counters["rays_per_s"] = benchmark::Counter(static_cast<double>(rays), benchmark::Counter::kIsRate);
+}
+
+void BM_BareEmbreeIncoherent(benchmark::State& state) {
+    const RenderScene& rs = *scene_named(kScenes[state.range(0)]);
+    enable_flush_denormals();
+    std::vector<Ray> rays;
+    Rng rng(3, 4);
+    const Bounds3& b = rs.scene->bounds;
+    for (int i = 0; i < 1 << 18; ++i) {
+        const Vec3 u(rng.next_float(), rng.next_float(), rng.next_float());
+        rays.push_back(Ray{b.lower + (0.01f + 0.98f * u) * b.extent(), sample_uniform_sphere(rng.next_vec2())});
+    }
+    RTCScene scene = rs.tracer->handle();
+    uint64_t hits = 0;
+    for (auto _ : state) {
+        for (const Ray& ray : rays) {
+            RTCIntersectContext context;
+            rtcInitIntersectContext(&context);
+            RTCRayHit rh;
+            rh.ray.org_x = ray.origin.x, rh.ray.org_y = ray.origin.y, rh.ray.org_z = ray.origin.z;
+            rh.ray.dir_x = ray.direction.x, rh.ray.dir_y = ray.direction.y, rh.ray.dir_z = ray.direction.z;
+            rh.ray.tnear = 0.0f;
+            rh.ray.tfar = std::numeric_limits<float>::infinity();
+            rh.ray.time = 0.0f;
+            rh.ray.mask = 0xFFFFFFFFu;
+            rh.ray.id = 0;
+            rh.ray.flags = 0;
+            rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+            rtcIntersect1(scene, &context, &rh);
+            hits += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+        }
+    }
+    benchmark::DoNotOptimize(hits);
+    state.counters["rays_per_s"] = benchmark::Counter(static_cast<double>(state.iterations() * rays.size()),
+                                                      benchmark::Counter::kIsRate);
+}
+
+BENCHMARK(BM_PhotonTracing)->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMillisecond)
+    ->Repetitions(5)->ReportAggregatesOnly(true);
+BENCHMARK(BM_BareEmbreeIncoherent)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Repetitions(5)
+    ->ReportAggregatesOnly(true);
+
+class MedianReporter : public benchmark::ConsoleReporter {
+public:
+    void ReportRuns(const std::vector<Run>& runs) override {
+        ConsoleReporter::ReportRuns(runs);
+        for (const Run& run : runs) {
+            if (run.aggregate_name != "median") continue;
+            for (const auto& [name, counter] : run.counters)
+                values[run.run_name.function_name + "/" + run.run_name.args + ":" + name] = counter.value;
+        }
+    }
+    std::map<std::string, double> values;
+};
+
+}  // namespace
+}  // namespace photond
+
+int main(int argc, char** argv) {
+    benchmark::Initialize(&argc, argv);
+    photond::MedianReporter reporter;
+    benchmark::RunSpecifiedBenchmarks(&reporter);
+    for (int s = 0; s < 2; ++s) {
+        const std::string arg = "/" + std::to_string(s);
+        const double photons = reporter.values["BM_PhotonTracing" + arg + ":photons_per_s"];
+        const double rays = reporter.values["BM_PhotonTracing" + arg + ":rays_per_s"];
+        const double bare = reporter.values["BM_BareEmbreeIncoherent" + arg + ":rays_per_s"];
+        if (photons > 0 && bare > 0) {
+            std::printf("%-20s %6.3f Mphotons/s per core, %6.2f Mrays/s in tracing, bare Embree %6.2f Mrays/s, ratio %.2f\n",
+                        photond::kScenes[s], photons * 1e-6, rays * 1e-6, bare * 1e-6, rays / bare);
+        }
+    }
+    return 0;
+}

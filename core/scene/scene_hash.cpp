@@ -1,0 +1,104 @@
+#include "core/scene/scene_hash.h"
+
+#include <bit>
+
+#include "core/photon/photon_tracer.h"
+
+namespace photond {
+namespace {
+
+// These fire when a field is added to a struct the hashes read: hash the new field (if it affects
+// light transport) in scene_content_hash or photon_map_key, then update the size here.
+static_assert(sizeof(Material) == sizeof(std::string) + 64,
+              "Material changed: hash the new field in scene_content_hash");
+static_assert(sizeof(PunctualLight) == sizeof(std::string) + 56,
+              "PunctualLight changed: hash the new field in scene_content_hash");
+static_assert(sizeof(Texture) == 8 + sizeof(std::vector<Color>),
+              "Texture changed: hash the new field in scene_content_hash");
+static_assert(sizeof(Scene) == sizeof(std::string) + 9 * sizeof(std::vector<int>) + sizeof(Bounds3),
+              "Scene changed: hash the new field in scene_content_hash");
+static_assert(sizeof(void*) != 8 || sizeof(PhotonTracingSettings) == 40,
+              "PhotonTracingSettings changed: add the new field to photon_map_key if the maps "
+              "depend on it");
+
+void hash_float(Sha256& hasher, float value) {
+    uint32_t bits = std::bit_cast<uint32_t>(value);
+    if (bits == 0x80000000u) bits = 0;  // -0.0 and 0.0 are the same geometry
+    hasher.update_value(bits);
+}
+
+void hash_vec2(Sha256& hasher, const Vec2& v) {
+    hash_float(hasher, v.x);
+    hash_float(hasher, v.y);
+}
+
+void hash_vec3(Sha256& hasher, const Vec3& v) {
+    hash_float(hasher, v.x);
+    hash_float(hasher, v.y);
+    hash_float(hasher, v.z);
+}
+
+// Every array is prefixed with its length, so that moving an element from one array to the next
+// changes the hash.
+template <class T, class HashElement>
+void hash_array(Sha256& hasher, const std::vector<T>& values, HashElement&& hash_element) {
+    hasher.update_value(uint64_t(values.size()));
+    for (const T& value : values) hash_element(value);
+}
+
+}  // namespace
+
+Sha256Digest scene_content_hash(const Scene& scene) {
+    Sha256 hasher;
+    hasher.update_string("photond scene content 1");
+    hash_array(hasher, scene.positions, [&](const Vec3& p) { hash_vec3(hasher, p); });
+    hash_array(hasher, scene.normals, [&](const Vec3& n) { hash_vec3(hasher, n); });
+    hash_array(hasher, scene.uvs, [&](const Vec2& uv) { hash_vec2(hasher, uv); });
+    hash_array(hasher, scene.triangles, [&](const glm::uvec3& t) {
+        hasher.update_value(uint32_t(t.x));
+        hasher.update_value(uint32_t(t.y));
+        hasher.update_value(uint32_t(t.z));
+    });
+    hash_array(hasher, scene.triangle_materials, [&](uint32_t m) { hasher.update_value(m); });
+    hash_array(hasher, scene.materials, [&](const Material& m) {
+        hash_vec3(hasher, m.base_color);
+        hasher.update_value(int32_t(m.base_color_texture));
+        hash_float(hasher, m.metallic);
+        hash_float(hasher, m.roughness);
+        hash_float(hasher, m.ior);
+        hash_float(hasher, m.transmission);
+        hash_float(hasher, m.specular);
+        hash_vec3(hasher, m.specular_color);
+        hash_vec3(hasher, m.emission);
+        hasher.update_value(uint8_t(m.double_sided ? 1 : 0));
+    });
+    hash_array(hasher, scene.textures, [&](const Texture& t) {
+        hasher.update_value(int32_t(t.width));
+        hasher.update_value(int32_t(t.height));
+        hash_array(hasher, t.texels, [&](const Color& c) { hash_vec3(hasher, c); });
+    });
+    hash_array(hasher, scene.lights, [&](const PunctualLight& l) {
+        hasher.update_value(uint8_t(l.type));
+        hash_vec3(hasher, l.position);
+        hash_vec3(hasher, l.direction);
+        hash_vec3(hasher, l.intensity);
+        hash_float(hasher, l.cos_inner);
+        hash_float(hasher, l.cos_outer);
+    });
+    return hasher.finish();
+}
+
+std::string photon_map_key(const Scene& scene, const PhotonTracingSettings& settings) {
+    Sha256 hasher;
+    hasher.update_string("photond photon-map key");
+    hasher.update_value(kPhotonMapAlgorithmVersion);
+    hasher.update(scene_content_hash(scene));
+    hasher.update_value(uint32_t(settings.global_photons));
+    hasher.update_value(uint32_t(settings.caustic_photons));
+    hasher.update_value(uint64_t(settings.seed));
+    hasher.update_value(int32_t(settings.max_bounces));
+    hasher.update_value(uint32_t(settings.max_emitted_per_stored));
+    return "pm1-" + Sha256::hex(hasher.finish());
+}
+
+}  // namespace photond
