@@ -40,6 +40,8 @@ nlohmann::json to_json(const RenderStatistics& s) {
             {"caustic_complete", p.caustic_complete},
             {"map_bytes", s.photon_map_bytes},
         };
+        if (!s.photon_cache.empty()) result["photons"]["cache"] = s.photon_cache;
+        if (!s.photon_map_key.empty()) result["photons"]["key"] = s.photon_map_key;
     }
     return result;
 }

@@ -160,6 +160,14 @@ void print_statistics(const RenderStatistics& s) {
                  s.samples_per_pixel, s.threads);
     for (const PassTiming& p : s.passes) std::fprintf(stderr, "  %-14s %9.3f s\n", p.name.c_str(), p.seconds);
     std::fprintf(stderr, "  %-14s %9.3f s\n", "total", s.total_seconds);
+    for (const PassDecision& d : s.plan)
+        std::fprintf(stderr, "  plan: %-12s %-8s %s\n", d.pass.c_str(), d.enabled ? "run" : "skipped", d.reason.c_str());
+    if (s.photons && s.photons->emitted > 0) {
+        std::fprintf(stderr, "  photons: %llu emitted, %llu global, %llu caustic, %.1f MB\n",
+                     static_cast<unsigned long long>(s.photons->emitted),
+                     static_cast<unsigned long long>(s.photons->stored_global),
+                     static_cast<unsigned long long>(s.photons->stored_caustic), s.photon_map_bytes / 1e6);
+    }
     std::fprintf(stderr, "  rays %llu + shadow rays %llu, %.2f Mrays/s\n",
                  static_cast<unsigned long long>(s.rays), static_cast<unsigned long long>(s.shadow_rays),
                  s.rays_per_second() * 1e-6);

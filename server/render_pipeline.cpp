@@ -12,6 +12,7 @@
 #include "core/render/render_scene.h"
 #include "core/scene/builtin_scenes.h"
 #include "core/scene/gltf_loader.h"
+#include "core/scene/scene_hash.h"
 
 namespace photond::service {
 namespace {
@@ -26,30 +27,40 @@ Vec3 to_vec3(const std::array<double, 3>& a) {
     return Vec3(static_cast<float>(a[0]), static_cast<float>(a[1]), static_cast<float>(a[2]));
 }
 
-/// Plans and runs the photon pass of a photon-map job, recording it in the statistics.
+/// Plans the photon pass of a photon-map job and gets its maps: from the store when one is
+/// given (a hit skips tracing), else traced for this job. Records it all in the statistics.
 Expected<std::shared_ptr<const PhotonMaps>> build_photon_maps(const protocol::Job& job, const RenderScene& scene,
                                                               const PipelineOptions& options,
                                                               RenderStatistics& stats) {
     const RenderPlan plan = plan_photon_passes(*scene.scene, *scene.lights,
                                                {job.photons.global, job.photons.caustic});
     stats.plan = plan.decisions;
-    PhotonTracingSettings settings;
-    settings.global_photons = plan.global_map ? job.photons.global : 0;
-    settings.caustic_photons = plan.caustic_map ? job.photons.caustic : 0;
-    settings.seed = job.photons.seed;
-    settings.threads = options.threads;
-    settings.cancel = options.callbacks.cancel;
+    const PhotonTracingSettings settings = photon_settings(job, plan, options);
     if (settings.global_photons == 0 && settings.caustic_photons == 0) {
         stats.photons = PhotonTracingStatistics{};
         return std::make_shared<const PhotonMaps>();
     }
-    auto maps = trace_photons(scene, settings);
-    if (!maps) return maps.error();
+    if (options.on_pass) options.on_pass("photon_tracing");
+    const auto trace = [&]() { return trace_photons(scene, settings); };
+    std::shared_ptr<const PhotonMaps> maps;
+    if (options.photon_maps) {
+        stats.photon_map_key = photon_map_key(*scene.scene, settings);
+        bool hit = false;
+        auto cached = options.photon_maps->get_or_build(stats.photon_map_key, trace, &hit);
+        if (!cached) return cached.error();
+        maps = *cached;
+        stats.photon_cache = hit ? "hit" : "miss";
+    } else {
+        auto traced = trace();
+        if (!traced) return traced.error();
+        maps = std::make_shared<const PhotonMaps>(std::move(traced).value());
+    }
     stats.photons = maps->statistics;
     stats.photon_map_bytes = maps->bytes();
-    stats.passes.push_back({"photon_tracing", maps->statistics.tracing_seconds});
-    stats.passes.push_back({"photon_kdtree", maps->statistics.build_seconds});
-    return std::make_shared<const PhotonMaps>(std::move(maps).value());
+    const bool traced_here = stats.photon_cache != "hit";
+    stats.passes.push_back({"photon_tracing", traced_here ? maps->statistics.tracing_seconds : 0.0});
+    stats.passes.push_back({"photon_kdtree", traced_here ? maps->statistics.build_seconds : 0.0});
+    return maps;
 }
 
 Expected<std::unique_ptr<Integrator>> make_integrator(const protocol::Job& job,
@@ -71,8 +82,20 @@ Expected<std::unique_ptr<Integrator>> make_integrator(const protocol::Job& job,
 
 }  // namespace
 
+PhotonTracingSettings photon_settings(const protocol::Job& job, const RenderPlan& plan,
+                                      const PipelineOptions& options) {
+    PhotonTracingSettings settings;
+    settings.global_photons = plan.global_map ? job.photons.global : 0;
+    settings.caustic_photons = plan.caustic_map ? job.photons.caustic : 0;
+    settings.seed = job.photons.seed;
+    settings.threads = options.threads;
+    settings.cancel = options.callbacks.cancel;
+    return settings;
+}
+
 Expected<std::shared_ptr<const Scene>> load_job_scene(const protocol::SceneRef& ref,
-                                                      const std::filesystem::path& scene_root) {
+                                                      const PipelineOptions& options) {
+    const std::filesystem::path& scene_root = options.scene_root;
     switch (ref.kind) {
         case protocol::SceneRef::Kind::Builtin: {
             auto scene = make_builtin_scene(ref.value);
@@ -93,7 +116,8 @@ Expected<std::shared_ptr<const Scene>> load_job_scene(const protocol::SceneRef& 
             return std::make_shared<const Scene>(std::move(scene).value());
         }
         case protocol::SceneRef::Kind::Id:
-            return Error{"scene.id: uploaded scenes are served by the daemon only"};
+            if (!options.scene_lookup) return Error{"scene.id: uploaded scenes are served by the daemon only"};
+            return options.scene_lookup(ref.value);
     }
     return Error{"scene: unknown kind"};
 }
@@ -142,11 +166,13 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
         return Error{"output.aovs: the " + job.integrator + " integrator does not produce AOVs yet"};
 
     Clock::time_point pass_start = Clock::now();
-    auto scene = load_job_scene(job.scene, options.scene_root);
+    if (options.on_pass) options.on_pass("scene");
+    auto scene = load_job_scene(job.scene, options);
     if (!scene) return scene.error();
     stats.passes.push_back({"scene", seconds_since(pass_start)});
 
     pass_start = Clock::now();
+    if (options.on_pass) options.on_pass("acceleration");
     auto render_scene = RenderScene::create(device, *scene);
     if (!render_scene) return render_scene.error();
     stats.passes.push_back({"acceleration", seconds_since(pass_start)});
@@ -168,6 +194,7 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
         tiles.region = PixelRect{r[0], r[1], r[2], r[3]};
     }
     pass_start = Clock::now();
+    if (options.on_pass) options.on_pass("render");
     TileRenderResult rendered = render_tiles(**integrator, *camera, tiles, options.callbacks);
     stats.render_seconds = seconds_since(pass_start);
     stats.passes.push_back({"render", stats.render_seconds});

@@ -9,7 +9,9 @@
 #include <memory>
 
 #include "core/accel/ray_tracer.h"
+#include "core/photon/photon_tracer.h"
 #include "core/image/image.h"
+#include "core/render/render_plan.h"
 #include "core/render/statistics.h"
 #include "core/render/tile_renderer.h"
 #include "core/scene/scene.h"
@@ -17,10 +19,29 @@
 
 namespace photond::service {
 
+/// Where built photon maps are kept between jobs. `get_or_build` returns the maps for `key`
+/// (from memory or disk) or calls `build` and keeps what it returns; it reports whether the maps
+/// came from the cache. Implementations must be thread-safe.
+class PhotonMapStore {
+public:
+    virtual ~PhotonMapStore() = default;
+    virtual Expected<std::shared_ptr<const PhotonMaps>> get_or_build(
+        const std::string& key, const std::function<Expected<PhotonMaps>()>& build, bool* cache_hit) = 0;
+};
+
+/// Resolves {"id": "sha256:..."} scenes (uploaded to the daemon).
+using SceneLookup = std::function<Expected<std::shared_ptr<const Scene>>(const std::string& id)>;
+
+/// Called when a pass starts ("scene", "acceleration", "photon_tracing", "render"), for status.
+using PassCallback = std::function<void(const std::string& pass)>;
+
 struct PipelineOptions {
     int threads = 0;                    // 0 = every core
     std::filesystem::path scene_root;   // {"path": ...} scenes are read below this directory only
     RenderCallbacks callbacks;          // per-tile progress and cancellation
+    PhotonMapStore* photon_maps = nullptr;  // null: photon maps are built for this job only
+    SceneLookup scene_lookup;               // null: {"id": ...} scenes are refused
+    PassCallback on_pass;
 };
 
 struct PipelineResult {
@@ -30,7 +51,11 @@ struct PipelineResult {
 
 /// Loads the scene a job names (builtin, or a glTF file below the scene root).
 Expected<std::shared_ptr<const Scene>> load_job_scene(const protocol::SceneRef& ref,
-                                                      const std::filesystem::path& scene_root);
+                                                      const PipelineOptions& options);
+
+/// The photon tracing settings of a photon-map job under its plan.
+PhotonTracingSettings photon_settings(const protocol::Job& job, const RenderPlan& plan,
+                                      const PipelineOptions& options);
 
 /// The camera a job asks for: its own, the scene's glTF camera, or a view of the whole scene.
 Expected<CameraDesc> resolve_camera(const protocol::Job& job, const Scene& scene);

@@ -33,6 +33,10 @@ struct RenderStatistics {
     /// The photon pass, when one ran or its maps came from the cache.
     std::optional<PhotonTracingStatistics> photons;
     size_t photon_map_bytes = 0;
+    /// "hit" when the photon maps came from the cache, "miss" when traced and stored, empty when
+    /// no cache was used.
+    std::string photon_cache;
+    std::string photon_map_key;
 
     double rays_per_second() const {
         return render_seconds > 0.0 ? static_cast<double>(rays + shadow_rays) / render_seconds : 0.0;
