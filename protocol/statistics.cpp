@@ -43,6 +43,17 @@ nlohmann::json to_json(const RenderStatistics& s) {
         if (!s.photon_cache.empty()) result["photons"]["cache"] = s.photon_cache;
         if (!s.photon_map_key.empty()) result["photons"]["key"] = s.photon_map_key;
     }
+    if (s.irradiance_cache) {
+        const auto& c = *s.irradiance_cache;
+        result["irradiance_cache"] = {
+            {"records", c.records},
+            {"waves", c.waves},
+            {"lookups", c.lookups},
+            {"misses", c.misses},
+            {"interpolated_share", c.interpolated_share()},
+            {"seconds", c.seconds},
+        };
+    }
     return result;
 }
 

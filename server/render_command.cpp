@@ -168,6 +168,12 @@ void print_statistics(const RenderStatistics& s) {
                      static_cast<unsigned long long>(s.photons->stored_global),
                      static_cast<unsigned long long>(s.photons->stored_caustic), s.photon_map_bytes / 1e6);
     }
+    if (s.irradiance_cache) {
+        std::fprintf(stderr, "  irradiance cache: %llu records in %d waves, %.1f %% of %llu lookups interpolated\n",
+                     static_cast<unsigned long long>(s.irradiance_cache->records), s.irradiance_cache->waves,
+                     100.0 * s.irradiance_cache->interpolated_share(),
+                     static_cast<unsigned long long>(s.irradiance_cache->lookups));
+    }
     std::fprintf(stderr, "  rays %llu + shadow rays %llu, %.2f Mrays/s\n",
                  static_cast<unsigned long long>(s.rays), static_cast<unsigned long long>(s.shadow_rays),
                  s.rays_per_second() * 1e-6);

@@ -75,6 +75,19 @@ Expected<std::unique_ptr<Integrator>> make_integrator(const protocol::Job& job,
         PhotonMapIntegratorSettings settings;
         settings.k_global = job.photons.k_global;
         settings.k_caustic = job.photons.k_caustic;
+        settings.gather.rays = job.gather.rays;
+        settings.irradiance_cache = job.irradiance_cache.enabled;
+        settings.cache.cache.accuracy = static_cast<float>(job.irradiance_cache.a);
+        settings.cache.cache.gradients = job.irradiance_cache.gradients;
+        settings.cache.min_spacing_px = static_cast<float>(job.irradiance_cache.min_spacing_px);
+        settings.cache.max_spacing_px = static_cast<float>(job.irradiance_cache.max_spacing_px);
+        settings.cache.seed = job.seed;
+        settings.cache.threads = options.threads;
+        settings.cache.cancel = options.callbacks.cancel;
+        if (job.image.region) {
+            const auto& r = *job.image.region;
+            settings.cache.region = PixelRect{r[0], r[1], r[2], r[3]};
+        }
         return std::unique_ptr<Integrator>(new PhotonMapIntegrator(scene, *maps, settings));
     }
     return Error{"integrator: unknown integrator '" + job.integrator + "'"};
@@ -184,6 +197,21 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     auto integrator = make_integrator(job, *render_scene, options, stats);
     if (!integrator) return integrator.error();
 
+    if (auto* photon_map = dynamic_cast<PhotonMapIntegrator*>(integrator->get())) {
+        if (options.on_pass) options.on_pass("irradiance_cache");
+        CacheBuildStatistics cache_stats;
+        photon_map->prepare(*camera, &cache_stats);
+        if (photon_map->cache()) {
+            stats.irradiance_cache = RenderStatistics::IrradianceCacheFigures{};
+            stats.irradiance_cache->records = cache_stats.records;
+            stats.irradiance_cache->waves = cache_stats.waves;
+            stats.irradiance_cache->seconds = cache_stats.seconds;
+            stats.passes.push_back({"irradiance_cache", cache_stats.seconds});
+            stats.rays += cache_stats.counters.rays;
+            stats.shadow_rays += cache_stats.counters.shadow_rays;
+        }
+    }
+
     TileSettings tiles;
     tiles.tile_size = job.image.tile_size;
     tiles.samples_per_pixel = job.image.spp;
@@ -198,8 +226,12 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     TileRenderResult rendered = render_tiles(**integrator, *camera, tiles, options.callbacks);
     stats.render_seconds = seconds_since(pass_start);
     stats.passes.push_back({"render", stats.render_seconds});
-    stats.rays = rendered.counters.rays;
-    stats.shadow_rays = rendered.counters.shadow_rays;
+    stats.rays += rendered.counters.rays;
+    stats.shadow_rays += rendered.counters.shadow_rays;
+    if (stats.irradiance_cache) {
+        stats.irradiance_cache->lookups = rendered.counters.irradiance_lookups;
+        stats.irradiance_cache->misses = rendered.counters.irradiance_misses;
+    }
     stats.cancelled = rendered.cancelled;
     stats.total_seconds = seconds_since(start);
     result.layers.beauty = std::move(rendered.image);

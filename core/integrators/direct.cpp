@@ -19,7 +19,7 @@ Color DirectIntegrator::radiance_along(const Ray& ray, int depth, SampleContext&
     const Bsdf bsdf = make_bsdf(*rs.scene, si, wo);
     if (bsdf.has_non_delta()) radiance += sample_direct_light(rs, si, bsdf, wo, context, false);
     if (bsdf.has_delta() && depth < max_specular_depth_) {
-        radiance += follow_delta_lobes(bsdf, wo, depth, context.rng, [&](const BsdfSample& s) {
+        radiance += follow_delta_lobes(bsdf, wo, depth < kBranchDepth, context.rng, [&](const BsdfSample& s) {
             return radiance_along(spawn_ray(rs, si, s.wi), depth + 1, context);
         });
     }

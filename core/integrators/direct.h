@@ -21,16 +21,19 @@ private:
     int max_specular_depth_;
 };
 
-/// Follows delta lobes at a hit: every lobe while depth < kBranchDepth (a noise-free first
-/// reflection and refraction), then one lobe chosen in proportion to its weight (unbiased, and
-/// no exponential growth of rays inside glass). `trace` is called with (direction, weight).
+/// Camera paths follow every delta lobe for their first kBranchDepth specular bounces (a
+/// noise-free first reflection and refraction), then one.
+inline constexpr int kBranchDepth = 2;
+
+/// Follows the delta lobes at a hit: all of them when `branch` (weights summed), else one chosen
+/// in proportion to its weight (unbiased, and no exponential growth of rays inside glass).
+/// `trace` is called with each followed BsdfSample and returns the radiance along it.
 template <typename TraceFn>
-Color follow_delta_lobes(const Bsdf& bsdf, const Vec3& wo, int depth, Rng& rng, TraceFn&& trace) {
-    constexpr int kBranchDepth = 2;
+Color follow_delta_lobes(const Bsdf& bsdf, const Vec3& wo, bool branch, Rng& rng, TraceFn&& trace) {
     std::array<BsdfSample, 2> lobes;
     const int count = bsdf.delta_lobes(wo, lobes);
     if (count == 0) return Color(0.0f);
-    if (count == 1 || depth < kBranchDepth) {
+    if (count == 1 || branch) {
         Color sum(0.0f);
         for (int i = 0; i < count; ++i) {
             if (!is_black(lobes[i].weight)) sum += lobes[i].weight * trace(lobes[i]);

@@ -18,10 +18,14 @@ namespace photond {
 struct RayCounters {
     uint64_t rays = 0;         // intersection queries
     uint64_t shadow_rays = 0;  // occlusion queries
+    uint64_t irradiance_lookups = 0;  // indirect irradiance asked of the irradiance cache
+    uint64_t irradiance_misses = 0;   // ... that no record covered (gathered on the spot)
 
     RayCounters& operator+=(const RayCounters& o) {
         rays += o.rays;
         shadow_rays += o.shadow_rays;
+        irradiance_lookups += o.irradiance_lookups;
+        irradiance_misses += o.irradiance_misses;
         return *this;
     }
 };
@@ -41,6 +45,11 @@ public:
     virtual std::string_view name() const = 0;
     virtual Color radiance(const CameraRay& ray, SampleContext& context) const = 0;
 };
+
+/// The camera-ray footprint: the width of one pixel per unit of distance along the ray.
+inline float pixel_spread(const CameraRay& ray) {
+    return 0.5f * (glm::length(ray.direction_dx - ray.direction) + glm::length(ray.direction_dy - ray.direction));
+}
 
 /// Intersection query that counts itself.
 inline std::optional<Hit> trace_ray(const RenderScene& rs, const Ray& ray, RayCounters& counters) {

@@ -3,6 +3,12 @@
 #include "core/integrators/direct.h"
 
 namespace photond {
+namespace {
+
+/// How far beyond a record's domain (as a factor of a) the render pass may extrapolate.
+constexpr float kExtrapolationScale = 2.0f;
+
+}  // namespace
 
 PhotonMapIntegrator::PhotonMapIntegrator(std::shared_ptr<const RenderScene> scene,
                                          std::shared_ptr<const PhotonMaps> maps,
@@ -18,15 +24,46 @@ PhotonMapIntegrator::PhotonMapIntegrator(std::shared_ptr<const RenderScene> scen
     global_options_.max_radius = settings_.max_radius_global > 0.0f
                                      ? settings_.max_radius_global
                                      : kDefaultGlobalRadiusShare * scene_radius;
-    // Direct light comes from light sampling; caustics from the caustic map when there is one.
+    // Read directly, the global map must skip what light sampling and the caustic map count.
     global_options_.exclude_flags = photon_flags::kDirect | (maps_->caustic ? photon_flags::kCaustic : 0);
+    if (settings_.final_gather && maps_->global) {
+        GatherSettings gather = settings_.gather;
+        gather.k_global = settings_.k_global;
+        gather.max_radius = global_options_.max_radius;
+        gatherer_ = std::make_unique<FinalGatherer>(scene_, maps_, gather);
+    }
+}
+
+void PhotonMapIntegrator::prepare(const Camera& camera, CacheBuildStatistics* statistics) {
+    if (!gatherer_ || !settings_.irradiance_cache) return;
+    CacheBuildSettings build = settings_.cache;
+    build.max_specular_depth = settings_.max_specular_depth;
+    cache_ = build_irradiance_cache(*scene_, *gatherer_, camera, build, statistics);
 }
 
 Color PhotonMapIntegrator::radiance(const CameraRay& ray, SampleContext& context) const {
-    return radiance_along(Ray{ray.origin, ray.direction}, 0, context);
+    return radiance_along(Ray{ray.origin, ray.direction}, 0, 0.0f, pixel_spread(ray), context);
 }
 
-Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, SampleContext& context) const {
+Color PhotonMapIntegrator::indirect_irradiance(const DiffusePoint& point, SampleContext& context) const {
+    Color e;
+    if (cache_) {
+        ++context.counters.irradiance_lookups;
+        if (cache_->interpolate(point.position, point.normal, &e)) return e;
+        // The prepass tested pixel centres; a sample elsewhere in the pixel may fall just outside
+        // every record's domain: extrapolate a little before gathering anew.
+        if (cache_->interpolate(point.position, point.normal, &e, kExtrapolationScale)) return e;
+        ++context.counters.irradiance_misses;
+    }
+    // No record covers the point (or no cache): gather here, without storing, so the cache stays
+    // as the prepass left it and the image independent of tile order.
+    const GatherResult g = gatherer_->gather(point.position, point.normal, point.geometric_normal, context.rng,
+                                             context.counters, false);
+    return g.irradiance;
+}
+
+Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_length, float spread,
+                                          SampleContext& context) const {
     const RenderScene& rs = *scene_;
     const std::optional<Hit> hit = trace_ray(rs, ray, context.counters);
     if (!hit) return Color(0.0f);
@@ -34,17 +71,43 @@ Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, SampleConte
     const Vec3 wo = -ray.direction;
     Color radiance = rs.lights->emitted_radiance(si, wo);
     const Bsdf bsdf = make_bsdf(*rs.scene, si, wo);
+    const float length = path_length + hit->t;
     if (bsdf.has_non_delta()) {
         radiance += sample_direct_light(rs, si, bsdf, wo, context, false);
         const Vec3 normal = glm::dot(si.shading_normal, wo) >= 0.0f ? si.shading_normal : -si.shading_normal;
         if (maps_->caustic)
             radiance += maps_->caustic->estimate_radiance(si.p, normal, bsdf, wo, caustic_options_);
-        if (maps_->global)
+        if (gatherer_) {
+            const Color rho = bsdf.diffuse_reflectance(wo);
+            if (max_component(rho) > 0.0f) {
+                const Vec3 ng = glm::dot(si.geometric_normal, wo) >= 0.0f ? si.geometric_normal : -si.geometric_normal;
+                const DiffusePoint point{si.p, normal, ng, length * spread};
+                radiance += rho * kInvPi * indirect_irradiance(point, context);
+            }
+            if (bsdf.has_non_lambertian_non_delta()) {
+                // Glossy and rough lobes: BSDF-sampled rays reading the photon maps where they land
+                // (no emission there: direct light is light sampling's, caustics the maps').
+                const LobeMask mask = kNonDeltaLobes | kExcludeLambertian;
+                const int rays = std::max(settings_.glossy_rays, 1);
+                Color sum(0.0f);
+                for (int i = 0; i < rays; ++i) {
+                    const float u_lobe = context.rng.next_float();
+                    const Vec2 u = context.rng.next_vec2();
+                    const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Radiance, mask);
+                    if (!s || is_black(s->weight)) continue;
+                    float distance = 0.0f;
+                    sum += s->weight * gatherer_->gather_ray_radiance(spawn_ray(rs, si, s->wi), context.rng,
+                                                                      context.counters, &distance);
+                }
+                radiance += sum / static_cast<float>(rays);
+            }
+        } else if (maps_->global) {
             radiance += maps_->global->estimate_radiance(si.p, normal, bsdf, wo, global_options_);
+        }
     }
     if (bsdf.has_delta() && depth < settings_.max_specular_depth) {
-        radiance += follow_delta_lobes(bsdf, wo, depth, context.rng, [&](const BsdfSample& s) {
-            return radiance_along(spawn_ray(rs, si, s.wi), depth + 1, context);
+        radiance += follow_delta_lobes(bsdf, wo, depth < kBranchDepth, context.rng, [&](const BsdfSample& s) {
+            return radiance_along(spawn_ray(rs, si, s.wi), depth + 1, length, spread, context);
         });
     }
     return radiance;

@@ -1,13 +1,22 @@
-// Integrator `photon-map`, first stage (ALGORITHMS.md section 4 without final gathering):
-// emitted light, direct light by light sampling, ideal specular reflection and refraction by
-// recursion, caustics from the caustic map at visible non-delta points, and indirect light read
-// from the global map directly at the first non-delta hit (photons of the global map that are
-// direct (L D) or caustic (L S+ D) are skipped there: those are counted by the other terms).
+// Integrator `photon-map` (ALGORITHMS.md section 4): emitted light, direct light by light
+// sampling, ideal specular reflection and refraction by recursion, caustics from the caustic map
+// at visible points, and indirect light by final gathering from the global map through the
+// shared irradiance cache:
+//   L = Le + L_direct + L_caustic + rho_d / pi * E_indirect + L_indirect,non-Lambertian
+// E_indirect comes from the irradiance cache (or a gather at the point when the cache is off or
+// has no record there); non-Lambertian lobes (glossy and rough microfacet) take BSDF-sampled rays
+// that read the photon maps where they land.
+//
+// Without final gathering (`final_gather = false`) indirect light is read from the global map
+// directly at the first hit, skipping its direct (L D) and caustic (L S+ D) photons, which the
+// other terms count: fast and blotchy, the classic look of a photon map seen directly.
 #pragma once
 
 #include <memory>
 
+#include "core/integrators/final_gather.h"
 #include "core/integrators/integrator.h"
+#include "core/integrators/irradiance_cache_builder.h"
 #include "core/photon/photon_tracer.h"
 
 namespace photond {
@@ -18,6 +27,11 @@ struct PhotonMapIntegratorSettings {
     float max_radius_global = 0.0f;   // world units; 0 = kDefaultGlobalRadiusShare of the scene
     float max_radius_caustic = 0.0f;  // world units; 0 = kDefaultCausticRadiusShare of the scene
     int max_specular_depth = 16;
+    bool final_gather = true;
+    GatherSettings gather;
+    bool irradiance_cache = true;
+    CacheBuildSettings cache;
+    int glossy_rays = 1;  // BSDF-sampled rays per visible point for non-Lambertian lobes
 };
 
 /// Default search radius caps as a share of the scene's bounding radius.
@@ -29,16 +43,25 @@ public:
     PhotonMapIntegrator(std::shared_ptr<const RenderScene> scene, std::shared_ptr<const PhotonMaps> maps,
                         const PhotonMapIntegratorSettings& settings);
     std::string_view name() const override { return "photon-map"; }
+
+    /// Fills the irradiance cache for this camera (a no-op without final gathering or cache).
+    void prepare(const Camera& camera, CacheBuildStatistics* statistics);
+
     Color radiance(const CameraRay& ray, SampleContext& context) const override;
 
+    const IrradianceCache* cache() const { return cache_.get(); }
+
 private:
-    Color radiance_along(const Ray& ray, int depth, SampleContext& context) const;
+    Color radiance_along(const Ray& ray, int depth, float path_length, float spread, SampleContext& context) const;
+    Color indirect_irradiance(const DiffusePoint& point, SampleContext& context) const;
 
     std::shared_ptr<const RenderScene> scene_;
     std::shared_ptr<const PhotonMaps> maps_;
     PhotonMapIntegratorSettings settings_;
     RadianceEstimateOptions caustic_options_;
     RadianceEstimateOptions global_options_;
+    std::unique_ptr<FinalGatherer> gatherer_;
+    std::unique_ptr<IrradianceCache> cache_;
 };
 
 }  // namespace photond

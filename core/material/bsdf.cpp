@@ -344,13 +344,20 @@ bool Bsdf::geometry_agrees(const Vec3& wo, const Vec3& wi, bool local_reflection
     return geometric_reflection == local_reflection;
 }
 
+bool Bsdf::has_non_lambertian_non_delta() const {
+    const bool rough_reflection = !smooth_ && (metallic_ > 0.0f || (layer_weight_ > 0.0f && specular_f90_ > 0.0f));
+    const bool rough_glass = glass_weight_ > 0.0f && !glass_delta_;
+    return rough_reflection || rough_glass;
+}
+
 Bsdf::SlotProbabilities Bsdf::slot_probabilities(const Vec3& wo, bool outside,
                                                  LobeMask mask) const {
     // Each slot's estimated albedo for this wo (exact for Lambert and the smooth lobes). The
     // estimates never depend on the TransportMode, so that pdf() needs none.
     SlotProbabilities p{0.0f, 0.0f, 0.0f};
     const float mu = wo.z;
-    if (in_mask(mask, LobeKind::Diffuse) && (lobes_ & mask_of(LobeKind::Diffuse))) {
+    if (in_mask(mask, LobeKind::Diffuse) && !(mask & kExcludeLambertian) &&
+        max_component(diffuse_) > 0.0f) {
         p[kSlotDiffuse] = average(lambert_albedo(mu));
     }
     if (in_mask(mask, specular_kind_) && (metallic_ > 0.0f || layer_weight_ > 0.0f)) {
@@ -371,7 +378,7 @@ Color Bsdf::eval_local(const Vec3& wo, const Vec3& wi, bool outside, TransportMo
     Color f(0.0f);
     const GgxDistribution ggx(alpha_);
     if (wi.z > 0.0f) {
-        if (in_mask(mask, LobeKind::Diffuse)) {
+        if (in_mask(mask, LobeKind::Diffuse) && !(mask & kExcludeLambertian)) {
             f += diffuse_weight_ * kInvPi * (Color(1.0f) - layer_albedo(wo.z)) *
                  (Color(1.0f) - layer_albedo(wi.z)) * diffuse_norm_;
         }

@@ -29,6 +29,10 @@ using LobeMask = uint8_t;
 inline constexpr LobeMask kAllLobes = 7;
 inline constexpr LobeMask kNonDeltaLobes = 3;
 inline constexpr LobeMask mask_of(LobeKind k) { return static_cast<LobeMask>(k); }
+/// Mask flag that leaves out the Lambertian lobe while keeping microfacet lobes of every kind:
+/// the irradiance cache handles Lambertian reflection as rho / pi * E, and BSDF-sampled rays
+/// handle the rest (kNonDeltaLobes | kExcludeLambertian).
+inline constexpr LobeMask kExcludeLambertian = 8;
 
 /// Perceptual roughness below which a microfacet lobe is treated as ideal specular (delta).
 inline constexpr float kDeltaRoughness = 0.02f;
@@ -89,6 +93,9 @@ public:
 
     bool has_delta() const { return (lobes_ & mask_of(LobeKind::Delta)) != 0; }
     bool has_non_delta() const { return (lobes_ & kNonDeltaLobes) != 0; }
+    /// Whether a non-delta lobe other than the Lambertian one exists (rough metal, rough
+    /// dielectric layer, rough transmission): then L_o is not rho / pi * E.
+    bool has_non_lambertian_non_delta() const;
     /// Which LobeKinds this BSDF has at all (a LobeMask).
     LobeMask lobes() const { return lobes_; }
     /// Reflectance of the Lambertian lobe alone (rho_d), so that L_o = rho_d / pi * E.

@@ -172,13 +172,11 @@ Bounds3 validate_subtree(const Photon* photons, uint32_t lo, uint32_t hi, std::s
     if (!error.empty()) return bounds;
     const float split = node.position[axis];
     if (!(left.upper[axis] <= split)) {
-        error = node_name + " splits axis " + std::to_string(axis) + " at " +
-                format_float(split) + " but its left subtree reaches " +
-                format_float(left.upper[axis]);
+        error = node_name + " splits axis " + std::to_string(axis) + " at " + format_float(split) +
+                " but its left subtree reaches " + format_float(left.upper[axis]);
     } else if (!(right.lower[axis] >= split)) {
-        error = node_name + " splits axis " + std::to_string(axis) + " at " +
-                format_float(split) + " but its right subtree reaches " +
-                format_float(right.lower[axis]);
+        error = node_name + " splits axis " + std::to_string(axis) + " at " + format_float(split) +
+                " but its right subtree reaches " + format_float(right.lower[axis]);
     }
     bounds = left;
     bounds.extend(right.lower);

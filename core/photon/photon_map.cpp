@@ -75,4 +75,21 @@ Color PhotonMap::estimate_irradiance(const Vec3& p, const Vec3& normal, uint32_t
     return Color(sum / (kPiDouble * radius2));
 }
 
+bool PhotonMap::nearest_irradiance(const Vec3& p, const Vec3& normal, float max_radius,
+                                   Color* irradiance) const {
+    if (tree_.empty()) return false;
+    constexpr uint32_t kCandidates = 8;
+    KnnResult& found = thread_scratch();
+    tree_.k_nearest(p, kCandidates, max_radius > 0.0f ? max_radius : std::numeric_limits<float>::infinity(), found);
+    const KnnNeighbor* best = nullptr;
+    for (const KnnNeighbor& n : found.neighbors) {
+        if (glm::dot(tree_.photon(n.index).direction(), normal) <= kIrradianceNormalCosine) continue;
+        // Nearest first; ties go to the smaller index so the choice is deterministic.
+        if (!best || n.dist2 < best->dist2 || (n.dist2 == best->dist2 && n.index < best->index)) best = &n;
+    }
+    if (!best) return false;
+    *irradiance = tree_.photon(best->index).flux();
+    return true;
+}
+
 }  // namespace photond

@@ -24,6 +24,9 @@ inline constexpr uint8_t kCaustic = 2;  // through one or more specular bounces:
 /// Fewer photons than this in an estimate give zero (the lecture's rule: too few to trust).
 inline constexpr uint32_t kMinPhotonsPerEstimate = 8;
 
+/// Minimum cosine between a query's normal and a precomputed-irradiance photon's normal.
+inline constexpr float kIrradianceNormalCosine = 0.9f;
+
 struct RadianceEstimateOptions {
     uint32_t k = 50;                 // nearest photons to gather
     float max_radius = 0.0f;         // search radius cap (world units); <= 0 means unbounded
@@ -50,6 +53,12 @@ public:
     /// Irradiance at p (photon flux per area), for diffuse reflection L = rho / pi * E.
     Color estimate_irradiance(const Vec3& p, const Vec3& normal, uint32_t k, float max_radius,
                               uint8_t exclude_flags = 0) const;
+
+    /// Precomputed irradiance (Christensen 1999, "Faster photon map global illumination"): in a
+    /// map whose photons hold irradiance (flux) and surface normal (direction), the nearest one
+    /// within max_radius whose normal agrees with `normal` (cosine > kIrradianceNormalCosine).
+    /// Returns false when none is near.
+    bool nearest_irradiance(const Vec3& p, const Vec3& normal, float max_radius, Color* irradiance) const;
 
     bool empty() const { return tree_.empty(); }
     size_t size() const { return tree_.size(); }

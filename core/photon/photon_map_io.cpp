@@ -27,7 +27,7 @@ constexpr size_t kChecksumSize = 32;
 
 // Fires when PhotonTracingStatistics gains a field: add it to the layout (and bump
 // kPhotonMapFormatVersion).
-static_assert(sizeof(PhotonTracingStatistics) == 72,
+static_assert(sizeof(PhotonTracingStatistics) == 88,
               "PhotonTracingStatistics changed: store the new field in photon_map_io");
 
 std::string system_message(int error_number) {
@@ -59,8 +59,7 @@ private:
 void put_map(ByteWriter& out, const std::shared_ptr<const PhotonMap>& map) {
     out.put_u8(map ? 1 : 0);
     out.put_u64(map ? map->emitted() : 0);
-    const std::span<const Photon> photons =
-        map ? map->tree().photons() : std::span<const Photon>();
+    const std::span<const Photon> photons = map ? map->tree().photons() : std::span<const Photon>();
     out.put_u64(photons.size());
     out.put_bytes(photons.data(), photons.size_bytes());
 }
@@ -80,8 +79,8 @@ public:
         if (!error_.empty()) return false;
         if (size > remaining()) {
             error_ = "truncated photon-map data: " + std::string(field) + " at byte " +
-                     std::to_string(position_) + " needs " + std::to_string(size) +
-                     " bytes, " + std::to_string(remaining()) + " remain";
+                     std::to_string(position_) + " needs " + std::to_string(size) + " bytes, " +
+                     std::to_string(remaining()) + " remain";
             return false;
         }
         if (size > 0) std::memcpy(data, bytes_.data() + position_, size);
@@ -105,8 +104,9 @@ public:
     bool get_flag(bool& value, const char* field) {
         uint8_t byte = 0;
         if (!get_u8(byte, field)) return false;
-        if (byte > 1) return fail(std::string(field) + " is " + std::to_string(byte) +
-                                  " (must be 0 or 1)");
+        if (byte > 1) {
+            return fail(std::string(field) + " is " + std::to_string(byte) + " (must be 0 or 1)");
+        }
         value = byte == 1;
         return true;
     }
@@ -130,7 +130,8 @@ struct Header {
 // Reads and checks the fixed header before the key: magic, version, byte order, photon size.
 bool read_header(ByteReader& in, Header& header) {
     std::array<uint8_t, 8> magic;
-    if (!in.get_bytes(magic.data(), magic.size(), "magic") || magic != kMagic) {
+    if (in.remaining() < magic.size() || !in.get_bytes(magic.data(), magic.size(), "magic") ||
+        magic != kMagic) {
         return in.fail("not a photon-map file (no \"PHOTONMP\" magic)");
     }
     if (!in.get_u32(header.version, "format version")) return false;
@@ -167,19 +168,22 @@ bool read_key(ByteReader& in, std::string& key) {
 }
 
 bool read_statistics(ByteReader& in, PhotonTracingStatistics& s) {
-    uint64_t tracing_bits = 0, build_bits = 0;
+    uint64_t tracing_bits = 0, build_bits = 0, irradiance_bits = 0;
     const bool ok = in.get_u64(s.emitted, "statistics.emitted") &&
                     in.get_u64(s.emitted_global, "statistics.emitted_global") &&
                     in.get_u64(s.emitted_caustic, "statistics.emitted_caustic") &&
                     in.get_u64(s.stored_global, "statistics.stored_global") &&
                     in.get_u64(s.stored_caustic, "statistics.stored_caustic") &&
                     in.get_u64(s.rays, "statistics.rays") &&
+                    in.get_u64(s.irradiance_photons, "statistics.irradiance_photons") &&
                     in.get_u64(tracing_bits, "statistics.tracing_seconds") &&
                     in.get_u64(build_bits, "statistics.build_seconds") &&
+                    in.get_u64(irradiance_bits, "statistics.irradiance_seconds") &&
                     in.get_flag(s.global_complete, "statistics.global_complete") &&
                     in.get_flag(s.caustic_complete, "statistics.caustic_complete");
     s.tracing_seconds = std::bit_cast<double>(tracing_bits);
     s.build_seconds = std::bit_cast<double>(build_bits);
+    s.irradiance_seconds = std::bit_cast<double>(irradiance_bits);
     return ok;
 }
 
@@ -194,8 +198,8 @@ bool read_map(ByteReader& in, const char* name, std::shared_ptr<const PhotonMap>
     }
     if (!present) {
         if (emitted != 0 || count != 0) {
-            return in.fail(prefix + "absent but with " + std::to_string(count) +
-                           " photons and " + std::to_string(emitted) + " emitted");
+            return in.fail(prefix + "absent but with " + std::to_string(count) + " photons and " +
+                           std::to_string(emitted) + " emitted");
         }
         map.reset();
         return true;
@@ -239,7 +243,7 @@ Expected<PhotonMaps> deserialize_checked(std::span<const uint8_t> bytes,
     }
     PhotonMaps maps;
     if (!read_statistics(in, maps.statistics) || !read_map(in, "global", maps.global) ||
-        !read_map(in, "caustic", maps.caustic)) {
+        !read_map(in, "caustic", maps.caustic) || !read_map(in, "irradiance", maps.irradiance)) {
         return Error{in.error()};
     }
     if (in.remaining() != 0) {
@@ -265,7 +269,11 @@ std::filesystem::path temporary_path(const std::filesystem::path& path) {
 
 Status write_all(const std::filesystem::path& path, std::span<const uint8_t> bytes) {
     const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-    if (fd < 0) return Error{path.string() + ": cannot create: " + system_message(errno)};
+    if (fd < 0) {
+        const int error_number = errno;
+        return Error{"cannot create the temporary file " + path.filename().string() + ": " +
+                     system_message(error_number)};
+    }
     size_t written = 0;
     while (written < bytes.size()) {
         const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
@@ -273,12 +281,15 @@ Status write_all(const std::filesystem::path& path, std::span<const uint8_t> byt
             if (errno == EINTR) continue;
             const int error_number = errno;
             ::close(fd);
-            return Error{path.string() + ": cannot write: " + system_message(error_number)};
+            return Error{"cannot write " + path.filename().string() + ": " +
+                         system_message(error_number)};
         }
         written += size_t(n);
     }
     if (::close(fd) != 0) {
-        return Error{path.string() + ": cannot write: " + system_message(errno)};
+        const int error_number = errno;
+        return Error{"cannot write " + path.filename().string() + ": " +
+                     system_message(error_number)};
     }
     return Status::ok();
 }
@@ -326,8 +337,9 @@ Expected<std::vector<uint8_t>> serialize_photon_maps(const PhotonMaps& maps,
     try {
         ByteWriter out;
         const size_t photons = (maps.global ? maps.global->size() : 0) +
-                               (maps.caustic ? maps.caustic->size() : 0);
-        out.reserve(160 + key.size() + photons * sizeof(Photon));
+                               (maps.caustic ? maps.caustic->size() : 0) +
+                               (maps.irradiance ? maps.irradiance->size() : 0);
+        out.reserve(256 + key.size() + photons * sizeof(Photon));
         out.put_bytes(kMagic.data(), kMagic.size());
         out.put_u32(kPhotonMapFormatVersion);
         out.put_bytes(&kByteOrderMarker, sizeof(kByteOrderMarker));  // in this machine's order
@@ -341,12 +353,15 @@ Expected<std::vector<uint8_t>> serialize_photon_maps(const PhotonMaps& maps,
         out.put_u64(s.stored_global);
         out.put_u64(s.stored_caustic);
         out.put_u64(s.rays);
+        out.put_u64(s.irradiance_photons);
         out.put_u64(std::bit_cast<uint64_t>(s.tracing_seconds));
         out.put_u64(std::bit_cast<uint64_t>(s.build_seconds));
+        out.put_u64(std::bit_cast<uint64_t>(s.irradiance_seconds));
         out.put_u8(s.global_complete ? 1 : 0);
         out.put_u8(s.caustic_complete ? 1 : 0);
         put_map(out, maps.global);
         put_map(out, maps.caustic);
+        put_map(out, maps.irradiance);
         const Sha256Digest checksum = sha256(out.bytes());
         out.put_bytes(checksum.data(), checksum.size());
         return std::move(out.bytes());
@@ -372,7 +387,7 @@ Status write_photon_maps_file(const std::filesystem::path& path, const PhotonMap
     if (Status written = write_all(temporary, *bytes); !written) {
         std::error_code ignored;
         std::filesystem::remove(temporary, ignored);
-        return written;
+        return Error{path.string() + ": " + written.error().message};
     }
     // rename(2) replaces path atomically: a reader opens either the old file or the new one.
     std::error_code error;

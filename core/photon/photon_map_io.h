@@ -10,11 +10,12 @@
 //   sizeof(Photon)                           u32 (20)
 //   key length, key bytes                    u32, then that many bytes (at most kMaxPhotonMapKey)
 //   statistics                               PhotonTracingStatistics: emitted, emitted_global,
-//                                            emitted_caustic, stored_global, stored_caustic, rays
-//                                            (u64 each), tracing_seconds, build_seconds (IEEE
-//                                            binary64 bits, u64 each), global_complete,
-//                                            caustic_complete (u8 each, 0 or 1)
-//   global map, then caustic map, each:      present u8 (0 or 1), emitted u64, photon count u64
+//                                            emitted_caustic, stored_global, stored_caustic, rays,
+//                                            irradiance_photons (u64 each), tracing_seconds,
+//                                            build_seconds, irradiance_seconds (IEEE binary64
+//                                            bits, u64 each), global_complete, caustic_complete
+//                                            (u8 each, 0 or 1)
+//   global, caustic, irradiance map, each:   present u8 (0 or 1), emitted u64, photon count u64
 //                                            (both 0 when absent), photons in tree order
 //   SHA-256 of every byte before it          32 bytes
 //

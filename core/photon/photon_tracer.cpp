@@ -15,12 +15,14 @@ using Clock = std::chrono::steady_clock;
 constexpr uint64_t kPhotonStreamTag = 0x70686f746f6e73ull;  // separates photon streams from pixels
 constexpr uint32_t kChunkSize = 1024;                       // photons per parallel task
 constexpr uint64_t kEmptyMapTrial = 1u << 20;               // emissions before an empty map is given up
+constexpr float kIrradianceRadiusShare = 0.2f;             // irradiance estimate radius cap / scene radius
 
 /// A stored photon before its map is complete: full-precision flux, scaled once at the end by
 /// 1 / (photons emitted for its map), then packed.
 struct TracedPhoton {
     Vec3 position;
     Vec3 direction;
+    Vec3 normal;  // shading normal on the side the photon arrived from
     Color flux;
     uint32_t path;  // emission index within the batch, to cut the map at the photon that fills it
     uint8_t flags;
@@ -85,7 +87,8 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
             const bool caustic_path = specular_bounces > 0 && !diffuse_seen;
             const uint8_t flags = static_cast<uint8_t>((bounce == 0 ? photon_flags::kDirect : 0) |
                                                        (caustic_path ? photon_flags::kCaustic : 0));
-            const TracedPhoton photon{si.p, ray.direction, flux, path_in_batch, flags};
+            const Vec3 normal = glm::dot(si.shading_normal, wo) >= 0.0f ? si.shading_normal : -si.shading_normal;
+            const TracedPhoton photon{si.p, ray.direction, normal, flux, path_in_batch, flags};
             if (want_global) out.global.push_back(photon);
             if (want_caustic && caustic_path) out.caustic.push_back(photon);
         }
@@ -110,6 +113,20 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
     }
 }
 
+/// Irradiance at every stride-th global photon (in photon order), estimated from the global map,
+/// packed as photons whose flux is the irradiance and whose direction is the surface normal.
+std::shared_ptr<const PhotonMap> precompute_irradiance(const PhotonMap& global, const std::vector<TracedPhoton>& traced,
+                                                       const PhotonTracingSettings& settings, float max_radius) {
+    const size_t count = (traced.size() + settings.irradiance_stride - 1) / settings.irradiance_stride;
+    std::vector<Photon> points(count);
+    tbb::parallel_for(size_t(0), count, [&](size_t i) {
+        const TracedPhoton& t = traced[i * settings.irradiance_stride];
+        const Color e = global.estimate_irradiance(t.position, t.normal, settings.k_irradiance, max_radius);
+        points[i] = make_photon(t.position, t.normal, e);
+    });
+    return std::make_shared<const PhotonMap>(std::move(points), 0);
+}
+
 std::shared_ptr<const PhotonMap> finish_map(MapBuilder& builder) {
     std::vector<Photon> packed;
     packed.reserve(builder.photons.size());
@@ -117,7 +134,6 @@ std::shared_ptr<const PhotonMap> finish_map(MapBuilder& builder) {
     for (const TracedPhoton& p : builder.photons) {
         packed.push_back(make_photon(p.position, p.direction, Color(DVec3(p.flux) * scale), p.flags));
     }
-    builder.photons = {};
     return std::make_shared<const PhotonMap>(std::move(packed), builder.emitted);
 }
 
@@ -213,6 +229,13 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
                              [&] { if (caustic.target > 0) maps.caustic = finish_map(caustic); });
     });
     stats.build_seconds = std::chrono::duration<double>(Clock::now() - build_start).count();
+    if (maps.global && settings.irradiance_stride > 0) {
+        const Clock::time_point irradiance_start = Clock::now();
+        const float max_radius = kIrradianceRadiusShare * rs.scene->bounds.radius();
+        arena.execute([&] { maps.irradiance = precompute_irradiance(*maps.global, global.photons, settings, max_radius); });
+        stats.irradiance_photons = maps.irradiance->size();
+        stats.irradiance_seconds = std::chrono::duration<double>(Clock::now() - irradiance_start).count();
+    }
     return maps;
 }
 

@@ -28,6 +28,10 @@ struct PhotonTracingSettings {
     /// with a message if a map received no photon at all by then (lights facing away, black
     /// scene). Maps that are partly filled are kept with what they have.
     uint32_t max_emitted_per_stored = 1000;
+    /// Irradiance is precomputed at every n-th global photon (0: none), with k_irradiance
+    /// photons per estimate, for fast lookups at final-gather hits (Christensen 1999).
+    uint32_t irradiance_stride = 4;
+    uint32_t k_irradiance = 50;
     int threads = 0;                    // 0 = every core
     const std::atomic<bool>* cancel = nullptr;
 };
@@ -41,18 +45,23 @@ struct PhotonTracingStatistics {
     uint64_t rays = 0;
     double tracing_seconds = 0.0;
     double build_seconds = 0.0;      // kd-trees
+    double irradiance_seconds = 0.0; // precomputed irradiance
+    uint64_t irradiance_photons = 0;
     bool global_complete = true;     // false: the emission cap stopped it short
     bool caustic_complete = true;
 };
 
-/// Both maps of a scene; a map not asked for is null.
+/// Both maps of a scene; a map not asked for is null. `irradiance` holds precomputed irradiance
+/// at a subset of the global photons (photon flux = irradiance, direction = surface normal).
 struct PhotonMaps {
     std::shared_ptr<const PhotonMap> global;
     std::shared_ptr<const PhotonMap> caustic;
+    std::shared_ptr<const PhotonMap> irradiance;
     PhotonTracingStatistics statistics;
 
     size_t bytes() const {
-        return (global ? global->bytes() : 0) + (caustic ? caustic->bytes() : 0);
+        return (global ? global->bytes() : 0) + (caustic ? caustic->bytes() : 0) +
+               (irradiance ? irradiance->bytes() : 0);
     }
 };
 

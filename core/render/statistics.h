@@ -38,6 +38,19 @@ struct RenderStatistics {
     std::string photon_cache;
     std::string photon_map_key;
 
+    /// The irradiance cache, when final gathering used one.
+    struct IrradianceCacheFigures {
+        uint64_t records = 0;
+        int waves = 0;
+        uint64_t lookups = 0;  // render pass
+        uint64_t misses = 0;   // lookups no record covered (gathered on the spot)
+        double seconds = 0.0;  // the prepass that placed the records
+        double interpolated_share() const {
+            return lookups > 0 ? 1.0 - static_cast<double>(misses) / static_cast<double>(lookups) : 0.0;
+        }
+    };
+    std::optional<IrradianceCacheFigures> irradiance_cache;
+
     double rays_per_second() const {
         return render_seconds > 0.0 ? static_cast<double>(rays + shadow_rays) / render_seconds : 0.0;
     }

@@ -17,7 +17,7 @@ static_assert(sizeof(Texture) == 8 + sizeof(std::vector<Color>),
               "Texture changed: hash the new field in scene_content_hash");
 static_assert(sizeof(Scene) == sizeof(std::string) + 9 * sizeof(std::vector<int>) + sizeof(Bounds3),
               "Scene changed: hash the new field in scene_content_hash");
-static_assert(sizeof(void*) != 8 || sizeof(PhotonTracingSettings) == 40,
+static_assert(sizeof(void*) != 8 || sizeof(PhotonTracingSettings) == 48,
               "PhotonTracingSettings changed: add the new field to photon_map_key if the maps "
               "depend on it");
 
@@ -98,6 +98,8 @@ std::string photon_map_key(const Scene& scene, const PhotonTracingSettings& sett
     hasher.update_value(uint64_t(settings.seed));
     hasher.update_value(int32_t(settings.max_bounces));
     hasher.update_value(uint32_t(settings.max_emitted_per_stored));
+    hasher.update_value(uint32_t(settings.irradiance_stride));
+    hasher.update_value(uint32_t(settings.k_irradiance));
     return "pm1-" + Sha256::hex(hasher.finish());
 }
 

@@ -26,8 +26,9 @@ Sha256Digest scene_content_hash(const Scene& scene);
 
 /// The cache key of the photon maps trace_photons builds for (scene, settings):
 /// "pm1-" + 64 hex digits, from scene_content_hash, global_photons, caustic_photons, seed,
-/// max_bounces, max_emitted_per_stored and kPhotonMapAlgorithmVersion. threads and cancel are not
-/// part of it (the maps do not depend on them).
+/// max_bounces, max_emitted_per_stored, irradiance_stride, k_irradiance and
+/// kPhotonMapAlgorithmVersion. threads and cancel are not part of it (the maps do not depend on
+/// them).
 std::string photon_map_key(const Scene& scene, const PhotonTracingSettings& settings);
 
 }  // namespace photond

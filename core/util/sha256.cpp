@@ -57,7 +57,8 @@ Sha256Digest Sha256::finish() {
     flush();
     Sha256Digest digest{};
     unsigned int length = 0;
-    if (EVP_DigestFinal_ex(context_.get(), digest.data(), &length) != 1 || length != digest.size()) {
+    if (EVP_DigestFinal_ex(context_.get(), digest.data(), &length) != 1 ||
+        length != digest.size()) {
         throw std::runtime_error("SHA-256: OpenSSL could not finish the digest");
     }
     restart();

@@ -1,0 +1,161 @@
+#include "core/integrators/final_gather.h"
+
+#include <limits>
+#include <vector>
+
+#include "core/integrators/direct.h"
+
+namespace photond {
+
+GatherGrid GatherGrid::for_rays(uint32_t rays) {
+    // N ~ pi M (Ward): M = sqrt(rays / pi), N = rays / M.
+    GatherGrid g;
+    g.m = std::max(1, static_cast<int>(std::lround(std::sqrt(static_cast<double>(rays) / 3.14159265358979))));
+    g.n = std::max(1, static_cast<int>(std::lround(static_cast<double>(rays) / g.m)));
+    return g;
+}
+
+FinalGatherer::FinalGatherer(std::shared_ptr<const RenderScene> scene, std::shared_ptr<const PhotonMaps> maps,
+                             const GatherSettings& settings)
+    : scene_(std::move(scene)), maps_(std::move(maps)), settings_(settings),
+      grid_(GatherGrid::for_rays(settings.rays)) {
+    if (settings_.max_radius <= 0.0f) settings_.max_radius = 0.2f * scene_->scene->bounds.radius();
+}
+
+namespace {
+
+/// Radiance leaving a non-delta surface towards wo, from the photon maps: precomputed
+/// irradiance times rho / pi where the surface is Lambertian, else the global map's estimate.
+Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si, const Bsdf& bsdf,
+                            const Vec3& wo, const GatherSettings& settings) {
+    if (!maps.global) return Color(0.0f);
+    const Vec3 n = glm::dot(si.shading_normal, wo) >= 0.0f ? si.shading_normal : -si.shading_normal;
+    if (maps.irradiance && !bsdf.has_non_lambertian_non_delta()) {
+        Color e;
+        if (maps.irradiance->nearest_irradiance(si.p, n, settings.max_radius, &e))
+            return bsdf.diffuse_reflectance(wo) * kInvPi * e;
+    }
+    RadianceEstimateOptions options;
+    options.k = settings.k_global;
+    options.max_radius = settings.max_radius;
+    return maps.global->estimate_radiance(si.p, n, bsdf, wo, options);
+}
+
+}  // namespace
+
+Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& counters, float* distance) const {
+    const RenderScene& rs = *scene_;
+    // Walk through ideal specular surfaces; `depth` counts them.
+    struct Walker {
+        const FinalGatherer& g;
+        const RenderScene& rs;
+        Rng& rng;
+        RayCounters& counters;
+        Color along(const Ray& r, int depth, float* first_distance) const {
+            const std::optional<Hit> hit = trace_ray(rs, r, counters);
+            if (first_distance) *first_distance = hit ? hit->t : std::numeric_limits<float>::infinity();
+            if (!hit) return Color(0.0f);
+            const SurfaceInteraction si = make_interaction(*rs.scene, *hit, r.direction);
+            const Vec3 wo = -r.direction;
+            const Bsdf bsdf = make_bsdf(*rs.scene, si, wo);
+            Color radiance(0.0f);
+            if (bsdf.has_non_delta()) radiance += radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_);
+            if (bsdf.has_delta() && depth < g.settings_.max_specular_depth) {
+                // One lobe per gather ray is enough: the gather averages many rays.
+                radiance += follow_delta_lobes(bsdf, wo, false, rng, [&](const BsdfSample& s) {
+                    return along(spawn_ray(rs, si, s.wi), depth + 1, nullptr);
+                });
+            }
+            return radiance;
+        }
+    };
+    return Walker{*this, rs, rng, counters}.along(ray, 0, distance);
+}
+
+GatherResult FinalGatherer::gather(const Vec3& p, const Vec3& n, const Vec3& geometric_normal, Rng& rng,
+                                   RayCounters& counters, bool compute_gradients) const {
+    const RenderScene& rs = *scene_;
+    const int m = grid_.m, cells_n = grid_.n;
+    const Frame frame(n);
+    thread_local std::vector<Color> radiance;
+    thread_local std::vector<float> distance;
+    radiance.assign(static_cast<size_t>(m * cells_n), Color(0.0f));
+    distance.assign(static_cast<size_t>(m * cells_n), std::numeric_limits<float>::infinity());
+    const auto cell = [cells_n](int j, int k) { return static_cast<size_t>(j * cells_n + k); };
+
+    GatherResult result;
+    DVec3 sum(0.0);
+    double inverse_distance_sum = 0.0;
+    for (int j = 0; j < m; ++j) {
+        for (int k = 0; k < cells_n; ++k) {
+            const Vec2 u = rng.next_vec2();
+            const float sin2 = (static_cast<float>(j) + u.x) / static_cast<float>(m);
+            const float sin_theta = std::sqrt(sin2), cos_theta = safe_sqrt(1.0f - sin2);
+            const float phi = 2.0f * kPi * (static_cast<float>(k) + u.y) / static_cast<float>(cells_n);
+            const Vec3 direction = frame.to_world({sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta});
+            // Directions under the geometric surface (tilted shading normals) see nothing.
+            if (glm::dot(direction, geometric_normal) <= 0.0f) continue;
+            float d = 0.0f;
+            const Color L = gather_ray_radiance(Ray{rs.tracer->offset_origin(p, geometric_normal, direction), direction},
+                                                rng, counters, &d);
+            radiance[cell(j, k)] = L;
+            distance[cell(j, k)] = d;
+            sum += DVec3(L);
+            if (std::isfinite(d) && d > 0.0f) inverse_distance_sum += 1.0 / d;
+            ++result.rays;
+        }
+    }
+    const double cells = static_cast<double>(m) * cells_n;
+    result.irradiance = Color(sum * (3.14159265358979323846 / cells));
+    result.harmonic_mean_distance = inverse_distance_sum > 0.0 ? static_cast<float>(cells / inverse_distance_sum)
+                                                               : std::numeric_limits<float>::infinity();
+    if (!compute_gradients) return result;
+
+    // Rotation gradient (Ward & Heckbert 1992): pi / (M N) sum_k v_k sum_j -tan(theta_j) L_jk, with
+    // theta_j at the row's centre so that tan stays bounded next to the horizon.
+    // Translation gradient: the change of the cosine-weighted solid angle each cell wall sweeps
+    // when the point moves, times the radiance difference across the wall, the wall at the
+    // nearer of its two cells' hit distances (Ward & Heckbert 1992, section 3.2).
+    std::array<DVec3, 3> rotation{}, translation{};
+    const float cell_phi = 2.0f * kPi / static_cast<float>(cells_n);
+    for (int k = 0; k < cells_n; ++k) {
+        const float phi_centre = (static_cast<float>(k) + 0.5f) * cell_phi;
+        const float phi_wall = static_cast<float>(k) * cell_phi;  // between cells k - 1 and k
+        const Vec3 u_k = frame.to_world({std::cos(phi_centre), std::sin(phi_centre), 0.0f});
+        const Vec3 v_k = frame.to_world({-std::sin(phi_centre), std::cos(phi_centre), 0.0f});
+        const Vec3 v_wall = frame.to_world({-std::sin(phi_wall), std::cos(phi_wall), 0.0f});
+        const int k_prev = (k + cells_n - 1) % cells_n;
+        DVec3 rotation_row(0.0);
+        for (int j = 0; j < m; ++j) {
+            const double theta_centre = std::asin(std::sqrt((j + 0.5) / m));
+            rotation_row -= std::tan(theta_centre) * DVec3(radiance[cell(j, k)]);
+            // Wall between rows j - 1 and j at theta_minus: sin cos^2 (2 pi / N) / r.
+            if (j > 0) {
+                const double sin_minus = std::sqrt(static_cast<double>(j) / m);
+                const double cos2_minus = 1.0 - sin_minus * sin_minus;
+                const double r = std::min(distance[cell(j, k)], distance[cell(j - 1, k)]);
+                if (std::isfinite(r) && r > 0.0) {
+                    const double coefficient = cell_phi * sin_minus * cos2_minus / r;
+                    const DVec3 difference = DVec3(radiance[cell(j, k)]) - DVec3(radiance[cell(j - 1, k)]);
+                    for (int c = 0; c < 3; ++c) translation[c] += DVec3(u_k) * (coefficient * difference[c]);
+                }
+            }
+            // Wall between columns k - 1 and k over row j: (sin theta+ - sin theta-) / r.
+            const double r = std::min(distance[cell(j, k)], distance[cell(j, k_prev)]);
+            if (cells_n > 1 && std::isfinite(r) && r > 0.0) {
+                const double coefficient = (std::sqrt((j + 1.0) / m) - std::sqrt(static_cast<double>(j) / m)) / r;
+                const DVec3 difference = DVec3(radiance[cell(j, k)]) - DVec3(radiance[cell(j, k_prev)]);
+                for (int c = 0; c < 3; ++c) translation[c] += DVec3(v_wall) * (coefficient * difference[c]);
+            }
+        }
+        for (int c = 0; c < 3; ++c) rotation[c] += DVec3(v_k) * rotation_row[c];
+    }
+    const double scale = 3.14159265358979323846 / cells;
+    for (int c = 0; c < 3; ++c) {
+        result.rotation_gradient[c] = Vec3(rotation[c] * scale);
+        result.translation_gradient[c] = Vec3(translation[c]);
+    }
+    return result;
+}
+
+}  // namespace photond

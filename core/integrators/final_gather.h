@@ -1,0 +1,68 @@
+// Final gathering (ALGORITHMS.md section 4 and 5): indirect irradiance at a surface point by
+// stratified, cosine-weighted hemisphere sampling in M x N cells,
+//   theta_j = asin(sqrt((j + X) / M)),  phi_k = 2 pi (k + Y) / N,  E = pi / (M N) sum L_jk,
+// with the radiance L_jk at each gather ray's hit read from the photon maps. The same samples
+// give the record's harmonic mean distance and the irradiance gradients (Ward & Heckbert 1992),
+// at no extra rays.
+//
+// Gather rays add no emitted light, and pass through ideal specular surfaces (up to a depth)
+// without counting emitters behind them either: light arriving through specular surfaces straight
+// from an emitter is the caustic map's share, so nothing is counted twice.
+#pragma once
+
+#include <array>
+
+#include "core/integrators/integrator.h"
+#include "core/photon/photon_tracer.h"
+
+namespace photond {
+
+struct GatherSettings {
+    uint32_t rays = 512;         // M x N, N ~ pi M
+    int max_specular_depth = 4;  // ideal specular surfaces a gather ray may pass through
+    uint32_t k_global = 50;      // photons per radiance estimate where no precomputed irradiance fits
+    float max_radius = 0.0f;     // estimate radius cap (world units)
+};
+
+/// Cosine-weighted irradiance and what an irradiance cache record needs.
+struct GatherResult {
+    Color irradiance{0.0f};
+    /// Harmonic mean of the gather rays' hit distances (infinity when every ray escaped).
+    float harmonic_mean_distance = 0.0f;
+    /// Gradients per colour channel: rotation (Ward & Heckbert 1992) and translation.
+    std::array<Vec3, 3> rotation_gradient{};
+    std::array<Vec3, 3> translation_gradient{};
+    uint32_t rays = 0;
+};
+
+/// The stratification of a gather: M rows in theta and N columns in phi, N ~ pi M.
+struct GatherGrid {
+    int m = 1;
+    int n = 1;
+    static GatherGrid for_rays(uint32_t rays);
+};
+
+class FinalGatherer {
+public:
+    FinalGatherer(std::shared_ptr<const RenderScene> scene, std::shared_ptr<const PhotonMaps> maps,
+                  const GatherSettings& settings);
+
+    /// Gathers at point p with unit normal n (the side light is gathered from), frame around n.
+    /// `compute_gradients` adds the rotation and translation gradients.
+    GatherResult gather(const Vec3& p, const Vec3& n, const Vec3& geometric_normal, Rng& rng,
+                        RayCounters& counters, bool compute_gradients) const;
+
+    /// Radiance leaving the first non-specular surface along a ray, from the photon maps (no
+    /// emission); writes the hit distance (infinity on a miss).
+    Color gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& counters, float* distance) const;
+
+    const GatherSettings& settings() const { return settings_; }
+
+private:
+    std::shared_ptr<const RenderScene> scene_;
+    std::shared_ptr<const PhotonMaps> maps_;
+    GatherSettings settings_;
+    GatherGrid grid_;
+};
+
+}  // namespace photond

@@ -1,0 +1,82 @@
+// The irradiance cache (Ward, Rubinstein & Clear 1988; gradients Ward & Heckbert 1992; neighbour
+// clamping Krivanek et al. 2006; pixel-space radius limits Tabellion & Lamorlette 2004).
+//
+// Records hold indirect irradiance E_i at P_i with normal N_i and radius R_i (harmonic mean of the
+// gather distances, clamped). At a point P with normal N, record i is usable when
+//   eps_i(P) = |P - P_i| / R_i + sqrt(1 - N . N_i) < a
+// and is not in front of P. Interpolation with gradients (ALGORITHMS.md section 5):
+//   E(P) = sum w_i [E_i + (N_i x N) . grad_r E_i + (P - P_i) . grad_t E_i] / sum w_i,
+// with Ward's weight shifted to vanish at the validity boundary, w_i = 1/eps_i - 1/a (it keeps
+// Ward's threshold w > 1/a, and the interpolated field stays continuous where a record's domain
+// ends, which removes the seams Ward's plain weight leaves).
+//
+// Storage: an octree; a record lives in the deepest node whose half size is at least its
+// validity radius a R_i, so a lookup visits only nodes whose box, grown by half its size,
+// contains P.
+//
+// Thread safety: the cache has two phases that never overlap. Reading (interpolate, covers) is
+// const and may run on any number of threads at once with no lock. Writing (insert) is done by
+// one thread while nobody reads. IrradianceCacheBuilder alternates them in waves, merging each
+// wave's new records in a fixed order, which is why the cache, and the image, are the same for
+// any thread count and tile order.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/math/vec.h"
+#include "core/scene/scene.h"
+
+namespace photond {
+
+struct IrradianceRecord {
+    Vec3 position{0.0f};
+    Vec3 normal{0.0f, 0.0f, 1.0f};
+    float radius = 0.0f;  // R_i
+    Color irradiance{0.0f};
+    std::array<Vec3, 3> rotation_gradient{};     // per colour channel
+    std::array<Vec3, 3> translation_gradient{};  // per colour channel
+};
+
+struct IrradianceCacheSettings {
+    float accuracy = 0.15f;  // a
+    bool gradients = true;
+};
+
+class IrradianceCache {
+public:
+    IrradianceCache(const Bounds3& scene_bounds, const IrradianceCacheSettings& settings);
+
+    /// Interpolated irradiance at p (normal n, unit); false when no record is usable there.
+    /// `accuracy_scale` > 1 widens every record's domain (extrapolation, for points the
+    /// prepass did not reach, e.g. sub-pixel positions at the edge of a record's domain).
+    bool interpolate(const Vec3& p, const Vec3& n, Color* irradiance, float accuracy_scale = 1.0f) const;
+
+    /// Adds a record. Its radius is first clamped by its neighbours' (R_i <= R_j + |P_i - P_j|,
+    /// and the neighbours' by it), never below `min_radius` (Krivanek et al. 2006).
+    void insert(IrradianceRecord record, float min_radius);
+
+    size_t size() const { return records_.size(); }
+    const std::vector<IrradianceRecord>& records() const { return records_; }
+    const IrradianceCacheSettings& settings() const { return settings_; }
+
+private:
+    struct Node {
+        Vec3 center;
+        float half_size;
+        std::array<int32_t, 8> children;
+        std::vector<uint32_t> records;
+    };
+    /// Calls f(record index) for the records of every node whose records, with their validity
+    /// radius scaled by domain_scale, can reach within `reach` of p.
+    template <typename F>
+    void for_each_candidate(const Vec3& p, float domain_scale, float reach, F&& f) const;
+    int32_t child_for(int32_t node, const Vec3& p);
+
+    IrradianceCacheSettings settings_;
+    std::vector<IrradianceRecord> records_;
+    std::vector<Node> nodes_;
+};
+
+}  // namespace photond

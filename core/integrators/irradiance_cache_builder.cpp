@@ -1,0 +1,130 @@
+#include "core/integrators/irradiance_cache_builder.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <chrono>
+
+#include "core/integrators/direct.h"
+
+namespace photond {
+namespace {
+
+constexpr uint64_t kRecordStreamTag = 0x69727263616368ull;  // separates record streams
+constexpr int kFirstWaveStep = 32;                            // pixels between first-wave candidates
+constexpr int kMaxPointsPerPixel = 8;
+
+/// The Lambertian points a camera ray sees through ideal specular surfaces: every delta lobe
+/// for the first kBranchDepth bounces, then the heaviest one (deterministic, no random numbers).
+void collect_diffuse_points(const RenderScene& rs, const Ray& ray, float path_length, float spread, int depth,
+                            int max_depth, RayCounters& counters, std::vector<DiffusePoint>& out) {
+    if (out.size() >= kMaxPointsPerPixel) return;
+    const std::optional<Hit> hit = trace_ray(rs, ray, counters);
+    if (!hit) return;
+    const SurfaceInteraction si = make_interaction(*rs.scene, *hit, ray.direction);
+    const Vec3 wo = -ray.direction;
+    const Bsdf bsdf = make_bsdf(*rs.scene, si, wo);
+    const float length = path_length + hit->t;
+    if (max_component(bsdf.diffuse_reflectance(wo)) > 0.0f) {
+        const Vec3 n = glm::dot(si.shading_normal, wo) >= 0.0f ? si.shading_normal : -si.shading_normal;
+        const Vec3 ng = glm::dot(si.geometric_normal, wo) >= 0.0f ? si.geometric_normal : -si.geometric_normal;
+        out.push_back({si.p, n, ng, length * spread});
+    }
+    if (!bsdf.has_delta() || depth >= max_depth) return;
+    std::array<BsdfSample, 2> lobes;
+    const int count = bsdf.delta_lobes(wo, lobes);
+    if (count == 0) return;
+    int first = 0, last = count;
+    if (depth >= kBranchDepth && count == 2) {
+        first = average(lobes[1].weight) > average(lobes[0].weight) ? 1 : 0;
+        last = first + 1;
+    }
+    for (int i = first; i < last; ++i) {
+        if (is_black(lobes[i].weight)) continue;
+        collect_diffuse_points(rs, spawn_ray(rs, si, lobes[i].wi), length, spread, depth + 1, max_depth, counters, out);
+    }
+}
+
+}  // namespace
+
+IrradianceRecord make_irradiance_record(const FinalGatherer& gatherer, const DiffusePoint& point,
+                                        const CacheBuildSettings& settings, Rng& rng, RayCounters& counters) {
+    const GatherResult g = gatherer.gather(point.position, point.normal, point.geometric_normal, rng, counters,
+                                           settings.cache.gradients);
+    float min_radius = 0.0f, max_radius = 0.0f;
+    record_radius_limits(settings, point.footprint, &min_radius, &max_radius);
+    IrradianceRecord r;
+    r.position = point.position;
+    r.normal = point.normal;
+    // Tabellion & Lamorlette 2004: the harmonic mean distance, within pixel-space limits.
+    r.radius = std::clamp(g.harmonic_mean_distance, min_radius, max_radius);
+    r.irradiance = g.irradiance;
+    r.rotation_gradient = g.rotation_gradient;
+    r.translation_gradient = g.translation_gradient;
+    return r;
+}
+
+std::unique_ptr<IrradianceCache> build_irradiance_cache(const RenderScene& rs, const FinalGatherer& gatherer,
+                                                        const Camera& camera, const CacheBuildSettings& settings,
+                                                        CacheBuildStatistics* statistics) {
+    const auto start = std::chrono::steady_clock::now();
+    auto cache = std::make_unique<IrradianceCache>(rs.scene->bounds, settings.cache);
+    CacheBuildStatistics stats;
+    const PixelRect frame{0, 0, camera.width(), camera.height()};
+    const PixelRect area = settings.region ? settings.region->intersect(frame) : frame;
+    tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
+
+    struct Candidate {
+        int x, y;
+        std::vector<IrradianceRecord> records;
+        std::vector<float> min_radii;
+        RayCounters counters;
+        uint64_t points = 0;
+    };
+    for (int step = kFirstWaveStep; step >= 1; step /= 2) {
+        if (settings.cancel && settings.cancel->load()) break;
+        // This wave's pixels: multiples of `step` not visited by a coarser wave.
+        std::vector<Candidate> candidates;
+        for (int y = area.y0 - area.y0 % step; y < area.y1; y += step) {
+            for (int x = area.x0 - area.x0 % step; x < area.x1; x += step) {
+                if (x < area.x0 || y < area.y0) continue;
+                const bool visited = step < kFirstWaveStep && x % (2 * step) == 0 && y % (2 * step) == 0;
+                if (!visited) candidates.push_back({x, y, {}, {}, {}, 0});
+            }
+        }
+        arena.execute([&] {
+            tbb::parallel_for(size_t(0), candidates.size(), [&](size_t i) {
+                enable_flush_denormals();
+                Candidate& c = candidates[i];
+                const CameraRay ray = camera.generate_ray(c.x + 0.5f, c.y + 0.5f);
+                std::vector<DiffusePoint> points;
+                collect_diffuse_points(rs, Ray{ray.origin, ray.direction}, 0.0f, pixel_spread(ray), 0,
+                                       settings.max_specular_depth, c.counters, points);
+                c.points = points.size();
+                for (size_t k = 0; k < points.size(); ++k) {
+                    Color unused;
+                    if (cache->interpolate(points[k].position, points[k].normal, &unused)) continue;
+                    const uint64_t pixel = static_cast<uint64_t>(c.y) * camera.width() + c.x;
+                    Rng rng = Rng::for_stream(settings.seed, kRecordStreamTag, pixel, k);
+                    c.records.push_back(make_irradiance_record(gatherer, points[k], settings, rng, c.counters));
+                    float min_radius = 0.0f, max_radius = 0.0f;
+                    record_radius_limits(settings, points[k].footprint, &min_radius, &max_radius);
+                    c.min_radii.push_back(min_radius);
+                }
+            });
+        });
+        // Merge in candidate order: one writer, no readers.
+        for (Candidate& c : candidates) {
+            for (size_t k = 0; k < c.records.size(); ++k) cache->insert(c.records[k], c.min_radii[k]);
+            stats.counters += c.counters;
+            stats.candidates += c.points;
+        }
+        ++stats.waves;
+    }
+    stats.records = cache->size();
+    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (statistics) *statistics = stats;
+    return cache;
+}
+
+}  // namespace photond

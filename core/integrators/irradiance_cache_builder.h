@@ -1,0 +1,60 @@
+// Filling the irradiance cache before the render pass, deterministically, in waves over a
+// coarse-to-fine pixel grid (steps 32, 16, ..., 1 pixels). In each wave every candidate pixel's
+// camera ray finds its visible diffuse points (through ideal specular surfaces) and, where the
+// cache (frozen during the wave) cannot interpolate, gathers a new record; all threads only read
+// the cache. Then one thread inserts the wave's records in pixel order. The records, and so the
+// image, do not depend on the thread count or on tile order; the render pass then mostly reads.
+#pragma once
+
+#include <atomic>
+#include <memory>
+
+#include "core/camera/camera.h"
+#include "core/image/image.h"
+#include "core/integrators/final_gather.h"
+#include "core/integrators/irradiance_cache.h"
+
+namespace photond {
+
+struct CacheBuildSettings {
+    IrradianceCacheSettings cache;
+    float min_spacing_px = 1.5f;  // record spacing a R_i limits, in pixels at the record
+    float max_spacing_px = 24.0f;
+    uint64_t seed = 1;
+    int max_specular_depth = 16;
+    int threads = 0;
+    std::optional<PixelRect> region;
+    const std::atomic<bool>* cancel = nullptr;
+};
+
+struct CacheBuildStatistics {
+    uint64_t records = 0;
+    uint64_t candidates = 0;  // visible points examined
+    int waves = 0;
+    RayCounters counters;
+    double seconds = 0.0;
+};
+
+/// A visible point on a Lambertian surface, where indirect irradiance is asked for.
+struct DiffusePoint {
+    Vec3 position;
+    Vec3 normal;             // shading normal on the viewer's side
+    Vec3 geometric_normal;   // on the viewer's side
+    float footprint;         // width of a pixel there (world units)
+};
+
+/// Radius limits from the pixel spacing limits at a point: a R_i in [min, max] pixels.
+inline void record_radius_limits(const CacheBuildSettings& s, float footprint, float* min_radius, float* max_radius) {
+    *min_radius = s.min_spacing_px * footprint / s.cache.accuracy;
+    *max_radius = s.max_spacing_px * footprint / s.cache.accuracy;
+}
+
+/// Gathers a new record at a point, its radius clamped to the pixel limits.
+IrradianceRecord make_irradiance_record(const FinalGatherer& gatherer, const DiffusePoint& point,
+                                        const CacheBuildSettings& settings, Rng& rng, RayCounters& counters);
+
+std::unique_ptr<IrradianceCache> build_irradiance_cache(const RenderScene& scene, const FinalGatherer& gatherer,
+                                                        const Camera& camera, const CacheBuildSettings& settings,
+                                                        CacheBuildStatistics* statistics);
+
+}  // namespace photond

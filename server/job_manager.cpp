@@ -1,0 +1,739 @@
+#include "server/job_manager.h"
+
+#include <algorithm>
+#include <cmath>
+#include <ctime>
+#include <random>
+#include <system_error>
+
+#include "core/image/exr_io.h"
+#include "core/image/png_preview.h"
+#include "core/render/tile_renderer.h"
+#include "core/scene/builtin_scenes.h"
+#include "core/util/sha256.h"
+#include "protocol/statistics.h"
+#include "server/atomic_file.h"
+#include "server/render_pipeline.h"
+#include "server/service_error.h"
+
+namespace photond::service {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using protocol::JobEventType;
+using protocol::JobState;
+using protocol::TileIndex;
+
+namespace {
+
+int64_t now_ms() {
+    return std::chrono::duration_cast<std::chrono::milliseconds>(
+               std::chrono::system_clock::now().time_since_epoch())
+        .count();
+}
+
+/// "20240612-101530-000042-9f3c2a1b": sortable by time, unique by the sequence number, and not
+/// guessable from another job's id thanks to 32 random bits.
+std::string make_job_id(uint64_t sequence, int64_t created_ms) {
+    const std::time_t seconds = static_cast<std::time_t>(created_ms / 1000);
+    std::tm utc{};
+    gmtime_r(&seconds, &utc);
+    static thread_local std::mt19937_64 random{std::random_device{}()};
+    char buffer[64];
+    std::snprintf(buffer, sizeof buffer, "%04d%02d%02d-%02d%02d%02d-%06llu-%08x", utc.tm_year + 1900,
+                  utc.tm_mon + 1, utc.tm_mday, utc.tm_hour, utc.tm_min, utc.tm_sec,
+                  static_cast<unsigned long long>(sequence % 1000000),
+                  static_cast<unsigned>(random() & 0xffffffffu));
+    return buffer;
+}
+
+/// The rendered area (the region, clipped to the frame, or the whole frame).
+PixelRect rendered_area(const protocol::Job& job) {
+    const PixelRect frame{0, 0, job.image.width, job.image.height};
+    if (!job.image.region) return frame;
+    const auto& r = *job.image.region;
+    return PixelRect{r[0], r[1], r[2], r[3]}.intersect(frame);
+}
+
+json rect_json(const PixelRect& r) { return json::array({r.x0, r.y0, r.x1, r.y1}); }
+
+std::vector<protocol::PlanEntry> plan_of(const RenderStatistics& statistics) {
+    std::vector<protocol::PlanEntry> plan;
+    for (const PassDecision& d : statistics.plan) plan.push_back({d.pass, d.enabled, d.reason});
+    return plan;
+}
+
+}  // namespace
+
+/// One job. The submission fields are constant after construction; everything else is guarded
+/// by JobManager::mutex_.
+struct JobManager::Entry {
+    JobSubmission submission;
+    PixelRect area;
+    int tile_size = 32;
+    int tiles_x = 0;
+    int tiles_y = 0;
+    std::atomic<bool> cancel{false};  // read by the renderer before each tile
+
+    protocol::JobStatus status;
+    std::vector<protocol::JobEvent> events;
+    std::map<TileIndex, std::shared_ptr<const Image>> tiles;  // finished, while rendering
+    std::vector<TileIndex> finished_order;
+    std::shared_ptr<const ImageLayers> image;  // a done job's final image, while in memory
+    bool cancelled_by_user = false;
+    Clock::time_point pass_started;
+    mutable std::condition_variable changed;
+
+    explicit Entry(JobSubmission s) : submission(std::move(s)) {
+        area = rendered_area(submission.job);
+        tile_size = std::max(submission.job.image.tile_size, 1);
+        tiles_x = (area.width() + tile_size - 1) / tile_size;
+        tiles_y = (area.height() + tile_size - 1) / tile_size;
+        status.id = submission.id;
+        status.priority = submission.job.priority;
+        status.created_at_ms = submission.created_at_ms;
+        status.progress.tiles_total = static_cast<uint64_t>(std::max(tiles_x * tiles_y, 0));
+        status.job = submission.job;
+    }
+
+    const std::string& id() const { return submission.id; }
+
+    TileIndex index_of(const PixelRect& rect) const {
+        return {(rect.x0 - area.x0) / tile_size, (rect.y0 - area.y0) / tile_size};
+    }
+
+    std::optional<PixelRect> rect_of(TileIndex t) const {
+        if (t.tx < 0 || t.ty < 0 || t.tx >= tiles_x || t.ty >= tiles_y) return std::nullopt;
+        const int x0 = area.x0 + t.tx * tile_size, y0 = area.y0 + t.ty * tile_size;
+        return PixelRect{x0, y0, std::min(x0 + tile_size, area.x1), std::min(y0 + tile_size, area.y1)};
+    }
+
+    json tile_event(TileIndex t) const {
+        return {{"tx", t.tx},
+                {"ty", t.ty},
+                {"rect", rect_json(*rect_of(t))},
+                {"url", protocol::tile_url(id(), t)},
+                {"tiles_done", status.progress.tiles_done},
+                {"tiles_total", status.progress.tiles_total}};
+    }
+
+    json progress_event() const {
+        json data = {{"tiles_done", status.progress.tiles_done},
+                     {"tiles_total", status.progress.tiles_total},
+                     {"fraction", status.progress.fraction()}};
+        if (!status.pass.empty()) data["pass"] = status.pass;
+        return data;
+    }
+};
+
+JobManager::JobManager(JobManagerOptions options, std::shared_ptr<EmbreeDevice> device,
+                       PhotonMapCache* photon_maps, SceneStore* scenes, Metrics* metrics)
+    : options_(std::move(options)), device_(std::move(device)), photon_maps_(photon_maps),
+      scenes_(scenes), metrics_(metrics), store_(options_.cache_dir / "jobs") {}
+
+JobManager::~JobManager() { shutdown(); }
+
+void JobManager::log(const std::string& line) const {
+    if (options_.log) options_.log(line);
+}
+
+void JobManager::push_event_locked(Entry& entry, JobEventType type, json data) {
+    entry.events.push_back({entry.events.size() + 1, type, std::move(data)});
+}
+
+// ---------------------------------------------------------------------------------------------
+// Start, restore, shutdown
+
+void JobManager::restore(StoredJob stored) {
+    auto entry = std::make_shared<Entry>(std::move(stored.submission));
+    protocol::JobStatus status = std::move(stored.status);
+    status.job = entry->submission.job;
+    status.progress.tiles_total = entry->status.progress.tiles_total;
+    status.pass.clear();
+    bool changed = false;
+    if (status.state == JobState::Running) {
+        status.state = JobState::Failed;
+        status.error = "daemon restarted while the job was running";
+        status.finished_at_ms = now_ms();
+        changed = true;
+    } else if (status.state == JobState::Done && !fs::exists(store_.image_path(entry->id()))) {
+        status.state = JobState::Failed;
+        status.error = "the result image is missing from the cache directory";
+        changed = true;
+    }
+    entry->status = std::move(status);
+    if (changed) (void)store_.save_status(entry->status);
+
+    std::lock_guard lock(mutex_);
+    Entry& e = *entry;
+    // The history of a restored job is rebuilt from its state: a client resuming or starting a
+    // stream sees the same shape of events as during the render (tiles, then the last event).
+    switch (e.status.state) {
+        case JobState::Queued:
+            e.status.progress.tiles_done = 0;
+            push_event_locked(e, JobEventType::State, {{"state", "queued"}});
+            queue_.insert({{-e.submission.job.priority, e.submission.sequence}, e.id()});
+            break;
+        case JobState::Done:
+            e.status.progress.tiles_done = e.status.progress.tiles_total;
+            for (int ty = 0; ty < e.tiles_y; ++ty)
+                for (int tx = 0; tx < e.tiles_x; ++tx) {
+                    e.finished_order.push_back({tx, ty});
+                    push_event_locked(e, JobEventType::Tile, e.tile_event({tx, ty}));
+                }
+            push_event_locked(e, JobEventType::Progress, e.progress_event());
+            push_event_locked(e, JobEventType::State, {{"state", "done"}});
+            push_event_locked(e, JobEventType::Done, protocol::to_json(e.status));
+            break;
+        case JobState::Failed:
+            push_event_locked(e, JobEventType::State, {{"state", "failed"}, {"reason", e.status.error}});
+            push_event_locked(e, JobEventType::Failed, protocol::to_json(e.status));
+            break;
+        case JobState::Cancelled:
+            push_event_locked(e, JobEventType::State, {{"state", "cancelled"}});
+            push_event_locked(e, JobEventType::Cancelled, protocol::to_json(e.status));
+            break;
+        case JobState::Running: break;  // turned into failed above
+    }
+    if (!e.submission.idempotency_key.empty()) idempotency_keys_[e.submission.idempotency_key] = e.id();
+    next_sequence_ = std::max(next_sequence_, e.submission.sequence + 1);
+    jobs_[e.id()] = entry;
+    arrival_order_.push_back(entry);
+}
+
+void JobManager::start() {
+    JobStore::Loaded loaded = store_.load_all();
+    for (const std::string& problem : loaded.problems) log("skipping a stored job: " + problem);
+    size_t requeued = 0;
+    for (StoredJob& stored : loaded.jobs) {
+        if (stored.status.state == JobState::Queued || stored.status.state == JobState::Running) ++requeued;
+        restore(std::move(stored));
+    }
+    if (!loaded.jobs.empty())
+        log("restored " + std::to_string(loaded.jobs.size()) + " job(s) from " +
+            store_.job_directory("").string() + " (" + std::to_string(queue_.size()) + " queued)");
+    worker_running_ = true;
+    worker_ = std::thread([this] { worker_loop(); });
+}
+
+void JobManager::shutdown() {
+    {
+        std::lock_guard lock(mutex_);
+        if (!stopping_.exchange(true)) {
+            if (running_) running_->cancel = true;
+            for (auto& [id, entry] : jobs_) entry->changed.notify_all();
+        }
+    }
+    work_available_.notify_all();
+    if (worker_.joinable()) worker_.join();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Submission and queries
+
+void JobManager::check_scene(const protocol::Job& job) const {
+    const protocol::SceneRef& scene = job.scene;
+    switch (scene.kind) {
+        case protocol::SceneRef::Kind::Builtin: {
+            const auto names = builtin_scene_names();
+            if (std::find(names.begin(), names.end(), scene.value) == names.end()) {
+                auto built = make_builtin_scene(scene.value);  // for its message naming the choices
+                throw ServiceError(ErrorKind::InvalidField,
+                                   built ? "unknown built-in scene '" + scene.value + "'"
+                                         : built.error().message,
+                                   "scene.builtin");
+            }
+            return;
+        }
+        case protocol::SceneRef::Kind::Path: {
+            std::error_code error;
+            const fs::path root = fs::weakly_canonical(options_.scene_root, error);
+            const fs::path file = fs::weakly_canonical(root / scene.value, error);
+            const auto [root_end, file_it] = std::mismatch(root.begin(), root.end(), file.begin(), file.end());
+            if (error || root_end != root.end() || file == root)
+                throw ServiceError(ErrorKind::InvalidField,
+                                   "'" + scene.value + "' lies outside the scene root (--scene-root " +
+                                       options_.scene_root.string() + "); give a path relative to it",
+                                   "scene.path");
+            if (!fs::is_regular_file(file, error))
+                throw ServiceError(ErrorKind::InvalidField,
+                                   "no scene file '" + scene.value + "' below the scene root (" +
+                                       options_.scene_root.string() + ")",
+                                   "scene.path");
+            return;
+        }
+        case protocol::SceneRef::Kind::Id:
+            if (!scenes_->contains(scene.value))
+                throw ServiceError(ErrorKind::InvalidField,
+                                   "no uploaded scene " + scene.value + " (upload it with POST /v1/scenes)",
+                                   "scene.id");
+            return;
+    }
+}
+
+int JobManager::retry_after_seconds_locked() const {
+    // The running job's expected remaining time, from its progress; a guess of 10 s without one.
+    if (running_ && running_->status.started_at_ms > 0) {
+        const double fraction = running_->status.progress.fraction();
+        const double elapsed = static_cast<double>(now_ms() - running_->status.started_at_ms) / 1000.0;
+        if (fraction > 0.0) return static_cast<int>(std::clamp(std::ceil(elapsed * (1.0 - fraction) / fraction), 1.0, 3600.0));
+    }
+    return 10;
+}
+
+JobManager::Submitted JobManager::submit(const protocol::Job& job, const std::string& idempotency_key) {
+    std::lock_guard submit_lock(submit_mutex_);
+    const std::string normalized = protocol::to_json(job).dump();
+    const std::string digest =
+        sha256_hex({reinterpret_cast<const uint8_t*>(normalized.data()), normalized.size()});
+    JobSubmission submission;
+    {
+        std::lock_guard lock(mutex_);
+        if (!idempotency_key.empty()) {
+            if (const auto it = idempotency_keys_.find(idempotency_key); it != idempotency_keys_.end()) {
+                const auto& entry = jobs_.at(it->second);
+                if (entry->submission.request_digest != digest)
+                    throw ServiceError(ErrorKind::Conflict,
+                                       "Idempotency-Key '" + idempotency_key + "' was used for job " +
+                                           entry->id() + " with another job description");
+                return {entry->status, false};
+            }
+        }
+        if (stopping_) throw ServiceError(ErrorKind::Unavailable, "the daemon is shutting down");
+        if (queue_.size() >= options_.max_queued) {
+            const int retry = retry_after_seconds_locked();
+            throw ServiceError(ErrorKind::QueueFull, "the queue holds " + std::to_string(queue_.size()) +
+                                                         " jobs (--max-queued " +
+                                                         std::to_string(options_.max_queued) +
+                                                         "); retry in " + std::to_string(retry) + " s")
+                .with_header("Retry-After", std::to_string(retry));
+        }
+        submission.sequence = next_sequence_++;
+    }
+    check_scene(job);
+    submission.created_at_ms = now_ms();
+    submission.id = make_job_id(submission.sequence, submission.created_at_ms);
+    submission.job = job;
+    submission.idempotency_key = idempotency_key;
+    submission.request_digest = digest;
+    auto entry = std::make_shared<Entry>(submission);
+    // On disk first: a job the client was told about survives a crash right after.
+    if (Status saved = store_.save_submission(submission); !saved)
+        throw ServiceError(ErrorKind::Unavailable, "cannot keep the job: " + saved.error().message);
+    if (Status saved = store_.save_status(entry->status); !saved)
+        throw ServiceError(ErrorKind::Unavailable, "cannot keep the job: " + saved.error().message);
+
+    protocol::JobStatus status;
+    {
+        std::lock_guard lock(mutex_);
+        push_event_locked(*entry, JobEventType::State, {{"state", "queued"}});
+        jobs_[entry->id()] = entry;
+        arrival_order_.push_back(entry);
+        queue_.insert({{-job.priority, submission.sequence}, entry->id()});
+        if (!idempotency_key.empty()) idempotency_keys_[idempotency_key] = entry->id();
+        status = entry->status;
+    }
+    metrics_->record_submitted();
+    work_available_.notify_one();
+    return {status, true};
+}
+
+std::shared_ptr<JobManager::Entry> JobManager::find_locked(const std::string& id) const {
+    const auto it = jobs_.find(id);
+    if (it == jobs_.end()) throw ServiceError(ErrorKind::NotFound, "no job '" + id + "'");
+    return it->second;
+}
+
+protocol::JobStatus JobManager::status(const std::string& id) const {
+    std::lock_guard lock(mutex_);
+    return find_locked(id)->status;
+}
+
+std::vector<protocol::JobStatus> JobManager::list(std::optional<JobState> state, size_t limit) const {
+    std::vector<protocol::JobStatus> result;
+    std::lock_guard lock(mutex_);
+    for (auto it = arrival_order_.rbegin(); it != arrival_order_.rend() && result.size() < limit; ++it) {
+        const protocol::JobStatus& s = (*it)->status;
+        if (state && s.state != *state) continue;
+        result.push_back(s);
+        result.back().statistics.reset();
+    }
+    return result;
+}
+
+protocol::JobStatus JobManager::cancel(const std::string& id, std::chrono::milliseconds wait) {
+    std::unique_lock lock(mutex_);
+    const auto entry = find_locked(id);
+    switch (entry->status.state) {
+        case JobState::Queued: {
+            queue_.erase({{-entry->submission.job.priority, entry->submission.sequence}, id});
+            entry->cancelled_by_user = true;
+            entry->cancel = true;
+            finish_locked(*entry, JobState::Cancelled, "", nullptr);
+            const protocol::JobStatus status = entry->status;
+            lock.unlock();
+            (void)store_.save_status(status);
+            log("job " + id + " cancelled while queued");
+            return status;
+        }
+        case JobState::Running:
+            entry->cancelled_by_user = true;
+            entry->cancel = true;
+            entry->changed.wait_for(lock, wait, [&] { return protocol::is_terminal(entry->status.state); });
+            return entry->status;
+        case JobState::Cancelled:
+            return entry->status;
+        case JobState::Done:
+        case JobState::Failed:
+            throw ServiceError(ErrorKind::Conflict, "job " + id + " is already " +
+                                                        std::string(protocol::to_string(entry->status.state)) +
+                                                        ": there is nothing to cancel");
+    }
+    return entry->status;
+}
+
+protocol::JobStatus JobManager::wait_finished(const std::string& id, std::chrono::milliseconds timeout) const {
+    std::unique_lock lock(mutex_);
+    const auto entry = find_locked(id);
+    entry->changed.wait_for(lock, timeout,
+                            [&] { return stopping_ || protocol::is_terminal(entry->status.state); });
+    return entry->status;
+}
+
+JobManager::EventBatch JobManager::wait_events(const std::string& id, uint64_t after_id,
+                                               std::chrono::milliseconds timeout) const {
+    std::unique_lock lock(mutex_);
+    const auto entry = find_locked(id);
+    const auto has_news = [&] {
+        return stopping_ || entry->events.size() > after_id || protocol::is_terminal(entry->status.state);
+    };
+    entry->changed.wait_for(lock, timeout, has_news);
+    EventBatch batch;
+    for (size_t i = after_id; i < entry->events.size(); ++i) batch.events.push_back(entry->events[i]);
+    batch.ended = stopping_ || protocol::is_terminal(entry->status.state);
+    return batch;
+}
+
+JobManager::TileBatch JobManager::wait_tiles(const std::string& id, size_t from,
+                                             std::chrono::milliseconds timeout) const {
+    std::unique_lock lock(mutex_);
+    const auto entry = find_locked(id);
+    entry->changed.wait_for(lock, timeout, [&] {
+        return stopping_ || entry->finished_order.size() > from || protocol::is_terminal(entry->status.state);
+    });
+    TileBatch batch;
+    for (size_t i = from; i < entry->finished_order.size(); ++i) batch.tiles.push_back(entry->finished_order[i]);
+    batch.next = std::max(from, entry->finished_order.size());
+    batch.ended = stopping_ || protocol::is_terminal(entry->status.state);
+    return batch;
+}
+
+std::optional<JobManager::TileGeometry> JobManager::tile_geometry(const std::string& id, TileIndex tile) const {
+    std::lock_guard lock(mutex_);
+    const auto entry = find_locked(id);
+    const auto rect = entry->rect_of(tile);
+    if (!rect) return std::nullopt;
+    return TileGeometry{*rect, entry->submission.job.image.width, entry->submission.job.image.height};
+}
+
+std::optional<std::vector<uint8_t>> JobManager::tile_exr(const std::string& id, TileIndex tile) {
+    std::shared_ptr<Entry> entry;
+    std::shared_ptr<const Image> pixels;
+    bool done = false;
+    {
+        std::lock_guard lock(mutex_);
+        entry = find_locked(id);
+        if (!entry->rect_of(tile)) return std::nullopt;
+        done = entry->status.state == JobState::Done;
+        if (!done) {
+            const auto it = entry->tiles.find(tile);
+            if (it == entry->tiles.end()) return std::nullopt;
+            pixels = it->second;
+        }
+    }
+    const protocol::Job& job = entry->submission.job;
+    const PixelRect rect = *entry->rect_of(tile);
+    ImageLayers layers;
+    if (done) {
+        const auto image = final_image(entry);
+        if (!image) return std::nullopt;
+        layers = copy_rect(*image, rect);
+    } else {
+        layers.beauty = *pixels;
+    }
+    const ExrPixelType type = job.output.pixel_type == "float" ? ExrPixelType::Float : ExrPixelType::Half;
+    auto bytes = encode_tile_exr(layers, rect, job.image.width, job.image.height, type);
+    if (!bytes) throw ServiceError(ErrorKind::Internal, bytes.error().message);
+    return std::move(bytes).value();
+}
+
+void JobManager::remember_image_locked(const std::shared_ptr<Entry>& entry) {
+    std::erase(images_in_memory_, entry->id());
+    images_in_memory_.push_back(entry->id());
+    while (images_in_memory_.size() > options_.final_images_in_memory) {
+        if (const auto it = jobs_.find(images_in_memory_.front()); it != jobs_.end()) it->second->image.reset();
+        images_in_memory_.erase(images_in_memory_.begin());
+    }
+}
+
+std::shared_ptr<const ImageLayers> JobManager::final_image(const std::shared_ptr<Entry>& entry) {
+    {
+        std::lock_guard lock(mutex_);
+        if (entry->image) return entry->image;
+    }
+    auto image = read_exr(store_.image_path(entry->id()));
+    if (!image) {
+        log("job " + entry->id() + ": " + image.error().message);
+        return nullptr;
+    }
+    auto shared = std::make_shared<const ImageLayers>(std::move(image).value());
+    std::lock_guard lock(mutex_);
+    entry->image = shared;
+    remember_image_locked(entry);
+    return shared;
+}
+
+fs::path JobManager::image_file(const std::string& id) const {
+    std::lock_guard lock(mutex_);
+    const auto entry = find_locked(id);
+    const protocol::JobStatus& s = entry->status;
+    switch (s.state) {
+        case JobState::Done: return store_.image_path(id);
+        case JobState::Failed:
+            throw ServiceError(ErrorKind::Conflict, "job " + id + " failed: " + s.error);
+        case JobState::Cancelled:
+            throw ServiceError(ErrorKind::Conflict, "job " + id + " was cancelled: it has no image");
+        default:
+            throw ServiceError(ErrorKind::Conflict,
+                               "job " + id + " is " + std::string(protocol::to_string(s.state)) + " (" +
+                                   std::to_string(static_cast<int>(100 * s.progress.fraction())) +
+                                   "% of the tiles); add ?wait=true to wait for the image");
+    }
+}
+
+std::vector<uint8_t> JobManager::preview_png(const std::string& id) {
+    std::shared_ptr<Entry> entry;
+    std::vector<std::pair<TileIndex, std::shared_ptr<const Image>>> tiles;
+    {
+        std::lock_guard lock(mutex_);
+        entry = find_locked(id);
+        const JobState state = entry->status.state;
+        if (state == JobState::Queued || state == JobState::Failed || state == JobState::Cancelled)
+            throw ServiceError(ErrorKind::Conflict, "job " + id + " is " +
+                                                        std::string(protocol::to_string(state)) +
+                                                        ": it has no pixels to preview");
+        if (state == JobState::Running) tiles.assign(entry->tiles.begin(), entry->tiles.end());
+    }
+    if (tiles.empty() && entry->status.state != JobState::Running) {
+        if (auto bytes = read_file_bytes(store_.preview_path(id))) return std::move(*bytes);
+        const auto image = final_image(entry);
+        if (!image) throw ServiceError(ErrorKind::Internal, "job " + id + ": the image cannot be read");
+        auto png = encode_png_preview(image->beauty);
+        if (!png) throw ServiceError(ErrorKind::Internal, png.error().message);
+        return std::move(png).value();
+    }
+    // While rendering: the finished tiles on black.
+    const protocol::Job& job = entry->submission.job;
+    Image frame(job.image.width, job.image.height);
+    for (const auto& [index, pixels] : tiles) {
+        const PixelRect rect = *entry->rect_of(index);
+        frame.paste(*pixels, rect.x0, rect.y0);
+    }
+    auto png = encode_png_preview(frame);
+    if (!png) throw ServiceError(ErrorKind::Internal, png.error().message);
+    return std::move(png).value();
+}
+
+void JobManager::fill_metrics(MetricsSnapshot& snapshot) const {
+    std::lock_guard lock(mutex_);
+    for (std::string_view name : protocol::kJobStateNames) snapshot.jobs_by_state[std::string(name)] = 0;
+    for (const auto& [id, entry] : jobs_)
+        ++snapshot.jobs_by_state[std::string(protocol::to_string(entry->status.state))];
+    snapshot.queue_depth = queue_.size();
+}
+
+// ---------------------------------------------------------------------------------------------
+// The worker
+
+void JobManager::worker_loop() {
+    for (;;) {
+        std::shared_ptr<Entry> entry;
+        {
+            std::unique_lock lock(mutex_);
+            work_available_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
+            if (stopping_) break;
+            const auto next = queue_.begin();
+            entry = jobs_.at(next->second);
+            queue_.erase(next);
+            running_ = entry;
+            entry->status.state = JobState::Running;
+            entry->status.started_at_ms = now_ms();
+            entry->pass_started = Clock::now();
+            push_event_locked(*entry, JobEventType::State, {{"state", "running"}});
+            entry->changed.notify_all();
+        }
+        (void)store_.save_status(status(entry->id()));
+        log("job " + entry->id() + " started");
+        run(entry);
+        std::lock_guard lock(mutex_);
+        running_.reset();
+    }
+    worker_running_ = false;
+}
+
+void JobManager::run(const std::shared_ptr<Entry>& entry) {
+    Entry& e = *entry;
+    PipelineOptions options;
+    options.threads = options_.threads;
+    options.scene_root = options_.scene_root;
+    options.photon_maps = photon_maps_;
+    options.scene_lookup = [this](const std::string& id) { return scenes_->lookup(id); };
+    options.callbacks.cancel = &e.cancel;
+    options.callbacks.on_tile = [&](const TileEvent& event, const Image& frame) {
+        // Only this tile's pixels are read: other threads write other tiles of the frame.
+        auto pixels = std::make_shared<const Image>(frame.copy_rect(event.rect));
+        const TileIndex index = e.index_of(event.rect);
+        metrics_->record_tile();
+        std::lock_guard lock(mutex_);
+        e.tiles[index] = std::move(pixels);
+        e.finished_order.push_back(index);
+        e.status.progress.tiles_done = e.finished_order.size();
+        push_event_locked(e, JobEventType::Tile, e.tile_event(index));
+        push_event_locked(e, JobEventType::Progress, e.progress_event());
+        e.changed.notify_all();
+    };
+    options.on_pass = [&](const std::string& pass) {
+        std::lock_guard lock(mutex_);
+        const Clock::time_point now = Clock::now();
+        if (!e.status.pass.empty())
+            e.status.timings.push_back(
+                {e.status.pass, std::chrono::duration<double>(now - e.pass_started).count()});
+        e.status.pass = pass;
+        e.pass_started = now;
+        push_event_locked(e, JobEventType::Progress, e.progress_event());
+        e.changed.notify_all();
+    };
+
+    auto result = run_job(e.submission.job, device_, options);
+
+    if (e.cancel) {
+        bool by_user = false;
+        {
+            std::lock_guard lock(mutex_);
+            by_user = e.cancelled_by_user;
+        }
+        if (by_user || !stopping_) {
+            finish(entry, JobState::Cancelled, "", result ? &result->statistics : nullptr);
+            return;
+        }
+        // Stopped by shutdown(): the job runs again when the daemon restarts.
+        protocol::JobStatus requeued;
+        {
+            std::lock_guard lock(mutex_);
+            e.status.state = JobState::Queued;
+            e.status.pass.clear();
+            e.status.started_at_ms = 0;
+            e.status.timings.clear();
+            e.status.progress.tiles_done = 0;
+            e.tiles.clear();
+            e.finished_order.clear();
+            push_event_locked(e, JobEventType::State,
+                              {{"state", "queued"},
+                               {"reason", "the daemon is shutting down; the job runs again when it restarts"}});
+            e.changed.notify_all();
+            requeued = e.status;
+        }
+        (void)store_.save_status(requeued);
+        log("job " + e.id() + " interrupted by shutdown; queued again for the next start");
+        return;
+    }
+    if (!result) {
+        finish(entry, JobState::Failed, result.error().message, nullptr);
+        return;
+    }
+
+    // The final image, written before the job is announced done so that it can be fetched
+    // as soon as a client hears of it.
+    options.on_pass("writing");
+    const protocol::Job& job = e.submission.job;
+    ExrWriteOptions exr;
+    exr.pixel_type = job.output.pixel_type == "float" ? ExrPixelType::Float : ExrPixelType::Half;
+    exr.tile_size = job.image.tile_size;
+    const Clock::time_point writing_started = Clock::now();
+    if (Status written = write_exr(store_.image_path(e.id()), result->layers, exr); !written) {
+        finish(entry, JobState::Failed, written.error().message, &result->statistics);
+        return;
+    }
+    if (Status written = write_png_preview(store_.preview_path(e.id()), result->layers.beauty); !written)
+        log("job " + e.id() + ": " + written.error().message);
+    result->statistics.passes.push_back(
+        {"writing", std::chrono::duration<double>(Clock::now() - writing_started).count()});
+    {
+        std::lock_guard lock(mutex_);
+        e.image = std::make_shared<const ImageLayers>(std::move(result->layers));
+        remember_image_locked(entry);
+    }
+    finish(entry, JobState::Done, "", &result->statistics);
+}
+
+void JobManager::finish_locked(Entry& e, JobState state, std::string error, const RenderStatistics* statistics) {
+    e.status.state = state;
+    e.status.error = std::move(error);
+    e.status.finished_at_ms = now_ms();
+    if (statistics) {
+        e.status.statistics = protocol::to_json(*statistics);
+        e.status.plan = plan_of(*statistics);
+        e.status.photon_cache = statistics->photon_cache;
+        e.status.photon_map_key = statistics->photon_map_key;
+        e.status.timings.clear();
+        for (const PassTiming& p : statistics->passes) e.status.timings.push_back({p.name, p.seconds});
+    } else if (!e.status.pass.empty()) {
+        e.status.timings.push_back(
+            {e.status.pass, std::chrono::duration<double>(Clock::now() - e.pass_started).count()});
+    }
+    e.status.pass.clear();
+    if (state != JobState::Done) {
+        // Nothing can be fetched from a cancelled or failed job: free its pixels.
+        e.tiles.clear();
+        e.finished_order.clear();
+        e.finished_order.shrink_to_fit();
+    } else {
+        e.tiles.clear();
+        e.status.progress.tiles_done = e.status.progress.tiles_total;
+    }
+    json reason = {{"state", std::string(protocol::to_string(state))}};
+    if (!e.status.error.empty()) reason["reason"] = e.status.error;
+    if (state == JobState::Done) push_event_locked(e, JobEventType::Progress, e.progress_event());
+    push_event_locked(e, JobEventType::State, std::move(reason));
+    const JobEventType last = state == JobState::Done     ? JobEventType::Done
+                              : state == JobState::Failed ? JobEventType::Failed
+                                                          : JobEventType::Cancelled;
+    push_event_locked(e, last, protocol::to_json(e.status));
+    e.changed.notify_all();
+}
+
+void JobManager::finish(const std::shared_ptr<Entry>& entry, JobState state, std::string error,
+                        const RenderStatistics* statistics) {
+    protocol::JobStatus status;
+    {
+        std::lock_guard lock(mutex_);
+        finish_locked(*entry, state, std::move(error), statistics);
+        status = entry->status;
+    }
+    (void)store_.save_status(status);
+    if (statistics) {
+        metrics_->record_rays(statistics->rays + statistics->shadow_rays);
+        for (const PassTiming& p : statistics->passes) metrics_->record_pass(p.name, p.seconds);
+    }
+    std::string line = "job " + status.id + " " + std::string(protocol::to_string(state));
+    if (statistics) {
+        char seconds[32];
+        std::snprintf(seconds, sizeof seconds, " in %.3f s", statistics->total_seconds);
+        line += seconds;
+        if (!statistics->photon_cache.empty()) line += " (photon maps: cache " + statistics->photon_cache + ")";
+    }
+    if (!status.error.empty()) line += ": " + status.error;
+    log(line);
+}
+
+}  // namespace photond::service

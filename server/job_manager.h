@@ -1,0 +1,184 @@
+// The job manager of `photond serve`: the queue, the one worker that renders, each job's status,
+// events and finished tiles, cancellation, and the jobs kept on disk.
+//
+// Scheduling: jobs wait in a queue ordered by priority (higher first), then by arrival. One job
+// renders at a time with every render thread (--threads), so that each job finishes as soon as
+// possible and a job's output does not depend on what else runs.
+//
+// Tiles: each finished tile's pixels are copied out of the frame in the renderer's tile callback
+// and kept with the job, so that tiles can be fetched and streamed while the job renders. When
+// the job is done its tiles are dropped and served from the final image (kept in memory for the
+// last few jobs, else read back from <cache-dir>/jobs/<id>/image.exr); a cancelled or failed
+// job's pixels are freed.
+//
+// Restart: finished jobs (done, failed, cancelled) are loaded back from the cache directory with
+// their results. Jobs that were queued are queued again. A job that was running when the daemon
+// stopped cleanly (SIGINT/SIGTERM: its render is cancelled) is queued again too; one that was
+// running when the daemon died (a crash: status.json still says "running") fails with the reason
+// "daemon restarted while the job was running", so that a job that crashes the daemon cannot
+// crash it again and again.
+//
+// Thread safety: every public member may be called from any thread at once. One mutex guards
+// all job state; the renderer's tile callbacks take it briefly per tile, and the waiting calls
+// (wait_events, wait_tiles, wait_finished) sleep on the job's condition variable, woken by every
+// change of that job and by shutdown(). Rendering, EXR/PNG encoding and file I/O run outside the
+// mutex.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <string>
+#include <thread>
+#include <unordered_map>
+#include <vector>
+
+#include "core/accel/ray_tracer.h"
+#include "core/image/image.h"
+#include "protocol/job.h"
+#include "protocol/job_status.h"
+#include "server/job_store.h"
+#include "server/metrics.h"
+#include "server/photon_map_cache.h"
+#include "server/scene_store.h"
+
+namespace photond::service {
+
+struct JobManagerOptions {
+    std::filesystem::path cache_dir;   // jobs are kept under cache_dir/jobs
+    std::filesystem::path scene_root;  // {"path": ...} scenes must lie below it
+    int threads = 0;                   // render threads; 0 = every core
+    size_t max_queued = 64;            // queued jobs beyond this are refused (429)
+    size_t final_images_in_memory = 4; // finished images kept decoded for tile requests
+    std::function<void(const std::string&)> log;  // one line per job event; may be empty
+};
+
+class JobManager {
+public:
+    /// `photon_maps`, `scenes` and `metrics` must outlive the manager.
+    JobManager(JobManagerOptions options, std::shared_ptr<EmbreeDevice> device,
+               PhotonMapCache* photon_maps, SceneStore* scenes, Metrics* metrics);
+    ~JobManager();
+    JobManager(const JobManager&) = delete;
+    JobManager& operator=(const JobManager&) = delete;
+
+    /// Loads the jobs kept in the cache directory and starts the worker. Call once.
+    void start();
+    /// Refuses new jobs, cancels the running one (it is queued again on disk), wakes every
+    /// waiting call and joins the worker. Idempotent.
+    void shutdown();
+    bool stopping() const { return stopping_.load(); }
+    bool worker_running() const { return worker_running_.load(); }
+    bool cache_dir_writable() const { return store_.writable(); }
+
+    struct Submitted {
+        protocol::JobStatus status;
+        bool created = false;  // false: an earlier job with the same Idempotency-Key
+    };
+    /// Queues a validated job. Throws ServiceError: InvalidField (a scene that does not exist,
+    /// a path outside the scene root), Conflict (the Idempotency-Key names another job
+    /// description), QueueFull (with Retry-After), Unavailable (shutting down, disk failure).
+    Submitted submit(const protocol::Job& job, const std::string& idempotency_key);
+
+    /// Throws ServiceError NotFound for an unknown id (so do the members below).
+    protocol::JobStatus status(const std::string& id) const;
+    /// Newest first; `state` filters; job lists carry no statistics.
+    std::vector<protocol::JobStatus> list(std::optional<protocol::JobState> state, size_t limit) const;
+
+    /// Cancels a queued or running job and waits up to `wait` for the render to stop. Cancelling
+    /// a cancelled job again is harmless; a done or failed job gives Conflict.
+    protocol::JobStatus cancel(const std::string& id, std::chrono::milliseconds wait);
+
+    /// Waits up to `timeout` for the job to end (or the daemon to stop); returns its status.
+    protocol::JobStatus wait_finished(const std::string& id, std::chrono::milliseconds timeout) const;
+
+    struct EventBatch {
+        std::vector<protocol::JobEvent> events;  // ids > the one asked for, in order
+        bool ended = false;  // the job ended and these include its last event, or shutdown
+    };
+    /// The events after `after_id`; waits up to `timeout` when there are none yet.
+    EventBatch wait_events(const std::string& id, uint64_t after_id,
+                           std::chrono::milliseconds timeout) const;
+
+    struct TileBatch {
+        std::vector<protocol::TileIndex> tiles;  // in the order they finished
+        size_t next = 0;      // where the next call should start
+        bool ended = false;   // no tile will follow (job ended, or shutdown)
+    };
+    /// The finished tiles from position `from` of the finishing order; waits up to `timeout`.
+    TileBatch wait_tiles(const std::string& id, size_t from, std::chrono::milliseconds timeout) const;
+
+    struct TileGeometry {
+        PixelRect rect;
+        int frame_width = 0;
+        int frame_height = 0;
+    };
+    /// The rectangle of tile (tx, ty); nullopt outside the job's grid.
+    std::optional<TileGeometry> tile_geometry(const std::string& id, protocol::TileIndex tile) const;
+    /// One finished tile as a small EXR (encode_tile_exr); nullopt while it is not finished (or
+    /// its pixels were freed: cancelled or failed job).
+    std::optional<std::vector<uint8_t>> tile_exr(const std::string& id, protocol::TileIndex tile);
+
+    /// The final image's file; Conflict while the job is not done.
+    std::filesystem::path image_file(const std::string& id) const;
+    /// A PNG preview: of the finished image, or of the tiles finished so far while rendering;
+    /// Conflict for a queued, failed or cancelled job.
+    std::vector<uint8_t> preview_png(const std::string& id);
+
+    /// Job counts by state and the queue depth, for /metrics.
+    void fill_metrics(MetricsSnapshot& snapshot) const;
+
+private:
+    struct Entry;
+    using Clock = std::chrono::steady_clock;
+
+    std::shared_ptr<Entry> find_locked(const std::string& id) const;  // throws NotFound
+    void check_scene(const protocol::Job& job) const;                  // throws InvalidField
+    int retry_after_seconds_locked() const;
+    void push_event_locked(Entry& entry, protocol::JobEventType type, nlohmann::json data);
+    void worker_loop();
+    void run(const std::shared_ptr<Entry>& entry);
+    /// Ends a job: state, statistics, events, files, metrics. Takes the mutex itself.
+    void finish(const std::shared_ptr<Entry>& entry, protocol::JobState state, std::string error,
+                const RenderStatistics* statistics);
+    void finish_locked(Entry& entry, protocol::JobState state, std::string error,
+                       const RenderStatistics* statistics);
+    /// The final image of a done job, from memory or from its EXR on disk.
+    std::shared_ptr<const ImageLayers> final_image(const std::shared_ptr<Entry>& entry);
+    void remember_image_locked(const std::shared_ptr<Entry>& entry);
+    void restore(StoredJob stored);
+    void log(const std::string& line) const;
+
+    JobManagerOptions options_;
+    std::shared_ptr<EmbreeDevice> device_;
+    PhotonMapCache* photon_maps_;
+    SceneStore* scenes_;
+    Metrics* metrics_;
+    JobStore store_;
+
+    mutable std::mutex mutex_;
+    std::condition_variable work_available_;
+    std::unordered_map<std::string, std::shared_ptr<Entry>> jobs_;
+    std::vector<std::shared_ptr<Entry>> arrival_order_;  // oldest first
+    // Queued jobs by (-priority, sequence): begin() runs next.
+    std::set<std::pair<std::pair<int, uint64_t>, std::string>> queue_;
+    std::unordered_map<std::string, std::string> idempotency_keys_;  // key -> job id
+    std::shared_ptr<Entry> running_;
+    std::vector<std::string> images_in_memory_;  // ids of done jobs holding their image, oldest first
+    uint64_t next_sequence_ = 1;
+    std::mutex submit_mutex_;  // serialises submissions (checks, disk write, insertion)
+
+    std::atomic<bool> stopping_{false};
+    std::atomic<bool> worker_running_{false};
+    std::thread worker_;
+};
+
+}  // namespace photond::service

@@ -1,0 +1,118 @@
+#include "server/job_store.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <fstream>
+#include <sstream>
+#include <system_error>
+
+#include "server/atomic_file.h"
+
+namespace photond::service {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+Expected<json> read_json(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return Error{path.string() + ": cannot be read"};
+    std::ostringstream text;
+    text << in.rdbuf();
+    json document = json::parse(text.str(), nullptr, false);
+    if (document.is_discarded()) return Error{path.string() + ": not valid JSON"};
+    return document;
+}
+
+}  // namespace
+
+JobStore::JobStore(fs::path directory) : directory_(std::move(directory)) {
+    std::error_code ignored;
+    fs::create_directories(directory_, ignored);
+}
+
+fs::path JobStore::job_directory(const std::string& id) const { return directory_ / id; }
+fs::path JobStore::image_path(const std::string& id) const { return directory_ / id / "image.exr"; }
+fs::path JobStore::preview_path(const std::string& id) const { return directory_ / id / "preview.png"; }
+
+Status JobStore::save_submission(const JobSubmission& s) {
+    std::error_code error;
+    fs::create_directories(job_directory(s.id), error);
+    if (error)
+        return Error{job_directory(s.id).string() + ": cannot be created (" + error.message() + ")"};
+    const json document = {{"id", s.id},
+                           {"job", protocol::to_json(s.job)},
+                           {"sequence", s.sequence},
+                           {"created_at", protocol::format_timestamp(s.created_at_ms)},
+                           {"idempotency_key", s.idempotency_key},
+                           {"request_digest", s.request_digest}};
+    return write_file_atomically(job_directory(s.id) / "job.json", document.dump(2) + "\n");
+}
+
+Status JobStore::save_status(const protocol::JobStatus& status) {
+    return write_file_atomically(job_directory(status.id) / "status.json",
+                                 protocol::to_json(status, false).dump(2) + "\n");
+}
+
+JobStore::Loaded JobStore::load_all() const {
+    Loaded loaded;
+    std::error_code error;
+    for (fs::directory_iterator it(directory_, error), end; !error && it != end; it.increment(error)) {
+        if (!it->is_directory()) continue;
+        const fs::path dir = it->path();
+        auto submission_json = read_json(dir / "job.json");
+        auto status_json = read_json(dir / "status.json");
+        if (!submission_json || !status_json) {
+            loaded.problems.push_back(!submission_json ? submission_json.error().message
+                                                       : status_json.error().message);
+            continue;
+        }
+        StoredJob stored;
+        try {
+            JobSubmission& s = stored.submission;
+            s.id = submission_json->at("id").get<std::string>();
+            auto job = protocol::parse_job(submission_json->at("job"));
+            if (!job) throw std::runtime_error("job: " + job.error().message);
+            s.job = std::move(job).value();
+            s.sequence = submission_json->at("sequence").get<uint64_t>();
+            s.created_at_ms =
+                protocol::parse_timestamp(submission_json->value("created_at", std::string())).value_or(0);
+            s.idempotency_key = submission_json->value("idempotency_key", std::string());
+            s.request_digest = submission_json->value("request_digest", std::string());
+            if (s.id != dir.filename().string()) throw std::runtime_error("id does not match the directory");
+        } catch (const std::exception& e) {
+            loaded.problems.push_back((dir / "job.json").string() + ": " + e.what());
+            continue;
+        }
+        auto status = protocol::job_status_from_json(*status_json);
+        if (!status) {
+            loaded.problems.push_back((dir / "status.json").string() + ": " + status.error().message);
+            continue;
+        }
+        stored.status = std::move(status).value();
+        stored.status.job = stored.submission.job;
+        loaded.jobs.push_back(std::move(stored));
+    }
+    std::sort(loaded.jobs.begin(), loaded.jobs.end(), [](const StoredJob& a, const StoredJob& b) {
+        return a.submission.sequence < b.submission.sequence;
+    });
+    return loaded;
+}
+
+bool JobStore::writable() const {
+    static std::atomic<uint64_t> counter{0};
+    const fs::path probe = directory_ / (".ready-probe-" + std::to_string(::getpid()) + "-" +
+                                         std::to_string(counter.fetch_add(1)));
+    {
+        std::ofstream out(probe, std::ios::trunc);
+        out << "ok";
+        if (!out) return false;
+    }
+    std::error_code error;
+    fs::remove(probe, error);
+    return !error;
+}
+
+}  // namespace photond::service

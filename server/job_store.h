@@ -1,0 +1,66 @@
+// Jobs on disk, so that finished results survive a restart of the daemon:
+//   <cache-dir>/jobs/<id>/job.json     the description with every default filled, and how it
+//                                      was submitted (sequence, Idempotency-Key, digest)
+//   <cache-dir>/jobs/<id>/status.json  the last status document (protocol::to_json)
+//   <cache-dir>/jobs/<id>/image.exr    the final image (tiled OpenEXR, as `photond render`)
+//   <cache-dir>/jobs/<id>/preview.png  its sRGB preview
+// Every file is written to a temporary name and renamed, so a crash leaves the old or the new
+// version, never half of one.
+//
+// Thread safety: calls for different jobs may run at once; calls for one job must not overlap
+// (the job manager serialises them).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/util/expected.h"
+#include "protocol/job.h"
+#include "protocol/job_status.h"
+
+namespace photond::service {
+
+/// How a job was submitted: constant for its whole life.
+struct JobSubmission {
+    std::string id;
+    protocol::Job job;
+    uint64_t sequence = 0;         // arrival order, unique per cache directory's history
+    int64_t created_at_ms = 0;
+    std::string idempotency_key;   // empty when the request had none
+    std::string request_digest;    // SHA-256 of the normalized job, for Idempotency-Key checks
+};
+
+struct StoredJob {
+    JobSubmission submission;
+    protocol::JobStatus status;
+};
+
+class JobStore {
+public:
+    /// `directory` is <cache-dir>/jobs; created when missing.
+    explicit JobStore(std::filesystem::path directory);
+
+    Status save_submission(const JobSubmission& submission);
+    Status save_status(const protocol::JobStatus& status);
+
+    std::filesystem::path job_directory(const std::string& id) const;
+    std::filesystem::path image_path(const std::string& id) const;
+    std::filesystem::path preview_path(const std::string& id) const;
+
+    struct Loaded {
+        std::vector<StoredJob> jobs;
+        std::vector<std::string> problems;  // directories that could not be read, and why
+    };
+    /// Every job on disk, in arrival order.
+    Loaded load_all() const;
+
+    /// True when a file can be created in the directory now (for /readyz).
+    bool writable() const;
+
+private:
+    std::filesystem::path directory_;
+};
+
+}  // namespace photond::service

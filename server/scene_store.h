@@ -1,0 +1,82 @@
+// Uploaded scenes (POST /v1/scenes), stored by content: <directory>/<sha256>.glb or .gltf, with
+// their metadata beside them in <sha256>.json. An upload is validated by loading it
+// (load_gltf_memory: a .glb or a self-contained .gltf) before it is kept. Jobs name an upload as
+// {"scene": {"id": "sha256:<hex>"}}; lookup() loads it and keeps the last few loaded scenes.
+//
+// Thread safety: every member may be called from any thread at once (one mutex guards the
+// loaded-scene cache; files are written to a temporary name and renamed, so concurrent uploads
+// of the same bytes, even by several daemons sharing the directory, are harmless).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <list>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/scene/scene.h"
+#include "core/util/expected.h"
+
+namespace photond::service {
+
+/// GET /v1/scenes/{id}.
+struct SceneInfo {
+    std::string id;      // "sha256:<64 hex digits>"
+    std::string format;  // "glb" or "gltf"
+    uint64_t bytes = 0;
+    std::string name;
+    uint64_t triangles = 0;
+    uint64_t vertices = 0;
+    uint64_t materials = 0;
+    uint64_t textures = 0;
+    uint64_t lights = 0;  // punctual lights (KHR_lights_punctual)
+    uint64_t emissive_triangles = 0;
+    uint64_t cameras = 0;
+    Bounds3 bounds;
+};
+
+nlohmann::json to_json(const SceneInfo& info);
+
+class SceneStore {
+public:
+    explicit SceneStore(std::filesystem::path directory, size_t loaded_scenes_kept = 4);
+
+    struct Added {
+        SceneInfo info;
+        bool created = false;  // false: these bytes were already stored
+    };
+    /// Validates and stores an upload; the Error carries the loader's message.
+    Expected<Added> add(std::span<const uint8_t> bytes);
+
+    /// The metadata of a stored scene; nullopt when unknown. `id` is "sha256:<hex>" or "<hex>".
+    std::optional<SceneInfo> info(const std::string& id);
+    bool contains(const std::string& id) const;
+    /// Removes the scene; false when it was not there.
+    bool remove(const std::string& id);
+    /// Every stored scene, sorted by id.
+    std::vector<SceneInfo> list();
+
+    /// The loaded scene, for the render pipeline (service::SceneLookup).
+    Expected<std::shared_ptr<const Scene>> lookup(const std::string& id);
+
+    /// "sha256:<hex>" for "sha256:<hex>" or "<hex>" (64 lower-case hex digits); nullopt else.
+    static std::optional<std::string> normalize_id(const std::string& id);
+
+private:
+    /// The stored file of a normalized id, if any.
+    std::optional<std::filesystem::path> file_of(const std::string& normalized_id) const;
+    std::filesystem::path metadata_file_of(const std::string& normalized_id) const;
+
+    std::filesystem::path directory_;
+    size_t loaded_scenes_kept_;
+    mutable std::mutex mutex_;
+    std::list<std::pair<std::string, std::shared_ptr<const Scene>>> loaded_;  // front = newest
+};
+
+}  // namespace photond::service
