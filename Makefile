@@ -9,7 +9,7 @@ DEBIAN_PACKAGES := cmake g++ make pkg-config libembree-dev libtbb-dev libopenexr
 	libbenchmark-dev curl
 OUT ?= out
 
-.PHONY: all deps configure build test demo bench clean format
+.PHONY: all deps configure build test tsan demo bench clean format
 
 all: build
 
@@ -31,6 +31,12 @@ build: configure
 
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j$(JOBS)
+
+# The irradiance cache's concurrency stress test under ThreadSanitizer (run by CI).
+tsan: deps
+	cmake -S . -B $(BUILD)-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPHOTOND_SANITIZE=thread
+	cmake --build $(BUILD)-tsan -j$(JOBS) --target irradiance_cache_test
+	TSAN_OPTIONS=halt_on_error=1 $(BUILD)-tsan/tests/irradiance_cache_test --gtest_filter='IrradianceCache.Concurrent*:IrradianceCache.Octree*'
 
 demo: build
 	./deploy/demo.sh $(BUILD) $(OUT)

@@ -9,11 +9,13 @@ namespace photond::service {
 
 int run_compare_command(std::span<const std::string> args) {
     constexpr const char* kUsage =
-        "usage: photond compare IMAGE.exr REFERENCE.exr [--region x0,y0,x1,y1] [--epsilon E]\n"
-        "prints relMSE, RMSE, the 99th percentile of per-pixel absolute error, and the mean bias\n";
+        "usage: photond compare IMAGE.exr REFERENCE.exr [--region x0,y0,x1,y1] [--epsilon E] [--block N]\n"
+        "prints relMSE, RMSE, the 99th percentile of per-pixel absolute error, and the mean bias;\n"
+        "--block N compares N x N block averages (the region in block units then)\n";
     std::vector<std::string> files;
     std::optional<PixelRect> region;
     double epsilon = 0.01;
+    int block = 1;
     for (size_t i = 0; i < args.size(); ++i) {
         if (args[i] == "--region" && i + 1 < args.size()) {
             PixelRect r;
@@ -24,6 +26,8 @@ int run_compare_command(std::span<const std::string> args) {
             region = r;
         } else if (args[i] == "--epsilon" && i + 1 < args.size()) {
             epsilon = std::atof(args[++i].c_str());
+        } else if (args[i] == "--block" && i + 1 < args.size()) {
+            block = std::max(1, std::atoi(args[++i].c_str()));
         } else if (args[i] == "-h" || args[i] == "--help") {
             std::fputs(kUsage, stdout);
             return 0;
@@ -41,7 +45,11 @@ int run_compare_command(std::span<const std::string> args) {
         std::fprintf(stderr, "photond compare: %s\n", (!image ? image.error() : reference.error()).message.c_str());
         return 1;
     }
-    auto e = compare_images(image->beauty, reference->beauty, region, epsilon);
+    if (region && block > 1)
+        region = PixelRect{region->x0 / block, region->y0 / block, (region->x1 + block - 1) / block,
+                           (region->y1 + block - 1) / block};
+    auto e = block > 1 ? compare_images(downsample(image->beauty, block), downsample(reference->beauty, block), region, epsilon)
+                       : compare_images(image->beauty, reference->beauty, region, epsilon);
     if (!e) {
         std::fprintf(stderr, "photond compare: %s\n", e.error().message.c_str());
         return 1;
@@ -54,13 +62,17 @@ int run_compare_command(std::span<const std::string> args) {
 
 int run_average_command(std::span<const std::string> args) {
     constexpr const char* kUsage =
-        "usage: photond average -o OUT.exr IN.exr [IN.exr ...]\n"
-        "writes the per-pixel mean of renders with equal sample counts and other seeds (float EXR)\n";
+        "usage: photond average -o OUT.exr [--half] IN.exr [IN.exr ...]\n"
+        "writes the per-pixel mean of renders with equal sample counts and other seeds (float EXR,\n"
+        "or half with --half)\n";
     std::string output;
     std::vector<std::string> inputs;
+    bool half = false;
     for (size_t i = 0; i < args.size(); ++i) {
         if ((args[i] == "-o" || args[i] == "--output") && i + 1 < args.size()) {
             output = args[++i];
+        } else if (args[i] == "--half") {
+            half = true;
         } else if (args[i] == "-h" || args[i] == "--help") {
             std::fputs(kUsage, stdout);
             return 0;
@@ -96,7 +108,7 @@ int run_average_command(std::span<const std::string> args) {
     ImageLayers layers;
     layers.beauty = std::move(sum);
     ExrWriteOptions options;
-    options.pixel_type = ExrPixelType::Float;
+    options.pixel_type = half ? ExrPixelType::Half : ExrPixelType::Float;
     if (Status st = write_exr(output, layers, options); !st) {
         std::fprintf(stderr, "photond average: %s\n", st.error().message.c_str());
         return 1;

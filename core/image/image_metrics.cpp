@@ -7,6 +7,26 @@
 
 namespace photond {
 
+Image downsample(const Image& image, int factor) {
+    factor = std::max(factor, 1);
+    const int w = (image.width() + factor - 1) / factor, h = (image.height() + factor - 1) / factor;
+    Image out(w, h);
+    for (int by = 0; by < h; ++by) {
+        for (int bx = 0; bx < w; ++bx) {
+            DVec3 sum(0.0);
+            int count = 0;
+            for (int y = by * factor; y < std::min((by + 1) * factor, image.height()); ++y) {
+                for (int x = bx * factor; x < std::min((bx + 1) * factor, image.width()); ++x) {
+                    sum += DVec3(image.at(x, y));
+                    ++count;
+                }
+            }
+            out.at(bx, by) = Color(sum / static_cast<double>(std::max(count, 1)));
+        }
+    }
+    return out;
+}
+
 Expected<ImageError> compare_images(const Image& image, const Image& reference,
                                     std::optional<PixelRect> region, double epsilon) {
     if (image.width() != reference.width() || image.height() != reference.height()) {

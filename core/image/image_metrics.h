@@ -18,6 +18,10 @@ struct ImageError {
     size_t pixels = 0;
 };
 
+/// The image averaged over factor x factor blocks (a box filter), for comparisons where pixel
+/// noise of the reference must not dominate. Edge blocks average what they hold.
+Image downsample(const Image& image, int factor);
+
 /// Compares `image` with `reference` over `region` (the whole frame by default). epsilon keeps
 /// the relative error finite where the reference is black (0.01, as in the literature).
 Expected<ImageError> compare_images(const Image& image, const Image& reference,

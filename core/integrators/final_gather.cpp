@@ -111,8 +111,11 @@ GatherResult FinalGatherer::gather(const Vec3& p, const Vec3& n, const Vec3& geo
                                                                : std::numeric_limits<float>::infinity();
     if (!compute_gradients) return result;
 
-    // Rotation gradient (Ward & Heckbert 1992): pi / (M N) sum_k v_k sum_j -tan(theta_j) L_jk, with
-    // theta_j at the row's centre so that tan stays bounded next to the horizon.
+    // Rotation gradient (Ward & Heckbert 1992): pi / (M N) sum_k v_k sum_j tan(theta_j) L_jk, v_k the
+    // tangent at azimuth phi_k + pi/2, theta_j at the row's centre so that tan stays bounded next
+    // to the horizon. Tilting the normal towards azimuth phi is a rotation about v(phi) and raises
+    // the cosine of directions near phi by tan(theta) per radian, hence the positive sign with
+    // the interpolation term (n_i x n) . grad_r (Ward & Heckbert orient v_k the other way).
     // Translation gradient: the change of the cosine-weighted solid angle each cell wall sweeps
     // when the point moves, times the radiance difference across the wall, the wall at the
     // nearer of its two cells' hit distances (Ward & Heckbert 1992, section 3.2).
@@ -128,7 +131,7 @@ GatherResult FinalGatherer::gather(const Vec3& p, const Vec3& n, const Vec3& geo
         DVec3 rotation_row(0.0);
         for (int j = 0; j < m; ++j) {
             const double theta_centre = std::asin(std::sqrt((j + 0.5) / m));
-            rotation_row -= std::tan(theta_centre) * DVec3(radiance[cell(j, k)]);
+            rotation_row += std::tan(theta_centre) * DVec3(radiance[cell(j, k)]);
             // Wall between rows j - 1 and j at theta_minus: sin cos^2 (2 pi / N) / r.
             if (j > 0) {
                 const double sin_minus = std::sqrt(static_cast<double>(j) / m);

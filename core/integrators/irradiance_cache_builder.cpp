@@ -81,14 +81,23 @@ std::unique_ptr<IrradianceCache> build_irradiance_cache(const RenderScene& rs, c
         RayCounters counters;
         uint64_t points = 0;
     };
-    for (int step = kFirstWaveStep; step >= 1; step /= 2) {
+    // Waves at steps 32, 16, ..., 1, then a repair wave over every pixel: neighbour clamping in
+    // later waves can shrink a record that covered a pixel centre when it was visited.
+    struct Wave {
+        int step;
+        bool repair;
+    };
+    std::vector<Wave> waves;
+    for (int step = kFirstWaveStep; step >= 1; step /= 2) waves.push_back({step, false});
+    waves.push_back({1, true});
+    for (const auto [step, repair] : waves) {
         if (settings.cancel && settings.cancel->load()) break;
-        // This wave's pixels: multiples of `step` not visited by a coarser wave.
+        // This wave's pixels: multiples of `step` not visited by a coarser wave (all in repair).
         std::vector<Candidate> candidates;
         for (int y = area.y0 - area.y0 % step; y < area.y1; y += step) {
             for (int x = area.x0 - area.x0 % step; x < area.x1; x += step) {
                 if (x < area.x0 || y < area.y0) continue;
-                const bool visited = step < kFirstWaveStep && x % (2 * step) == 0 && y % (2 * step) == 0;
+                const bool visited = !repair && step < kFirstWaveStep && x % (2 * step) == 0 && y % (2 * step) == 0;
                 if (!visited) candidates.push_back({x, y, {}, {}, {}, 0});
             }
         }

@@ -78,7 +78,7 @@ Color PhotonMap::estimate_irradiance(const Vec3& p, const Vec3& normal, uint32_t
 bool PhotonMap::nearest_irradiance(const Vec3& p, const Vec3& normal, float max_radius,
                                    Color* irradiance) const {
     if (tree_.empty()) return false;
-    constexpr uint32_t kCandidates = 8;
+    constexpr uint32_t kCandidates = 4;
     KnnResult& found = thread_scratch();
     tree_.k_nearest(p, kCandidates, max_radius > 0.0f ? max_radius : std::numeric_limits<float>::infinity(), found);
     const KnnNeighbor* best = nullptr;
