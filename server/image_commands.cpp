@@ -4,6 +4,7 @@
 
 #include "core/image/exr_io.h"
 #include "core/image/image_metrics.h"
+#include "core/image/png_preview.h"
 
 namespace photond::service {
 
@@ -11,11 +12,13 @@ int run_compare_command(std::span<const std::string> args) {
     constexpr const char* kUsage =
         "usage: photond compare IMAGE.exr REFERENCE.exr [--region x0,y0,x1,y1] [--epsilon E] [--block N]\n"
         "prints relMSE, RMSE, the 99th percentile of per-pixel absolute error, and the mean bias;\n"
-        "--block N compares N x N block averages (the region in block units then)\n";
+        "--block N compares N x N block averages (the region in block units then);\n"
+        "--error-png F writes the per-pixel relative squared error as a PNG (white = 1 or more)\n";
     std::vector<std::string> files;
     std::optional<PixelRect> region;
     double epsilon = 0.01;
     int block = 1;
+    std::string error_png;
     for (size_t i = 0; i < args.size(); ++i) {
         if (args[i] == "--region" && i + 1 < args.size()) {
             PixelRect r;
@@ -26,6 +29,8 @@ int run_compare_command(std::span<const std::string> args) {
             region = r;
         } else if (args[i] == "--epsilon" && i + 1 < args.size()) {
             epsilon = std::atof(args[++i].c_str());
+        } else if (args[i] == "--error-png" && i + 1 < args.size()) {
+            error_png = args[++i];
         } else if (args[i] == "--block" && i + 1 < args.size()) {
             block = std::max(1, std::atoi(args[++i].c_str()));
         } else if (args[i] == "-h" || args[i] == "--help") {
@@ -44,6 +49,19 @@ int run_compare_command(std::span<const std::string> args) {
     if (!image || !reference) {
         std::fprintf(stderr, "photond compare: %s\n", (!image ? image.error() : reference.error()).message.c_str());
         return 1;
+    }
+    if (!error_png.empty() && image->beauty.width() == reference->beauty.width() &&
+        image->beauty.height() == reference->beauty.height()) {
+        Image error(image->beauty.width(), image->beauty.height());
+        for (size_t p = 0; p < error.pixel_count(); ++p) {
+            const Color d = image->beauty.pixels()[p] - reference->beauty.pixels()[p];
+            const Color r = reference->beauty.pixels()[p];
+            error.pixels()[p] = Color(average(d * d / (r * r + Color(static_cast<float>(epsilon)))));
+        }
+        if (Status st = write_png_preview(error_png, error); !st) {
+            std::fprintf(stderr, "photond compare: %s\n", st.error().message.c_str());
+            return 1;
+        }
     }
     if (region && block > 1)
         region = PixelRect{region->x0 / block, region->y0 / block, (region->x1 + block - 1) / block,

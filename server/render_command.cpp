@@ -158,8 +158,8 @@ private:
 void print_statistics(const RenderStatistics& s) {
     std::fprintf(stderr, "%s, %dx%d, %d spp, %d threads\n", s.integrator.c_str(), s.width, s.height,
                  s.samples_per_pixel, s.threads);
-    for (const PassTiming& p : s.passes) std::fprintf(stderr, "  %-14s %9.3f s\n", p.name.c_str(), p.seconds);
-    std::fprintf(stderr, "  %-14s %9.3f s\n", "total", s.total_seconds);
+    for (const PassTiming& p : s.passes) std::fprintf(stderr, "  %-18s %9.3f s\n", p.name.c_str(), p.seconds);
+    std::fprintf(stderr, "  %-18s %9.3f s\n", "total", s.total_seconds);
     for (const PassDecision& d : s.plan)
         std::fprintf(stderr, "  plan: %-12s %-8s %s\n", d.pass.c_str(), d.enabled ? "run" : "skipped", d.reason.c_str());
     if (s.photons && s.photons->emitted > 0) {

@@ -1,5 +1,6 @@
 #include "core/integrators/irradiance_cache.h"
 
+#include <algorithm>
 #include <limits>
 
 namespace photond {
@@ -23,10 +24,8 @@ IrradianceCache::IrradianceCache(const Bounds3& scene_bounds, const IrradianceCa
 
 template <typename F>
 void IrradianceCache::for_each_candidate(const Vec3& p, float domain_scale, float reach, F&& f) const {
-    // A node's records have their centre inside it and a validity radius at most its half size,
-    // so only nodes whose box grown by half its size (times domain_scale, plus `reach`) contains
-    // p can matter. The
-    // root is always visited: it also keeps records placed outside its box.
+    // A record is filed in the nodes of its level that its domain's bounding cube overlaps; a
+    // node's records lie within its half size of it (scaled by domain_scale, plus `reach`).
     const auto reaches = [&](const Node& node) {
         return max_component(glm::abs(p - node.center)) <= (1.0f + domain_scale) * node.half_size + reach;
     };
@@ -43,12 +42,34 @@ void IrradianceCache::for_each_candidate(const Vec3& p, float domain_scale, floa
     }
 }
 
+template <typename F>
+void IrradianceCache::for_each_unique_candidate(const Vec3& p, float domain_scale, float reach, F&& f) const {
+    // Records filed in several nodes would be seen several times: report each once.
+    thread_local std::vector<uint32_t> seen;
+    seen.clear();
+    for_each_candidate(p, domain_scale, reach, [&](uint32_t r) { seen.push_back(r); });
+    std::sort(seen.begin(), seen.end());
+    seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
+    for (uint32_t r : seen) f(r);
+}
+
+template <typename F>
+void IrradianceCache::for_each_on_path(const Vec3& p, F&& f) const {
+    int32_t node = 0;
+    while (node >= 0) {
+        const Node& n = nodes_[static_cast<size_t>(node)];
+        for (uint32_t r : n.records) f(r);
+        const int octant = (p.x > n.center.x ? 1 : 0) | (p.y > n.center.y ? 2 : 0) | (p.z > n.center.z ? 4 : 0);
+        node = n.children[static_cast<size_t>(octant)];
+    }
+}
+
 bool IrradianceCache::interpolate(const Vec3& p, const Vec3& n, Color* irradiance, float accuracy_scale) const {
     if (records_.empty()) return false;
     const float a = settings_.accuracy * accuracy_scale;
     double weight_sum = 0.0;
     DVec3 sum(0.0);
-    for_each_candidate(p, accuracy_scale, 0.0f, [&](uint32_t index) {
+    const auto add = [&](uint32_t index) {
         const IrradianceRecord& r = records_[index];
         const Vec3 offset = p - r.position;
         const float distance = glm::length(offset);
@@ -68,7 +89,13 @@ bool IrradianceCache::interpolate(const Vec3& p, const Vec3& n, Color* irradianc
         // Gradient extrapolation may not push a record's estimate below zero.
         sum += w * DVec3(glm::max(e, Color(0.0f)));
         weight_sum += w;
-    });
+    };
+    if (accuracy_scale <= 1.0f) {
+        // Every record whose domain holds p is filed in the node on p's root-to-leaf path.
+        for_each_on_path(p, add);
+    } else {
+        for_each_unique_candidate(p, accuracy_scale, 0.0f, add);
+    }
     if (!(weight_sum > 0.0)) return false;
     *irradiance = Color(sum / weight_sum);
     return true;
@@ -96,7 +123,7 @@ void IrradianceCache::insert(IrradianceRecord record, float min_radius) {
     // Neighbour clamping: R_i <= R_j + |P_i - P_j| for every record whose domain overlaps.
     const uint32_t new_index = static_cast<uint32_t>(records_.size());
     std::vector<uint32_t> neighbours;
-    for_each_candidate(record.position, 1.0f, a * record.radius, [&](uint32_t j) {
+    for_each_unique_candidate(record.position, 1.0f, a * record.radius, [&](uint32_t j) {
         const IrradianceRecord& r = records_[j];
         const float d = glm::length(record.position - r.position);
         if (d < a * (record.radius + r.radius) && glm::dot(record.normal, r.normal) > 0.0f) neighbours.push_back(j);
@@ -109,17 +136,28 @@ void IrradianceCache::insert(IrradianceRecord record, float min_radius) {
         IrradianceRecord& r = records_[j];
         r.radius = std::min(r.radius, record.radius + glm::length(record.position - r.position));
     }
-    // The deepest node whose half size still holds the validity radius a R_i.
+    // The level whose nodes' half size h satisfies validity <= h < 2 validity; the record goes in
+    // every node of that level its domain's bounding cube overlaps (at most 8), so a lookup only
+    // needs the nodes on its own root-to-leaf path.
     const float validity = a * record.radius;
-    int32_t node = 0;
-    const Node& root = nodes_[0];
-    if (max_component(glm::abs(record.position - root.center)) <= root.half_size) {
-        while (0.5f * nodes_[static_cast<size_t>(node)].half_size >= validity &&
-               nodes_[static_cast<size_t>(node)].half_size > 1e-30f) {
-            node = child_for(node, record.position);
-        }
+    int level = 0;
+    float half = nodes_[0].half_size;
+    while (0.5f * half >= validity && level < kMaxDepth) {
+        half *= 0.5f;
+        ++level;
     }
-    nodes_[static_cast<size_t>(node)].records.push_back(new_index);
+    const Vec3 lower = record.position - Vec3(validity), upper = record.position + Vec3(validity);
+    bool filed = false;
+    for (int corner = 0; corner < 8; ++corner) {
+        const Vec3 q((corner & 1) ? upper.x : lower.x, (corner & 2) ? upper.y : lower.y, (corner & 4) ? upper.z : lower.z);
+        if (max_component(glm::abs(q - nodes_[0].center)) > nodes_[0].half_size) continue;  // outside the root
+        int32_t node = 0;
+        for (int l = 0; l < level; ++l) node = child_for(node, q);
+        std::vector<uint32_t>& list = nodes_[static_cast<size_t>(node)].records;
+        if (list.empty() || list.back() != new_index) list.push_back(new_index);
+        filed = true;
+    }
+    if (!filed) nodes_[0].records.push_back(new_index);  // wholly outside the root: the root keeps it
     records_.push_back(record);
 }
 

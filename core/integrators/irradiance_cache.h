@@ -10,9 +10,9 @@
 // Ward's threshold w > 1/a, and the interpolated field stays continuous where a record's domain
 // ends, which removes the seams Ward's plain weight leaves).
 //
-// Storage: an octree; a record lives in the deepest node whose half size is at least its
-// validity radius a R_i, so a lookup visits only nodes whose box, grown by half its size,
-// contains P.
+// Storage: an octree; a record is filed at the level whose node half size h holds its validity
+// radius (a R_i <= h < 2 a R_i), in every node of that level its domain overlaps (at most 8), so a
+// lookup tests only the records of the nodes on P's root-to-leaf path.
 //
 // Thread safety: the cache has two phases that never overlap. Reading (interpolate, covers) is
 // const and may run on any number of threads at once with no lock. Writing (insert) is done by
@@ -69,9 +69,17 @@ private:
         std::vector<uint32_t> records;
     };
     /// Calls f(record index) for the records of every node whose records, with their validity
-    /// radius scaled by domain_scale, can reach within `reach` of p.
+    /// radius scaled by domain_scale, can reach within `reach` of p (a record may come twice).
     template <typename F>
     void for_each_candidate(const Vec3& p, float domain_scale, float reach, F&& f) const;
+    /// The same, each record once.
+    template <typename F>
+    void for_each_unique_candidate(const Vec3& p, float domain_scale, float reach, F&& f) const;
+    /// The records filed in the nodes on p's root-to-leaf path: every record whose domain holds p.
+    template <typename F>
+    void for_each_on_path(const Vec3& p, F&& f) const;
+
+    static constexpr int kMaxDepth = 48;
     int32_t child_for(int32_t node, const Vec3& p);
 
     IrradianceCacheSettings settings_;
