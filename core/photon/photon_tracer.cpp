@@ -148,6 +148,9 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
     caustic.target = settings.caustic_photons;
     global.active = global.target > 0;
     caustic.active = caustic.target > 0;
+    // Room for the whole map up front: growing it while merging batches is serial copying.
+    global.photons.reserve(global.target);
+    caustic.photons.reserve(caustic.target);
     global.cap = static_cast<uint64_t>(global.target) * settings.max_emitted_per_stored;
     caustic.cap = static_cast<uint64_t>(caustic.target) * settings.max_emitted_per_stored;
 
