@@ -309,6 +309,8 @@ Bsdf::Bsdf(const Material& material, const Color& base_color, const Frame& shadi
         lobes_ |= mask_of(specular_kind_);
     }
     if (glass_weight_ > 0.0f) lobes_ |= mask_of(glass_kind_);
+    pure_lambertian_ = lobes_ == mask_of(LobeKind::Diffuse) && metallic_ <= 0.0f && glass_weight_ <= 0.0f &&
+                       specular_f90_ <= 0.0f;
 }
 
 Color Bsdf::layer_albedo(float cos_theta) const {
@@ -457,6 +459,10 @@ Color Bsdf::eval(const Vec3& wo, const Vec3& wi, TransportMode mode, LobeMask ma
     Vec3 o = frame_.to_local(wo), i = frame_.to_local(wi);
     if (o.z == 0.0f || i.z == 0.0f) return Color(0.0f);
     if (!geometry_agrees(wo, wi, o.z * i.z > 0.0f)) return Color(0.0f);
+    if (pure_lambertian_) {
+        const bool lambert = in_mask(mask, LobeKind::Diffuse) && !(mask & kExcludeLambertian);
+        return lambert && o.z * i.z > 0.0f ? diffuse_ * kInvPi : Color(0.0f);
+    }
     const bool outside = o.z > 0.0f;
     if (!outside) {
         o.z = -o.z;
@@ -469,6 +475,10 @@ float Bsdf::pdf(const Vec3& wo, const Vec3& wi, LobeMask mask) const {
     Vec3 o = frame_.to_local(wo), i = frame_.to_local(wi);
     if (o.z == 0.0f || i.z == 0.0f) return 0.0f;
     if (!geometry_agrees(wo, wi, o.z * i.z > 0.0f)) return 0.0f;
+    if (pure_lambertian_) {
+        const bool lambert = in_mask(mask, LobeKind::Diffuse) && !(mask & kExcludeLambertian);
+        return lambert && o.z * i.z > 0.0f ? std::abs(i.z) * kInvPi : 0.0f;
+    }
     const bool outside = o.z > 0.0f;
     if (!outside) {
         o.z = -o.z;
@@ -483,6 +493,21 @@ std::optional<BsdfSample> Bsdf::sample(const Vec3& wo, float u_lobe, const Vec2&
     if (!(o.z != 0.0f) || !is_finite(o)) return std::nullopt;
     const bool outside = o.z > 0.0f;
     if (!outside) o.z = -o.z;
+    if (pure_lambertian_) {
+        // Cosine-weighted sampling of f = rho / pi: weight = rho, pdf = cos / pi.
+        if (!in_mask(mask, LobeKind::Diffuse) || (mask & kExcludeLambertian)) return std::nullopt;
+        Vec3 i = sample_cosine_hemisphere(u);
+        if (!(i.z > 0.0f)) return std::nullopt;
+        const float pdf = i.z * kInvPi;
+        if (!outside) i.z = -i.z;
+        BsdfSample s;
+        s.wi = frame_.to_world(i);
+        if (!geometry_agrees(wo, s.wi, true)) return std::nullopt;
+        s.weight = diffuse_;
+        s.pdf = pdf;
+        s.kind = LobeKind::Diffuse;
+        return s;
+    }
     const SlotProbabilities slots = slot_probabilities(o, outside, mask);
 
     // Choose a slot with u_lobe; reuse the remainder of u_lobe for the reflect/refract choice.

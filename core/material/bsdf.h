@@ -145,6 +145,9 @@ private:
     LobeKind specular_kind_;  // kind of the metal/layer reflection lobe
     LobeKind glass_kind_;     // kind of the dielectric reflection/transmission lobe
     LobeMask lobes_ = 0;
+    /// Only the Lambertian lobe, with no specular layer above it (KHR_materials_specular factor 0,
+    /// not metallic, not transmissive): eval, pdf and sample take their closed forms.
+    bool pure_lambertian_ = false;
     int albedo_cell_ = -1;            // roughness cell of the layer albedo table; -1: mirror
     float albedo_cell_weight_ = 0.0f;  // interpolation weight within that cell
 };

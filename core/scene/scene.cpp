@@ -33,18 +33,21 @@ float Scene::triangle_area(uint32_t triangle) const {
                                          positions[t.z] - positions[t.x]));
 }
 
-Vec3 Scene::triangle_normal(uint32_t triangle) const {
-    const glm::uvec3& t = triangles[triangle];
-    const Vec3 c = glm::cross(positions[t.y] - positions[t.x], positions[t.z] - positions[t.x]);
-    const float len = glm::length(c);
-    return len > 0.0f && std::isfinite(len) ? c / len : Vec3(0.0f);
+void Scene::compute_triangle_normals() {
+    triangle_normals.resize(triangles.size());
+    for (size_t i = 0; i < triangles.size(); ++i) {
+        const glm::uvec3& t = triangles[i];
+        const Vec3 c = glm::cross(positions[t.y] - positions[t.x], positions[t.z] - positions[t.x]);
+        const float len = glm::length(c);
+        triangle_normals[i] = len > 0.0f && std::isfinite(len) ? c / len : Vec3(0.0f);
+    }
 }
 
 Status Scene::validate() const {
     if (normals.size() != positions.size() || uvs.size() != positions.size())
         return Error{"scene '" + name + "': per-vertex arrays differ in size"};
-    if (triangle_materials.size() != triangles.size())
-        return Error{"scene '" + name + "': per-triangle material array differs in size"};
+    if (triangle_materials.size() != triangles.size() || triangle_normals.size() != triangles.size())
+        return Error{"scene '" + name + "': per-triangle arrays differ in size"};
     for (size_t i = 0; i < positions.size(); ++i) {
         if (!is_finite(positions[i]))
             return Error{"scene '" + name + "': vertex " + std::to_string(i) +
@@ -159,6 +162,13 @@ Status SceneBuilder::add_mesh(std::span<const Vec3> positions, std::span<const V
 Expected<Scene> SceneBuilder::build() {
     for (const PunctualLight& l : scene_.lights) {
         if (l.type != PunctualLightType::Directional) scene_.bounds.extend(l.position);
+    }
+    scene_.triangle_normals.clear();
+    if (!scene_.triangles.empty()) {
+        // Validate indices before computing normals from them.
+        scene_.triangle_normals.assign(scene_.triangles.size(), Vec3(0.0f));
+        if (Status st = scene_.validate(); !st) return st.error();
+        scene_.compute_triangle_normals();
     }
     if (Status st = scene_.validate(); !st) return st.error();
     Scene out = std::move(scene_);

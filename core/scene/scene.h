@@ -88,6 +88,9 @@ struct Scene {
     std::vector<Vec2> uvs;      // per vertex, same size as positions
     std::vector<glm::uvec3> triangles;
     std::vector<uint32_t> triangle_materials;  // per triangle, index into materials
+    /// Per triangle, unit, zero for degenerate triangles; derived from the positions by
+    /// SceneBuilder::build (every ray hit needs it).
+    std::vector<Vec3> triangle_normals;
     std::vector<Material> materials;
     std::vector<Texture> textures;
     std::vector<PunctualLight> lights;
@@ -99,7 +102,11 @@ struct Scene {
     /// Base colour of a material at a texture coordinate (texture times factor).
     Color base_color(uint32_t material, const Vec2& uv) const;
     float triangle_area(uint32_t triangle) const;
-    Vec3 triangle_normal(uint32_t triangle) const;  // geometric, unit (zero for degenerate)
+    Vec3 triangle_normal(uint32_t triangle) const {  // geometric, unit (zero for degenerate)
+        return triangle_normals[triangle];
+    }
+    /// Recomputes triangle_normals from the positions (after editing them).
+    void compute_triangle_normals();
 };
 
 /// Assembles a Scene: transforms meshes into world space, generates flat normals where a mesh
