@@ -88,22 +88,7 @@ RayTracer::~RayTracer() {
 std::optional<Hit> RayTracer::intersect(const Ray& ray) const {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    RTCRayHit rayhit;
-    rayhit.ray.org_x = ray.origin.x;
-    rayhit.ray.org_y = ray.origin.y;
-    rayhit.ray.org_z = ray.origin.z;
-    rayhit.ray.dir_x = ray.direction.x;
-    rayhit.ray.dir_y = ray.direction.y;
-    rayhit.ray.dir_z = ray.direction.z;
-    rayhit.ray.tnear = ray.tmin;
-    rayhit.ray.tfar = ray.tmax;
-    rayhit.ray.time = 0.0f;
-    rayhit.ray.mask = 0xFFFFFFFFu;
-    rayhit.ray.id = 0;
-    rayhit.ray.flags = 0;
-    rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rayhit.hit.primID = RTC_INVALID_GEOMETRY_ID;
-    rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    RTCRayHit rayhit = to_rtc_rayhit(ray);
     rtcIntersect1(rtc_scene_, &context, &rayhit);
     if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
     return Hit{rayhit.ray.tfar, rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v};
@@ -112,19 +97,7 @@ std::optional<Hit> RayTracer::intersect(const Ray& ray) const {
 bool RayTracer::occluded(const Ray& ray) const {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    RTCRay r;
-    r.org_x = ray.origin.x;
-    r.org_y = ray.origin.y;
-    r.org_z = ray.origin.z;
-    r.dir_x = ray.direction.x;
-    r.dir_y = ray.direction.y;
-    r.dir_z = ray.direction.z;
-    r.tnear = ray.tmin;
-    r.tfar = ray.tmax;
-    r.time = 0.0f;
-    r.mask = 0xFFFFFFFFu;
-    r.id = 0;
-    r.flags = 0;
+    RTCRay r = to_rtc_ray(ray);
     rtcOccluded1(rtc_scene_, &context, &r);
     return r.tfar < 0.0f;  // Embree sets tfar = -inf on an occluded ray
 }

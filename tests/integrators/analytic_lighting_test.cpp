@@ -7,26 +7,13 @@
 #include "core/render/tile_renderer.h"
 #include "core/scene/builtin_scenes.h"
 
+#include "tests/support/render_fixtures.h"
+
 namespace photond {
 namespace {
 
-std::shared_ptr<EmbreeDevice> device() {
-    static std::shared_ptr<EmbreeDevice> d = EmbreeDevice::create().value();
-    return d;
-}
-
-std::shared_ptr<const RenderScene> make_render_scene(Scene scene) {
-    return RenderScene::create(device(), std::make_shared<const Scene>(std::move(scene))).value();
-}
-
-Material lambertian(Color albedo) {
-    Material m;
-    m.base_color = albedo;
-    m.metallic = 0.0f;
-    m.roughness = 1.0f;
-    m.specular = 0.0f;  // no dielectric layer: a pure Lambertian reflector
-    return m;
-}
+using test_support::lambertian;
+using test_support::make_render_scene;
 
 /// A 200 x 200 plane at y = 0 facing +y, albedo rho.
 SceneBuilder plane_scene(float rho) {

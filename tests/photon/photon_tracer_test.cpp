@@ -9,24 +9,13 @@
 #include "core/scene/builtin_scenes.h"
 #include "core/scene/shapes.h"
 
+#include "tests/support/render_fixtures.h"
+
 namespace photond {
 namespace {
 
-std::shared_ptr<EmbreeDevice> device() {
-    static std::shared_ptr<EmbreeDevice> d = EmbreeDevice::create().value();
-    return d;
-}
-
-std::shared_ptr<const RenderScene> make_render_scene(Scene scene) {
-    return RenderScene::create(device(), std::make_shared<const Scene>(std::move(scene))).value();
-}
-
-Material lambertian(Color albedo) {
-    Material m;
-    m.base_color = albedo;
-    m.specular = 0.0f;
-    return m;
-}
+using test_support::lambertian;
+using test_support::make_render_scene;
 
 /// A closed 4 x 4 x 4 room (faces inward) of albedo rho with a point light inside.
 Scene closed_room(float rho, const Vec3& light_position, const Color& intensity) {
