@@ -45,6 +45,7 @@ bench: build
 	$(BUILD)/bench/ray_throughput_bench
 	$(BUILD)/bench/photon_tracing_bench
 	$(BUILD)/bench/kd_tree_bench
+	$(BUILD)/bench/http_bench
 
 format:
 	find core protocol server clients tests bench -name '*.h' -o -name '*.cpp' | xargs clang-format -i

@@ -10,7 +10,8 @@ namespace {
 using nlohmann::json;
 
 template <size_t N>
-std::optional<size_t> index_of(const std::array<std::string_view, N>& names, std::string_view name) {
+std::optional<size_t> index_of(const std::array<std::string_view, N>& names,
+                               std::string_view name) {
     const auto it = std::find(names.begin(), names.end(), name);
     if (it == names.end()) return std::nullopt;
     return static_cast<size_t>(it - names.begin());
@@ -175,7 +176,8 @@ Expected<JobStatus> job_status_from_json(const json& d) {
             s.statistics = *it;
             // The pass order lives in the statistics; the "timings" object is sorted by name.
             for (const json& p : it->value("passes", json::array()))
-                s.timings.push_back({p.at("name").get<std::string>(), p.at("seconds").get<double>()});
+                s.timings.push_back(
+                    {p.at("name").get<std::string>(), p.at("seconds").get<double>()});
         }
         if (s.timings.empty()) {
             if (const auto it = d.find("timings"); it != d.end() && it->is_object())
@@ -257,8 +259,7 @@ json job_status_json_schema() {
             {"key", {{"type", "string"}}}}}}},
         {"statistics", {{"type", "object"}, {"description", "the render statistics"}}},
         {"job", {{"$ref", "#/components/schemas/Job"}}},
-        {"links",
-         {{"type", "object"}, {"additionalProperties", {{"type", "string"}}}}},
+        {"links", {{"type", "object"}, {"additionalProperties", {{"type", "string"}}}}},
     };
     return {{"$schema", "https://json-schema.org/draft/2020-12/schema"},
             {"title", "photond job status v1"},

@@ -39,7 +39,8 @@ Status write_file_atomically(const fs::path& path, std::string_view bytes) {
 std::optional<std::vector<uint8_t>> read_file_bytes(const fs::path& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in) return std::nullopt;
-    std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)),
+                               std::istreambuf_iterator<char>());
     if (in.bad()) return std::nullopt;
     return bytes;
 }

@@ -32,18 +32,20 @@ int64_t now_ms() {
         .count();
 }
 
-/// "20240612-101530-000042-9f3c2a1b": sortable by time, unique by the sequence number, and not
-/// guessable from another job's id thanks to 32 random bits.
+/// "20240612-101530-000042-9f3c2a1b5d7e0f64": sortable by time, and unique and not guessable
+/// from another job's id thanks to 64 random bits (daemons sharing a cache directory have
+/// sequence numbers of their own).
 std::string make_job_id(uint64_t sequence, int64_t created_ms) {
     const std::time_t seconds = static_cast<std::time_t>(created_ms / 1000);
     std::tm utc{};
     gmtime_r(&seconds, &utc);
-    static thread_local std::mt19937_64 random{std::random_device{}()};
+    std::random_device entropy;
+    const uint64_t random = (uint64_t{entropy()} << 32) ^ uint64_t { entropy() };
     char buffer[64];
-    std::snprintf(buffer, sizeof buffer, "%04d%02d%02d-%02d%02d%02d-%06llu-%08x", utc.tm_year + 1900,
-                  utc.tm_mon + 1, utc.tm_mday, utc.tm_hour, utc.tm_min, utc.tm_sec,
-                  static_cast<unsigned long long>(sequence % 1000000),
-                  static_cast<unsigned>(random() & 0xffffffffu));
+    std::snprintf(buffer, sizeof buffer, "%04d%02d%02d-%02d%02d%02d-%06llu-%016llx",
+                  utc.tm_year + 1900, utc.tm_mon + 1, utc.tm_mday, utc.tm_hour, utc.tm_min,
+                  utc.tm_sec, static_cast<unsigned long long>(sequence % 1000000),
+                  static_cast<unsigned long long>(random));
     return buffer;
 }
 
@@ -105,7 +107,8 @@ struct JobManager::Entry {
     std::optional<PixelRect> rect_of(TileIndex t) const {
         if (t.tx < 0 || t.ty < 0 || t.tx >= tiles_x || t.ty >= tiles_y) return std::nullopt;
         const int x0 = area.x0 + t.tx * tile_size, y0 = area.y0 + t.ty * tile_size;
-        return PixelRect{x0, y0, std::min(x0 + tile_size, area.x1), std::min(y0 + tile_size, area.y1)};
+        return PixelRect{x0, y0, std::min(x0 + tile_size, area.x1),
+                         std::min(y0 + tile_size, area.y1)};
     }
 
     json tile_event(TileIndex t) const {
@@ -128,8 +131,12 @@ struct JobManager::Entry {
 
 JobManager::JobManager(JobManagerOptions options, std::shared_ptr<EmbreeDevice> device,
                        PhotonMapCache* photon_maps, SceneStore* scenes, Metrics* metrics)
-    : options_(std::move(options)), device_(std::move(device)), photon_maps_(photon_maps),
-      scenes_(scenes), metrics_(metrics), store_(options_.cache_dir / "jobs") {}
+    : options_(std::move(options)),
+      device_(std::move(device)),
+      photon_maps_(photon_maps),
+      scenes_(scenes),
+      metrics_(metrics),
+      store_(options_.cache_dir / "jobs") {}
 
 JobManager::~JobManager() { shutdown(); }
 
@@ -186,16 +193,19 @@ void JobManager::restore(StoredJob stored) {
             push_event_locked(e, JobEventType::Done, protocol::to_json(e.status));
             break;
         case JobState::Failed:
-            push_event_locked(e, JobEventType::State, {{"state", "failed"}, {"reason", e.status.error}});
+            push_event_locked(e, JobEventType::State,
+                              {{"state", "failed"}, {"reason", e.status.error}});
             push_event_locked(e, JobEventType::Failed, protocol::to_json(e.status));
             break;
         case JobState::Cancelled:
             push_event_locked(e, JobEventType::State, {{"state", "cancelled"}});
             push_event_locked(e, JobEventType::Cancelled, protocol::to_json(e.status));
             break;
-        case JobState::Running: break;  // turned into failed above
+        case JobState::Running:
+            break;  // turned into failed above
     }
-    if (!e.submission.idempotency_key.empty()) idempotency_keys_[e.submission.idempotency_key] = e.id();
+    if (!e.submission.idempotency_key.empty())
+        idempotency_keys_[e.submission.idempotency_key] = e.id();
     next_sequence_ = std::max(next_sequence_, e.submission.sequence + 1);
     jobs_[e.id()] = entry;
     arrival_order_.push_back(entry);
@@ -206,7 +216,8 @@ void JobManager::start() {
     for (const std::string& problem : loaded.problems) log("skipping a stored job: " + problem);
     size_t requeued = 0;
     for (StoredJob& stored : loaded.jobs) {
-        if (stored.status.state == JobState::Queued || stored.status.state == JobState::Running) ++requeued;
+        if (stored.status.state == JobState::Queued || stored.status.state == JobState::Running)
+            ++requeued;
         restore(std::move(stored));
     }
     if (!loaded.jobs.empty())
@@ -238,10 +249,10 @@ void JobManager::check_scene(const protocol::Job& job) const {
             const auto names = builtin_scene_names();
             if (std::find(names.begin(), names.end(), scene.value) == names.end()) {
                 auto built = make_builtin_scene(scene.value);  // for its message naming the choices
-                throw ServiceError(ErrorKind::InvalidField,
-                                   built ? "unknown built-in scene '" + scene.value + "'"
-                                         : built.error().message,
-                                   "scene.builtin");
+                throw ServiceError(
+                    ErrorKind::InvalidField,
+                    built ? "unknown built-in scene '" + scene.value + "'" : built.error().message,
+                    "scene.builtin");
             }
             return;
         }
@@ -249,12 +260,14 @@ void JobManager::check_scene(const protocol::Job& job) const {
             std::error_code error;
             const fs::path root = fs::weakly_canonical(options_.scene_root, error);
             const fs::path file = fs::weakly_canonical(root / scene.value, error);
-            const auto [root_end, file_it] = std::mismatch(root.begin(), root.end(), file.begin(), file.end());
+            const auto [root_end, file_it] =
+                std::mismatch(root.begin(), root.end(), file.begin(), file.end());
             if (error || root_end != root.end() || file == root)
-                throw ServiceError(ErrorKind::InvalidField,
-                                   "'" + scene.value + "' lies outside the scene root (--scene-root " +
-                                       options_.scene_root.string() + "); give a path relative to it",
-                                   "scene.path");
+                throw ServiceError(
+                    ErrorKind::InvalidField,
+                    "'" + scene.value + "' lies outside the scene root (--scene-root " +
+                        options_.scene_root.string() + "); give a path relative to it",
+                    "scene.path");
             if (!fs::is_regular_file(file, error))
                 throw ServiceError(ErrorKind::InvalidField,
                                    "no scene file '" + scene.value + "' below the scene root (" +
@@ -264,9 +277,10 @@ void JobManager::check_scene(const protocol::Job& job) const {
         }
         case protocol::SceneRef::Kind::Id:
             if (!scenes_->contains(scene.value))
-                throw ServiceError(ErrorKind::InvalidField,
-                                   "no uploaded scene " + scene.value + " (upload it with POST /v1/scenes)",
-                                   "scene.id");
+                throw ServiceError(
+                    ErrorKind::InvalidField,
+                    "no uploaded scene " + scene.value + " (upload it with POST /v1/scenes)",
+                    "scene.id");
             return;
     }
 }
@@ -275,13 +289,17 @@ int JobManager::retry_after_seconds_locked() const {
     // The running job's expected remaining time, from its progress; a guess of 10 s without one.
     if (running_ && running_->status.started_at_ms > 0) {
         const double fraction = running_->status.progress.fraction();
-        const double elapsed = static_cast<double>(now_ms() - running_->status.started_at_ms) / 1000.0;
-        if (fraction > 0.0) return static_cast<int>(std::clamp(std::ceil(elapsed * (1.0 - fraction) / fraction), 1.0, 3600.0));
+        const double elapsed =
+            static_cast<double>(now_ms() - running_->status.started_at_ms) / 1000.0;
+        if (fraction > 0.0)
+            return static_cast<int>(
+                std::clamp(std::ceil(elapsed * (1.0 - fraction) / fraction), 1.0, 3600.0));
     }
     return 10;
 }
 
-JobManager::Submitted JobManager::submit(const protocol::Job& job, const std::string& idempotency_key) {
+JobManager::Submitted JobManager::submit(const protocol::Job& job,
+                                         const std::string& idempotency_key) {
     std::lock_guard submit_lock(submit_mutex_);
     const std::string normalized = protocol::to_json(job).dump();
     const std::string digest =
@@ -290,22 +308,24 @@ JobManager::Submitted JobManager::submit(const protocol::Job& job, const std::st
     {
         std::lock_guard lock(mutex_);
         if (!idempotency_key.empty()) {
-            if (const auto it = idempotency_keys_.find(idempotency_key); it != idempotency_keys_.end()) {
+            if (const auto it = idempotency_keys_.find(idempotency_key);
+                it != idempotency_keys_.end()) {
                 const auto& entry = jobs_.at(it->second);
                 if (entry->submission.request_digest != digest)
-                    throw ServiceError(ErrorKind::Conflict,
-                                       "Idempotency-Key '" + idempotency_key + "' was used for job " +
-                                           entry->id() + " with another job description");
+                    throw ServiceError(ErrorKind::Conflict, "Idempotency-Key '" + idempotency_key +
+                                                                "' was used for job " +
+                                                                entry->id() +
+                                                                " with another job description");
                 return {entry->status, false};
             }
         }
         if (stopping_) throw ServiceError(ErrorKind::Unavailable, "the daemon is shutting down");
         if (queue_.size() >= options_.max_queued) {
             const int retry = retry_after_seconds_locked();
-            throw ServiceError(ErrorKind::QueueFull, "the queue holds " + std::to_string(queue_.size()) +
-                                                         " jobs (--max-queued " +
-                                                         std::to_string(options_.max_queued) +
-                                                         "); retry in " + std::to_string(retry) + " s")
+            throw ServiceError(ErrorKind::QueueFull,
+                               "the queue holds " + std::to_string(queue_.size()) +
+                                   " jobs (--max-queued " + std::to_string(options_.max_queued) +
+                                   "); retry in " + std::to_string(retry) + " s")
                 .with_header("Retry-After", std::to_string(retry));
         }
         submission.sequence = next_sequence_++;
@@ -349,10 +369,12 @@ protocol::JobStatus JobManager::status(const std::string& id) const {
     return find_locked(id)->status;
 }
 
-std::vector<protocol::JobStatus> JobManager::list(std::optional<JobState> state, size_t limit) const {
+std::vector<protocol::JobStatus> JobManager::list(std::optional<JobState> state,
+                                                  size_t limit) const {
     std::vector<protocol::JobStatus> result;
     std::lock_guard lock(mutex_);
-    for (auto it = arrival_order_.rbegin(); it != arrival_order_.rend() && result.size() < limit; ++it) {
+    for (auto it = arrival_order_.rbegin(); it != arrival_order_.rend() && result.size() < limit;
+         ++it) {
         const protocol::JobStatus& s = (*it)->status;
         if (state && s.state != *state) continue;
         result.push_back(s);
@@ -379,24 +401,27 @@ protocol::JobStatus JobManager::cancel(const std::string& id, std::chrono::milli
         case JobState::Running:
             entry->cancelled_by_user = true;
             entry->cancel = true;
-            entry->changed.wait_for(lock, wait, [&] { return protocol::is_terminal(entry->status.state); });
+            entry->changed.wait_for(lock, wait,
+                                    [&] { return protocol::is_terminal(entry->status.state); });
             return entry->status;
         case JobState::Cancelled:
             return entry->status;
         case JobState::Done:
         case JobState::Failed:
-            throw ServiceError(ErrorKind::Conflict, "job " + id + " is already " +
-                                                        std::string(protocol::to_string(entry->status.state)) +
-                                                        ": there is nothing to cancel");
+            throw ServiceError(ErrorKind::Conflict,
+                               "job " + id + " is already " +
+                                   std::string(protocol::to_string(entry->status.state)) +
+                                   ": there is nothing to cancel");
     }
     return entry->status;
 }
 
-protocol::JobStatus JobManager::wait_finished(const std::string& id, std::chrono::milliseconds timeout) const {
+protocol::JobStatus JobManager::wait_finished(const std::string& id,
+                                              std::chrono::milliseconds timeout) const {
     std::unique_lock lock(mutex_);
     const auto entry = find_locked(id);
-    entry->changed.wait_for(lock, timeout,
-                            [&] { return stopping_ || protocol::is_terminal(entry->status.state); });
+    entry->changed.wait_for(
+        lock, timeout, [&] { return stopping_ || protocol::is_terminal(entry->status.state); });
     return entry->status;
 }
 
@@ -405,11 +430,13 @@ JobManager::EventBatch JobManager::wait_events(const std::string& id, uint64_t a
     std::unique_lock lock(mutex_);
     const auto entry = find_locked(id);
     const auto has_news = [&] {
-        return stopping_ || entry->events.size() > after_id || protocol::is_terminal(entry->status.state);
+        return stopping_ || entry->events.size() > after_id ||
+               protocol::is_terminal(entry->status.state);
     };
     entry->changed.wait_for(lock, timeout, has_news);
     EventBatch batch;
-    for (size_t i = after_id; i < entry->events.size(); ++i) batch.events.push_back(entry->events[i]);
+    for (size_t i = after_id; i < entry->events.size(); ++i)
+        batch.events.push_back(entry->events[i]);
     batch.ended = stopping_ || protocol::is_terminal(entry->status.state);
     return batch;
 }
@@ -419,21 +446,25 @@ JobManager::TileBatch JobManager::wait_tiles(const std::string& id, size_t from,
     std::unique_lock lock(mutex_);
     const auto entry = find_locked(id);
     entry->changed.wait_for(lock, timeout, [&] {
-        return stopping_ || entry->finished_order.size() > from || protocol::is_terminal(entry->status.state);
+        return stopping_ || entry->finished_order.size() > from ||
+               protocol::is_terminal(entry->status.state);
     });
     TileBatch batch;
-    for (size_t i = from; i < entry->finished_order.size(); ++i) batch.tiles.push_back(entry->finished_order[i]);
+    for (size_t i = from; i < entry->finished_order.size(); ++i)
+        batch.tiles.push_back(entry->finished_order[i]);
     batch.next = std::max(from, entry->finished_order.size());
     batch.ended = stopping_ || protocol::is_terminal(entry->status.state);
     return batch;
 }
 
-std::optional<JobManager::TileGeometry> JobManager::tile_geometry(const std::string& id, TileIndex tile) const {
+std::optional<JobManager::TileGeometry> JobManager::tile_geometry(const std::string& id,
+                                                                  TileIndex tile) const {
     std::lock_guard lock(mutex_);
     const auto entry = find_locked(id);
     const auto rect = entry->rect_of(tile);
     if (!rect) return std::nullopt;
-    return TileGeometry{*rect, entry->submission.job.image.width, entry->submission.job.image.height};
+    return TileGeometry{*rect, entry->submission.job.image.width,
+                        entry->submission.job.image.height};
 }
 
 std::optional<std::vector<uint8_t>> JobManager::tile_exr(const std::string& id, TileIndex tile) {
@@ -461,7 +492,8 @@ std::optional<std::vector<uint8_t>> JobManager::tile_exr(const std::string& id, 
     } else {
         layers.beauty = *pixels;
     }
-    const ExrPixelType type = job.output.pixel_type == "float" ? ExrPixelType::Float : ExrPixelType::Half;
+    const ExrPixelType type =
+        job.output.pixel_type == "float" ? ExrPixelType::Float : ExrPixelType::Half;
     auto bytes = encode_tile_exr(layers, rect, job.image.width, job.image.height, type);
     if (!bytes) throw ServiceError(ErrorKind::Internal, bytes.error().message);
     return std::move(bytes).value();
@@ -471,7 +503,8 @@ void JobManager::remember_image_locked(const std::shared_ptr<Entry>& entry) {
     std::erase(images_in_memory_, entry->id());
     images_in_memory_.push_back(entry->id());
     while (images_in_memory_.size() > options_.final_images_in_memory) {
-        if (const auto it = jobs_.find(images_in_memory_.front()); it != jobs_.end()) it->second->image.reset();
+        if (const auto it = jobs_.find(images_in_memory_.front()); it != jobs_.end())
+            it->second->image.reset();
         images_in_memory_.erase(images_in_memory_.begin());
     }
 }
@@ -498,14 +531,17 @@ fs::path JobManager::image_file(const std::string& id) const {
     const auto entry = find_locked(id);
     const protocol::JobStatus& s = entry->status;
     switch (s.state) {
-        case JobState::Done: return store_.image_path(id);
+        case JobState::Done:
+            return store_.image_path(id);
         case JobState::Failed:
             throw ServiceError(ErrorKind::Conflict, "job " + id + " failed: " + s.error);
         case JobState::Cancelled:
-            throw ServiceError(ErrorKind::Conflict, "job " + id + " was cancelled: it has no image");
+            throw ServiceError(ErrorKind::Conflict,
+                               "job " + id + " was cancelled: it has no image");
         default:
             throw ServiceError(ErrorKind::Conflict,
-                               "job " + id + " is " + std::string(protocol::to_string(s.state)) + " (" +
+                               "job " + id + " is " + std::string(protocol::to_string(s.state)) +
+                                   " (" +
                                    std::to_string(static_cast<int>(100 * s.progress.fraction())) +
                                    "% of the tiles); add ?wait=true to wait for the image");
     }
@@ -527,9 +563,13 @@ std::vector<uint8_t> JobManager::preview_png(const std::string& id) {
     if (tiles.empty() && entry->status.state != JobState::Running) {
         if (auto bytes = read_file_bytes(store_.preview_path(id))) return std::move(*bytes);
         const auto image = final_image(entry);
-        if (!image) throw ServiceError(ErrorKind::Internal, "job " + id + ": the image cannot be read");
+        if (!image)
+            throw ServiceError(ErrorKind::Internal, "job " + id + ": the image cannot be read");
         auto png = encode_png_preview(image->beauty);
         if (!png) throw ServiceError(ErrorKind::Internal, png.error().message);
+        // Made on the first request rather than with every job; kept for the next one.
+        (void)write_file_atomically(store_.preview_path(id),
+                                    {reinterpret_cast<const char*>(png->data()), png->size()});
         return std::move(png).value();
     }
     // While rendering: the finished tiles on black.
@@ -546,7 +586,8 @@ std::vector<uint8_t> JobManager::preview_png(const std::string& id) {
 
 void JobManager::fill_metrics(MetricsSnapshot& snapshot) const {
     std::lock_guard lock(mutex_);
-    for (std::string_view name : protocol::kJobStateNames) snapshot.jobs_by_state[std::string(name)] = 0;
+    for (std::string_view name : protocol::kJobStateNames)
+        snapshot.jobs_by_state[std::string(name)] = 0;
     for (const auto& [id, entry] : jobs_)
         ++snapshot.jobs_by_state[std::string(protocol::to_string(entry->status.state))];
     snapshot.queue_depth = queue_.size();
@@ -637,9 +678,10 @@ void JobManager::run(const std::shared_ptr<Entry>& entry) {
             e.status.progress.tiles_done = 0;
             e.tiles.clear();
             e.finished_order.clear();
-            push_event_locked(e, JobEventType::State,
-                              {{"state", "queued"},
-                               {"reason", "the daemon is shutting down; the job runs again when it restarts"}});
+            push_event_locked(
+                e, JobEventType::State,
+                {{"state", "queued"},
+                 {"reason", "the daemon is shutting down; the job runs again when it restarts"}});
             e.changed.notify_all();
             requeued = e.status;
         }
@@ -653,7 +695,7 @@ void JobManager::run(const std::shared_ptr<Entry>& entry) {
     }
 
     // The final image, written before the job is announced done so that it can be fetched
-    // as soon as a client hears of it.
+    // as soon as a client hears of it. (The PNG preview is made on its first request.)
     options.on_pass("writing");
     const protocol::Job& job = e.submission.job;
     ExrWriteOptions exr;
@@ -664,8 +706,6 @@ void JobManager::run(const std::shared_ptr<Entry>& entry) {
         finish(entry, JobState::Failed, written.error().message, &result->statistics);
         return;
     }
-    if (Status written = write_png_preview(store_.preview_path(e.id()), result->layers.beauty); !written)
-        log("job " + e.id() + ": " + written.error().message);
     result->statistics.passes.push_back(
         {"writing", std::chrono::duration<double>(Clock::now() - writing_started).count()});
     {
@@ -676,7 +716,8 @@ void JobManager::run(const std::shared_ptr<Entry>& entry) {
     finish(entry, JobState::Done, "", &result->statistics);
 }
 
-void JobManager::finish_locked(Entry& e, JobState state, std::string error, const RenderStatistics* statistics) {
+void JobManager::finish_locked(Entry& e, JobState state, std::string error,
+                               const RenderStatistics* statistics) {
     e.status.state = state;
     e.status.error = std::move(error);
     e.status.finished_at_ms = now_ms();
@@ -686,7 +727,8 @@ void JobManager::finish_locked(Entry& e, JobState state, std::string error, cons
         e.status.photon_cache = statistics->photon_cache;
         e.status.photon_map_key = statistics->photon_map_key;
         e.status.timings.clear();
-        for (const PassTiming& p : statistics->passes) e.status.timings.push_back({p.name, p.seconds});
+        for (const PassTiming& p : statistics->passes)
+            e.status.timings.push_back({p.name, p.seconds});
     } else if (!e.status.pass.empty()) {
         e.status.timings.push_back(
             {e.status.pass, std::chrono::duration<double>(Clock::now() - e.pass_started).count()});
@@ -714,6 +756,11 @@ void JobManager::finish_locked(Entry& e, JobState state, std::string error, cons
 
 void JobManager::finish(const std::shared_ptr<Entry>& entry, JobState state, std::string error,
                         const RenderStatistics* statistics) {
+    // Metrics first: a client that sees the job end and then scrapes /metrics finds it counted.
+    if (statistics) {
+        metrics_->record_rays(statistics->rays + statistics->shadow_rays);
+        for (const PassTiming& p : statistics->passes) metrics_->record_pass(p.name, p.seconds);
+    }
     protocol::JobStatus status;
     {
         std::lock_guard lock(mutex_);
@@ -721,16 +768,13 @@ void JobManager::finish(const std::shared_ptr<Entry>& entry, JobState state, std
         status = entry->status;
     }
     (void)store_.save_status(status);
-    if (statistics) {
-        metrics_->record_rays(statistics->rays + statistics->shadow_rays);
-        for (const PassTiming& p : statistics->passes) metrics_->record_pass(p.name, p.seconds);
-    }
     std::string line = "job " + status.id + " " + std::string(protocol::to_string(state));
     if (statistics) {
         char seconds[32];
         std::snprintf(seconds, sizeof seconds, " in %.3f s", statistics->total_seconds);
         line += seconds;
-        if (!statistics->photon_cache.empty()) line += " (photon maps: cache " + statistics->photon_cache + ")";
+        if (!statistics->photon_cache.empty())
+            line += " (photon maps: cache " + statistics->photon_cache + ")";
     }
     if (!status.error.empty()) line += ": " + status.error;
     log(line);

@@ -53,11 +53,11 @@
 namespace photond::service {
 
 struct JobManagerOptions {
-    std::filesystem::path cache_dir;   // jobs are kept under cache_dir/jobs
-    std::filesystem::path scene_root;  // {"path": ...} scenes must lie below it
-    int threads = 0;                   // render threads; 0 = every core
-    size_t max_queued = 64;            // queued jobs beyond this are refused (429)
-    size_t final_images_in_memory = 4; // finished images kept decoded for tile requests
+    std::filesystem::path cache_dir;              // jobs are kept under cache_dir/jobs
+    std::filesystem::path scene_root;             // {"path": ...} scenes must lie below it
+    int threads = 0;                              // render threads; 0 = every core
+    size_t max_queued = 64;                       // queued jobs beyond this are refused (429)
+    size_t final_images_in_memory = 4;            // finished images kept decoded for tile requests
     std::function<void(const std::string&)> log;  // one line per job event; may be empty
 };
 
@@ -91,14 +91,16 @@ public:
     /// Throws ServiceError NotFound for an unknown id (so do the members below).
     protocol::JobStatus status(const std::string& id) const;
     /// Newest first; `state` filters; job lists carry no statistics.
-    std::vector<protocol::JobStatus> list(std::optional<protocol::JobState> state, size_t limit) const;
+    std::vector<protocol::JobStatus> list(std::optional<protocol::JobState> state,
+                                          size_t limit) const;
 
     /// Cancels a queued or running job and waits up to `wait` for the render to stop. Cancelling
     /// a cancelled job again is harmless; a done or failed job gives Conflict.
     protocol::JobStatus cancel(const std::string& id, std::chrono::milliseconds wait);
 
     /// Waits up to `timeout` for the job to end (or the daemon to stop); returns its status.
-    protocol::JobStatus wait_finished(const std::string& id, std::chrono::milliseconds timeout) const;
+    protocol::JobStatus wait_finished(const std::string& id,
+                                      std::chrono::milliseconds timeout) const;
 
     struct EventBatch {
         std::vector<protocol::JobEvent> events;  // ids > the one asked for, in order
@@ -110,11 +112,12 @@ public:
 
     struct TileBatch {
         std::vector<protocol::TileIndex> tiles;  // in the order they finished
-        size_t next = 0;      // where the next call should start
-        bool ended = false;   // no tile will follow (job ended, or shutdown)
+        size_t next = 0;                         // where the next call should start
+        bool ended = false;                      // no tile will follow (job ended, or shutdown)
     };
     /// The finished tiles from position `from` of the finishing order; waits up to `timeout`.
-    TileBatch wait_tiles(const std::string& id, size_t from, std::chrono::milliseconds timeout) const;
+    TileBatch wait_tiles(const std::string& id, size_t from,
+                         std::chrono::milliseconds timeout) const;
 
     struct TileGeometry {
         PixelRect rect;
@@ -122,7 +125,8 @@ public:
         int frame_height = 0;
     };
     /// The rectangle of tile (tx, ty); nullopt outside the job's grid.
-    std::optional<TileGeometry> tile_geometry(const std::string& id, protocol::TileIndex tile) const;
+    std::optional<TileGeometry> tile_geometry(const std::string& id,
+                                              protocol::TileIndex tile) const;
     /// One finished tile as a small EXR (encode_tile_exr); nullopt while it is not finished (or
     /// its pixels were freed: cancelled or failed job).
     std::optional<std::vector<uint8_t>> tile_exr(const std::string& id, protocol::TileIndex tile);
@@ -141,7 +145,7 @@ private:
     using Clock = std::chrono::steady_clock;
 
     std::shared_ptr<Entry> find_locked(const std::string& id) const;  // throws NotFound
-    void check_scene(const protocol::Job& job) const;                  // throws InvalidField
+    void check_scene(const protocol::Job& job) const;                 // throws InvalidField
     int retry_after_seconds_locked() const;
     void push_event_locked(Entry& entry, protocol::JobEventType type, nlohmann::json data);
     void worker_loop();
@@ -172,7 +176,8 @@ private:
     std::set<std::pair<std::pair<int, uint64_t>, std::string>> queue_;
     std::unordered_map<std::string, std::string> idempotency_keys_;  // key -> job id
     std::shared_ptr<Entry> running_;
-    std::vector<std::string> images_in_memory_;  // ids of done jobs holding their image, oldest first
+    std::vector<std::string>
+        images_in_memory_;  // ids of done jobs holding their image, oldest first
     uint64_t next_sequence_ = 1;
     std::mutex submit_mutex_;  // serialises submissions (checks, disk write, insertion)
 

@@ -35,13 +35,16 @@ JobStore::JobStore(fs::path directory) : directory_(std::move(directory)) {
 
 fs::path JobStore::job_directory(const std::string& id) const { return directory_ / id; }
 fs::path JobStore::image_path(const std::string& id) const { return directory_ / id / "image.exr"; }
-fs::path JobStore::preview_path(const std::string& id) const { return directory_ / id / "preview.png"; }
+fs::path JobStore::preview_path(const std::string& id) const {
+    return directory_ / id / "preview.png";
+}
 
 Status JobStore::save_submission(const JobSubmission& s) {
     std::error_code error;
     fs::create_directories(job_directory(s.id), error);
     if (error)
-        return Error{job_directory(s.id).string() + ": cannot be created (" + error.message() + ")"};
+        return Error{job_directory(s.id).string() + ": cannot be created (" + error.message() +
+                     ")"};
     const json document = {{"id", s.id},
                            {"job", protocol::to_json(s.job)},
                            {"sequence", s.sequence},
@@ -59,7 +62,8 @@ Status JobStore::save_status(const protocol::JobStatus& status) {
 JobStore::Loaded JobStore::load_all() const {
     Loaded loaded;
     std::error_code error;
-    for (fs::directory_iterator it(directory_, error), end; !error && it != end; it.increment(error)) {
+    for (fs::directory_iterator it(directory_, error), end; !error && it != end;
+         it.increment(error)) {
         if (!it->is_directory()) continue;
         const fs::path dir = it->path();
         auto submission_json = read_json(dir / "job.json");
@@ -78,17 +82,20 @@ JobStore::Loaded JobStore::load_all() const {
             s.job = std::move(job).value();
             s.sequence = submission_json->at("sequence").get<uint64_t>();
             s.created_at_ms =
-                protocol::parse_timestamp(submission_json->value("created_at", std::string())).value_or(0);
+                protocol::parse_timestamp(submission_json->value("created_at", std::string()))
+                    .value_or(0);
             s.idempotency_key = submission_json->value("idempotency_key", std::string());
             s.request_digest = submission_json->value("request_digest", std::string());
-            if (s.id != dir.filename().string()) throw std::runtime_error("id does not match the directory");
+            if (s.id != dir.filename().string())
+                throw std::runtime_error("id does not match the directory");
         } catch (const std::exception& e) {
             loaded.problems.push_back((dir / "job.json").string() + ": " + e.what());
             continue;
         }
         auto status = protocol::job_status_from_json(*status_json);
         if (!status) {
-            loaded.problems.push_back((dir / "status.json").string() + ": " + status.error().message);
+            loaded.problems.push_back((dir / "status.json").string() + ": " +
+                                      status.error().message);
             continue;
         }
         stored.status = std::move(status).value();

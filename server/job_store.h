@@ -3,7 +3,7 @@
 //                                      was submitted (sequence, Idempotency-Key, digest)
 //   <cache-dir>/jobs/<id>/status.json  the last status document (protocol::to_json)
 //   <cache-dir>/jobs/<id>/image.exr    the final image (tiled OpenEXR, as `photond render`)
-//   <cache-dir>/jobs/<id>/preview.png  its sRGB preview
+//   <cache-dir>/jobs/<id>/preview.png  its sRGB preview, made on the first request
 // Every file is written to a temporary name and renamed, so a crash leaves the old or the new
 // version, never half of one.
 //
@@ -26,10 +26,10 @@ namespace photond::service {
 struct JobSubmission {
     std::string id;
     protocol::Job job;
-    uint64_t sequence = 0;         // arrival order, unique per cache directory's history
+    uint64_t sequence = 0;  // arrival order, unique per cache directory's history
     int64_t created_at_ms = 0;
-    std::string idempotency_key;   // empty when the request had none
-    std::string request_digest;    // SHA-256 of the normalized job, for Idempotency-Key checks
+    std::string idempotency_key;  // empty when the request had none
+    std::string request_digest;   // SHA-256 of the normalized job, for Idempotency-Key checks
 };
 
 struct StoredJob {

@@ -67,8 +67,10 @@ std::string Metrics::render(const MetricsSnapshot& s) const {
     for (const auto& [pass, h] : pass_seconds_) {
         const std::string label = "pass=\"" + pass + "\"";
         for (size_t i = 0; i < kPassBuckets.size(); ++i)
-            sample(out, "photond_pass_seconds_bucket{" + label + ",le=\"" + number(kPassBuckets[i]) + "\"}",
-                   h.buckets[i]);
+            sample(
+                out,
+                "photond_pass_seconds_bucket{" + label + ",le=\"" + number(kPassBuckets[i]) + "\"}",
+                h.buckets[i]);
         sample(out, "photond_pass_seconds_bucket{" + label + ",le=\"+Inf\"}", h.count);
         out += "photond_pass_seconds_sum{" + label + "} " + number(h.sum) + "\n";
         sample(out, "photond_pass_seconds_count{" + label + "}", h.count);

@@ -37,7 +37,7 @@ public:
     std::string render(const MetricsSnapshot& snapshot) const;
 
     /// Upper bounds of the pass-duration histogram buckets, in seconds.
-    static constexpr std::array<double, 10> kPassBuckets{0.001, 0.01, 0.05, 0.1, 0.5,
+    static constexpr std::array<double, 10> kPassBuckets{0.001, 0.01, 0.05, 0.1,   0.5,
                                                          1.0,   5.0,  30.0, 120.0, 600.0};
 
 private:

@@ -18,7 +18,9 @@ constexpr const char* kExtension = ".pm";
 
 PhotonMapCache::PhotonMapCache(fs::path directory, size_t memory_budget_bytes,
                                std::function<void(const std::string&)> log)
-    : directory_(std::move(directory)), memory_budget_bytes_(memory_budget_bytes), log_(std::move(log)) {
+    : directory_(std::move(directory)),
+      memory_budget_bytes_(memory_budget_bytes),
+      log_(std::move(log)) {
     std::error_code ignored;
     fs::create_directories(directory_, ignored);
 }
@@ -28,7 +30,9 @@ bool PhotonMapCache::is_valid_key(std::string_view key) {
     return std::regex_match(key.begin(), key.end(), pattern);
 }
 
-fs::path PhotonMapCache::file_of(const std::string& key) const { return directory_ / (key + kExtension); }
+fs::path PhotonMapCache::file_of(const std::string& key) const {
+    return directory_ / (key + kExtension);
+}
 
 void PhotonMapCache::log(const std::string& line) const {
     if (log_) log_(line);
@@ -141,7 +145,8 @@ std::optional<std::vector<uint8_t>> PhotonMapCache::export_maps(const std::strin
 }
 
 Expected<bool> PhotonMapCache::import_maps(const std::string& key, std::span<const uint8_t> bytes) {
-    if (!is_valid_key(key)) return Error{"'" + key + "' is not a photon-map key (pm1-<64 hex digits>)"};
+    if (!is_valid_key(key))
+        return Error{"'" + key + "' is not a photon-map key (pm1-<64 hex digits>)"};
     auto maps = deserialize_photon_maps(bytes, key);
     if (!maps) return maps.error();
     auto shared = std::make_shared<const PhotonMaps>(std::move(maps).value());
@@ -167,7 +172,8 @@ std::vector<std::string> PhotonMapCache::keys() const {
         for (const auto& [key, entry] : entries_) keys.insert(key);
     }
     std::error_code error;
-    for (fs::directory_iterator it(directory_, error), end; !error && it != end; it.increment(error)) {
+    for (fs::directory_iterator it(directory_, error), end; !error && it != end;
+         it.increment(error)) {
         const fs::path& path = it->path();
         if (path.extension() != kExtension) continue;
         const std::string key = path.stem().string();

@@ -61,9 +61,9 @@ public:
     std::vector<std::string> keys() const;
 
     struct Counters {
-        uint64_t hits = 0;           // get_or_build answered from memory or disk
-        uint64_t misses = 0;         // get_or_build traced the maps
-        uint64_t memory_bytes = 0;   // bytes of the maps held in memory now
+        uint64_t hits = 0;          // get_or_build answered from memory or disk
+        uint64_t misses = 0;        // get_or_build traced the maps
+        uint64_t memory_bytes = 0;  // bytes of the maps held in memory now
         uint64_t memory_entries = 0;
         uint64_t corrupt_files = 0;  // files on disk refused and moved aside
     };
@@ -96,7 +96,7 @@ private:
         std::list<std::string>::iterator lru_position;
     };
     std::unordered_map<std::string, Entry> entries_;
-    std::list<std::string> lru_;  // front = most recently used
+    std::list<std::string> lru_;      // front = most recently used
     std::set<std::string> building_;  // keys being traced (or read from disk) now
     Counters counters_;
 };

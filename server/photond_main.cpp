@@ -5,6 +5,7 @@
 
 #include "server/image_commands.h"
 #include "server/render_command.h"
+#include "server/serve_command.h"
 
 namespace {
 
@@ -12,6 +13,7 @@ constexpr const char* kUsage =
     "usage: photond <command> [options]\n"
     "commands:\n"
     "  render    render one job offline and write an OpenEXR (photond render --help)\n"
+    "  serve     run the render daemon: HTTP API v1 (photond serve --help)\n"
     "  compare   error of an EXR against a reference EXR (relMSE, RMSE, p99, bias)\n"
     "  average   mean of several EXRs (independent renders), for converged references\n"
     "  version   print the version\n";
@@ -27,6 +29,7 @@ int main(int argc, char** argv) {
     const std::string command = args[0];
     const std::span<const std::string> rest(args.data() + 1, args.size() - 1);
     if (command == "render") return photond::service::run_render_command(rest);
+    if (command == "serve") return photond::service::run_serve_command(rest);
     if (command == "compare") return photond::service::run_compare_command(rest);
     if (command == "average") return photond::service::run_average_command(rest);
     if (command == "version" || command == "--version") {

@@ -16,13 +16,17 @@ using nlohmann::json;
 
 constexpr std::string_view kIdPrefix = "sha256:";
 
-std::string hex_of(const std::string& normalized_id) { return normalized_id.substr(kIdPrefix.size()); }
-
-bool is_glb(std::span<const uint8_t> bytes) {
-    return bytes.size() >= 4 && bytes[0] == 'g' && bytes[1] == 'l' && bytes[2] == 'T' && bytes[3] == 'F';
+std::string hex_of(const std::string& normalized_id) {
+    return normalized_id.substr(kIdPrefix.size());
 }
 
-SceneInfo describe(const Scene& scene, const std::string& id, const std::string& format, uint64_t bytes) {
+bool is_glb(std::span<const uint8_t> bytes) {
+    return bytes.size() >= 4 && bytes[0] == 'g' && bytes[1] == 'l' && bytes[2] == 'T' &&
+           bytes[3] == 'F';
+}
+
+SceneInfo describe(const Scene& scene, const std::string& id, const std::string& format,
+                   uint64_t bytes) {
     SceneInfo info;
     info.id = id;
     info.format = format;
@@ -60,8 +64,10 @@ std::optional<SceneInfo> info_from_json(const json& d) {
         if (d.contains("bounds")) {
             const auto& lower = d["bounds"].at("min");
             const auto& upper = d["bounds"].at("max");
-            info.bounds.lower = Vec3(lower[0].get<float>(), lower[1].get<float>(), lower[2].get<float>());
-            info.bounds.upper = Vec3(upper[0].get<float>(), upper[1].get<float>(), upper[2].get<float>());
+            info.bounds.lower =
+                Vec3(lower[0].get<float>(), lower[1].get<float>(), lower[2].get<float>());
+            info.bounds.upper =
+                Vec3(upper[0].get<float>(), upper[1].get<float>(), upper[2].get<float>());
         }
         return info;
     } catch (const json::exception&) {
@@ -84,7 +90,8 @@ json to_json(const SceneInfo& info) {
                      {"emissive_triangles", info.emissive_triangles},
                      {"cameras", info.cameras}};
     if (!info.bounds.empty())
-        document["bounds"] = {{"min", vec_json(info.bounds.lower)}, {"max", vec_json(info.bounds.upper)}};
+        document["bounds"] = {{"min", vec_json(info.bounds.lower)},
+                              {"max", vec_json(info.bounds.upper)}};
     return document;
 }
 
@@ -115,7 +122,8 @@ fs::path SceneStore::metadata_file_of(const std::string& normalized_id) const {
 }
 
 Expected<SceneStore::Added> SceneStore::add(std::span<const uint8_t> bytes) {
-    if (bytes.empty()) return Error{"the upload is empty: send a .glb or a self-contained .gltf as the body"};
+    if (bytes.empty())
+        return Error{"the upload is empty: send a .glb or a self-contained .gltf as the body"};
     const std::string id = std::string(kIdPrefix) + sha256_hex(bytes);
     if (auto existing = info(id)) return Added{*existing, false};
 
@@ -160,7 +168,8 @@ std::optional<SceneInfo> SceneStore::info(const std::string& id) {
     if (!bytes) return std::nullopt;
     auto scene = load_gltf_memory(*bytes, file->filename().string());
     if (!scene) return std::nullopt;
-    return describe(*scene, *normalized, file->extension() == ".glb" ? "glb" : "gltf", bytes->size());
+    return describe(*scene, *normalized, file->extension() == ".glb" ? "glb" : "gltf",
+                    bytes->size());
 }
 
 bool SceneStore::remove(const std::string& id) {
@@ -181,7 +190,8 @@ std::vector<SceneInfo> SceneStore::list() {
     std::vector<SceneInfo> scenes;
     std::error_code error;
     std::vector<std::string> ids;
-    for (fs::directory_iterator it(directory_, error), end; !error && it != end; it.increment(error)) {
+    for (fs::directory_iterator it(directory_, error), end; !error && it != end;
+         it.increment(error)) {
         const fs::path& path = it->path();
         if (path.extension() != ".glb" && path.extension() != ".gltf") continue;
         if (auto id = normalize_id(path.stem().string())) ids.push_back(*id);
@@ -194,7 +204,8 @@ std::vector<SceneInfo> SceneStore::list() {
 
 Expected<std::shared_ptr<const Scene>> SceneStore::lookup(const std::string& id) {
     const auto normalized = normalize_id(id);
-    if (!normalized) return Error{"scene.id: '" + id + "' is not a scene id (sha256:<64 hex digits>)"};
+    if (!normalized)
+        return Error{"scene.id: '" + id + "' is not a scene id (sha256:<64 hex digits>)"};
     {
         std::lock_guard lock(mutex_);
         for (auto it = loaded_.begin(); it != loaded_.end(); ++it) {
@@ -204,7 +215,9 @@ Expected<std::shared_ptr<const Scene>> SceneStore::lookup(const std::string& id)
         }
     }
     const auto file = file_of(*normalized);
-    if (!file) return Error{"scene.id: no uploaded scene " + *normalized + " (upload it with POST /v1/scenes)"};
+    if (!file)
+        return Error{"scene.id: no uploaded scene " + *normalized +
+                     " (upload it with POST /v1/scenes)"};
     auto bytes = read_file_bytes(*file);
     if (!bytes) return Error{"scene.id: " + file->string() + " cannot be read"};
     auto scene = load_gltf_memory(*bytes, *normalized);

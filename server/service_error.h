@@ -34,7 +34,9 @@ std::string error_type_uri(ErrorKind kind);
 class ServiceError : public std::runtime_error {
 public:
     ServiceError(ErrorKind kind, std::string detail, std::string field = {})
-        : std::runtime_error(detail), kind_(kind), detail_(std::move(detail)),
+        : std::runtime_error(detail),
+          kind_(kind),
+          detail_(std::move(detail)),
           field_(std::move(field)) {}
 
     ErrorKind kind() const { return kind_; }

@@ -37,8 +37,11 @@ Color PhotonMap::estimate_radiance(const Vec3& p, const Vec3& normal, const Bsdf
     const float max_radius = options.max_radius > 0.0f ? options.max_radius
                                                        : std::numeric_limits<float>::infinity();
     tree_.k_nearest(p, options.k, max_radius, found);
-    if (found.size() < kMinPhotonsPerEstimate || !(found.radius2 > 0.0f)) return Color(0.0f);
-    const double r = std::sqrt(estimate_radius2(found, options.k, max_radius));
+    // The estimate's own radius decides (a pile of photons at p inside a finite search ball has
+    // one); zero only when k photons sit exactly at p, where the density is undefined.
+    const double radius2 = estimate_radius2(found, options.k, max_radius);
+    if (found.size() < kMinPhotonsPerEstimate || !(radius2 > 0.0)) return Color(0.0f);
+    const double r = std::sqrt(radius2);
     // Cone filter weight w = 1 - d / (k_cone r), normalised by 1 - 2 / (3 k_cone) (Jensen 2001).
     constexpr double kCone = 1.1;
     DVec3 sum(0.0);
@@ -63,8 +66,8 @@ Color PhotonMap::estimate_irradiance(const Vec3& p, const Vec3& normal, uint32_t
     KnnResult& found = thread_scratch();
     max_radius = max_radius > 0.0f ? max_radius : std::numeric_limits<float>::infinity();
     tree_.k_nearest(p, k, max_radius, found);
-    if (found.size() < kMinPhotonsPerEstimate || !(found.radius2 > 0.0f)) return Color(0.0f);
-    const double radius2 = estimate_radius2(found, k, max_radius);
+    const double radius2 = estimate_radius2(found, k, max_radius);  // see estimate_radiance
+    if (found.size() < kMinPhotonsPerEstimate || !(radius2 > 0.0)) return Color(0.0f);
     DVec3 sum(0.0);
     for (const KnnNeighbor& n : found.neighbors) {
         const Photon& photon = tree_.photon(n.index);

@@ -1,0 +1,664 @@
+#include "server/http_server.h"
+
+#include <httplib.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <random>
+#include <regex>
+#include <set>
+#include <vector>
+
+#include "protocol/job.h"
+#include "protocol/job_status.h"
+#include "server/job_manager.h"
+#include "server/metrics.h"
+#include "server/openapi.h"
+#include "server/photon_map_cache.h"
+#include "server/scene_store.h"
+#include "server/service_error.h"
+
+namespace photond::service {
+namespace {
+
+using httplib::Request;
+using httplib::Response;
+using nlohmann::json;
+using Handler = std::function<void(const Request&, Response&)>;
+
+constexpr const char* kJsonType = "application/json";
+constexpr const char* kProblemType = "application/problem+json";
+constexpr const char* kExrType = "image/x-exr";
+constexpr std::string_view kIdPattern = "([A-Za-z0-9_-]{1,128})";
+
+// ---------------------------------------------------------------------------------------------
+// Errors: the one place where failures become HTTP responses.
+
+void write_problem(Response& res, ErrorKind kind, const std::string& detail,
+                   const std::string& field, const std::string& instance) {
+    protocol::Problem problem;
+    problem.type = error_type_uri(kind);
+    problem.title = error_title(kind);
+    problem.status = http_status(kind);
+    problem.detail = detail;
+    problem.field = field;
+    problem.instance = instance;
+    res.status = problem.status;
+    res.set_content(protocol::to_json(problem).dump(2) + "\n", kProblemType);
+}
+
+void write_problem(Response& res, const ServiceError& error, const Request& req) {
+    write_problem(res, error.kind(), error.detail(), error.field(), req.path);
+    for (const auto& [name, value] : error.headers()) res.set_header(name, value);
+}
+
+/// Problems for the statuses cpp-httplib sets itself, before any handler ran.
+ErrorKind kind_of_status(int status) {
+    switch (status) {
+        case 400:
+            return ErrorKind::MalformedRequest;
+        case 401:
+            return ErrorKind::Unauthorized;
+        case 404:
+            return ErrorKind::NotFound;
+        case 405:
+            return ErrorKind::MethodNotAllowed;
+        case 409:
+            return ErrorKind::Conflict;
+        case 413:
+            return ErrorKind::PayloadTooLarge;
+        case 422:
+            return ErrorKind::InvalidField;
+        case 429:
+            return ErrorKind::QueueFull;
+        case 503:
+            return ErrorKind::Unavailable;
+        default:
+            return ErrorKind::Internal;
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Small decoding and encoding helpers
+
+void send_json(Response& res, const json& document, int status = 200) {
+    res.status = status;
+    res.set_content(document.dump(2) + "\n", kJsonType);
+}
+
+void send_bytes(Response& res, std::vector<uint8_t> bytes, const char* type) {
+    res.set_content(reinterpret_cast<const char*>(bytes.data()), bytes.size(), type);
+}
+
+template <class T>
+std::optional<T> parse_number(std::string_view text) {
+    T value{};
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+    if (error != std::errc() || end != text.data() + text.size()) return std::nullopt;
+    return value;
+}
+
+bool is_true(const std::string& value) { return value == "true" || value == "1" || value == "yes"; }
+
+/// Constant-time comparison, so that the token cannot be guessed byte by byte from timings.
+bool same_secret(std::string_view given, std::string_view expected) {
+    if (expected.empty()) return false;
+    unsigned char difference = given.size() == expected.size() ? 0 : 1;
+    for (size_t i = 0; i < given.size(); ++i)
+        difference |= static_cast<unsigned char>(given[i] ^ expected[i % expected.size()]);
+    return difference == 0;
+}
+
+protocol::Job decode_job(const std::string& body) {
+    const json document = json::parse(body, nullptr, false);
+    if (document.is_discarded()) {
+        // Parsed again for the message with line and column.
+        const auto parsed = protocol::parse_job_text_detailed(body);
+        const auto* error = std::get_if<protocol::FieldError>(&parsed);
+        throw ServiceError(ErrorKind::MalformedRequest,
+                           error ? error->message : std::string("malformed JSON"));
+    }
+    auto parsed = protocol::parse_job_detailed(document);
+    if (auto* error = std::get_if<protocol::FieldError>(&parsed))
+        throw ServiceError(ErrorKind::InvalidField, protocol::describe(*error), error->path);
+    return std::get<protocol::Job>(std::move(parsed));
+}
+
+std::string random_boundary() {
+    static thread_local std::mt19937_64 random{std::random_device{}()};
+    char buffer[40];
+    std::snprintf(buffer, sizeof buffer, "photond-tiles-%016llx",
+                  static_cast<unsigned long long>(random()));
+    return buffer;
+}
+
+std::string rect_header(const PixelRect& r) {
+    return std::to_string(r.x0) + "," + std::to_string(r.y0) + "," + std::to_string(r.x1) + "," +
+           std::to_string(r.y1);
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+struct HttpServer::Impl {
+    HttpServerOptions options;
+    HttpServices services;
+    httplib::Server server;
+
+    struct Route {
+        std::string method;
+        std::string pattern;
+        Handler handler;
+        bool open = false;  // served without the bearer token (health checks)
+    };
+    std::vector<Route> routes;
+    std::vector<std::pair<std::regex, std::set<std::string>>> known_paths;  // for 405 answers
+
+    Impl(HttpServerOptions o, HttpServices s) : options(std::move(o)), services(s) {}
+
+    void log(const std::string& line) const {
+        if (options.log) options.log(line);
+    }
+
+    void route(std::string method, std::string pattern, Handler handler, bool open = false) {
+        routes.push_back({std::move(method), std::move(pattern), std::move(handler), open});
+    }
+
+    void check_token(const Request& req) const {
+        if (options.token.empty()) return;
+        const std::string header = req.get_header_value("Authorization");
+        constexpr std::string_view kScheme = "Bearer ";
+        if (header.empty())
+            throw ServiceError(
+                ErrorKind::Unauthorized,
+                "this daemon needs a bearer token: send 'Authorization: Bearer <token>'")
+                .with_header("WWW-Authenticate", "Bearer realm=\"photond\"");
+        if (header.size() <= kScheme.size() ||
+            !std::equal(kScheme.begin(), kScheme.end(), header.begin(),
+                        [](char a, char b) { return std::tolower(a) == std::tolower(b); }) ||
+            !same_secret(std::string_view(header).substr(kScheme.size()), options.token))
+            throw ServiceError(ErrorKind::Unauthorized, "the bearer token is not valid")
+                .with_header("WWW-Authenticate",
+                             "Bearer realm=\"photond\", error=\"invalid_token\"");
+    }
+
+    void register_routes();
+    void install();
+
+    // Handlers, in the order of PRODUCT.md.
+    void submit_job(const Request& req, Response& res);
+    void list_jobs(const Request& req, Response& res);
+    void get_job(const Request& req, Response& res);
+    void cancel_job(const Request& req, Response& res);
+    void job_events(const Request& req, Response& res);
+    void job_tile(const Request& req, Response& res);
+    void job_tile_stream(const Request& req, Response& res);
+    void job_image(const Request& req, Response& res);
+    void job_preview(const Request& req, Response& res);
+    void upload_scene(const Request& req, Response& res);
+    void list_scenes(const Request& req, Response& res);
+    void get_scene(const Request& req, Response& res);
+    void delete_scene(const Request& req, Response& res);
+    void list_photon_maps(const Request& req, Response& res);
+    void export_photon_maps(const Request& req, Response& res);
+    void import_photon_maps(const Request& req, Response& res);
+    void healthz(const Request& req, Response& res);
+    void readyz(const Request& req, Response& res);
+    void metrics(const Request& req, Response& res);
+    void openapi(const Request& req, Response& res);
+};
+
+void HttpServer::Impl::register_routes() {
+    const std::string job = "/v1/jobs/" + std::string(kIdPattern);
+    auto bind_handler = [this](void (Impl::*member)(const Request&, Response&)) -> Handler {
+        return [this, member](const Request& req, Response& res) { (this->*member)(req, res); };
+    };
+    route("POST", "/v1/jobs", bind_handler(&Impl::submit_job));
+    route("GET", "/v1/jobs", bind_handler(&Impl::list_jobs));
+    route("GET", job, bind_handler(&Impl::get_job));
+    route("DELETE", job, bind_handler(&Impl::cancel_job));
+    route("GET", job + "/events", bind_handler(&Impl::job_events));
+    route("GET", job + "/tiles", bind_handler(&Impl::job_tile_stream));
+    route("GET", job + "/tiles/([0-9]{1,9})/([0-9]{1,9})\\.exr", bind_handler(&Impl::job_tile));
+    route("GET", job + "/image\\.exr", bind_handler(&Impl::job_image));
+    route("GET", job + "/preview\\.png", bind_handler(&Impl::job_preview));
+    route("POST", "/v1/scenes", bind_handler(&Impl::upload_scene));
+    route("GET", "/v1/scenes", bind_handler(&Impl::list_scenes));
+    route("GET", "/v1/scenes/([^/]+)", bind_handler(&Impl::get_scene));
+    route("DELETE", "/v1/scenes/([^/]+)", bind_handler(&Impl::delete_scene));
+    route("GET", "/v1/photon-maps", bind_handler(&Impl::list_photon_maps));
+    route("GET", "/v1/photon-maps/([^/]+)", bind_handler(&Impl::export_photon_maps));
+    route("PUT", "/v1/photon-maps/([^/]+)", bind_handler(&Impl::import_photon_maps));
+    route("GET", "/healthz", bind_handler(&Impl::healthz), /*open=*/true);
+    route("GET", "/readyz", bind_handler(&Impl::readyz), /*open=*/true);
+    route("GET", "/metrics", bind_handler(&Impl::metrics));
+    route("GET", "/v1/openapi.json", bind_handler(&Impl::openapi));
+}
+
+/// Hands the routes to cpp-httplib, each wrapped with the token check, and answers 405 (with
+/// Allow) for the other methods on a known path.
+void HttpServer::Impl::install() {
+    std::map<std::string, std::set<std::string>> methods_of;  // pattern -> methods
+    for (const Route& r : routes) methods_of[r.pattern].insert(r.method);
+    auto add = [this](const std::string& method, const std::string& pattern, Handler handler) {
+        if (method == "GET")
+            server.Get(pattern, std::move(handler));
+        else if (method == "POST")
+            server.Post(pattern, std::move(handler));
+        else if (method == "PUT")
+            server.Put(pattern, std::move(handler));
+        else if (method == "PATCH")
+            server.Patch(pattern, std::move(handler));
+        else if (method == "DELETE")
+            server.Delete(pattern, std::move(handler));
+    };
+    for (const Route& r : routes) {
+        add(r.method, r.pattern,
+            [this, handler = r.handler, open = r.open](const Request& req, Response& res) {
+                if (!open) check_token(req);
+                handler(req, res);
+            });
+    }
+    for (const auto& [pattern, methods] : methods_of) {
+        std::string allow;
+        for (const std::string& m : methods) allow += (allow.empty() ? "" : ", ") + m;
+        for (const char* method : {"GET", "POST", "PUT", "PATCH", "DELETE"}) {
+            if (methods.contains(method)) continue;
+            add(method, pattern, [allow, method](const Request&, Response&) {
+                throw ServiceError(ErrorKind::MethodNotAllowed,
+                                   std::string(method) + " is not allowed here; allowed: " + allow)
+                    .with_header("Allow", allow);
+            });
+        }
+    }
+
+    server.set_exception_handler(
+        [this](const Request& req, Response& res, std::exception_ptr error) {
+            try {
+                std::rethrow_exception(error);
+            } catch (const ServiceError& e) {
+                write_problem(res, e, req);
+            } catch (const std::exception& e) {
+                log("internal error on " + req.method + " " + req.path + ": " + e.what());
+                write_problem(res, ErrorKind::Internal, e.what(), "", req.path);
+            } catch (...) {
+                log("internal error on " + req.method + " " + req.path);
+                write_problem(res, ErrorKind::Internal, "unknown error", "", req.path);
+            }
+        });
+    // Errors cpp-httplib answers by itself: no route (404), body too large (413), a malformed
+    // request (400; also a PUT without a body). A response a handler wrote already has a body and
+    // is left alone. A known path with a method it does not serve is a 405 whatever httplib said.
+    for (const auto& [pattern, methods] : methods_of)
+        known_paths.push_back({std::regex(pattern), methods});
+    server.set_error_handler(httplib::Server::HandlerWithResponse([this](const Request& req,
+                                                                         Response& res) {
+        if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
+        int status = res.status;
+        std::string detail;
+        for (const auto& [pattern, methods] : known_paths) {
+            if (!std::regex_match(req.path, pattern) || methods.contains(req.method)) continue;
+            std::string allow;
+            for (const std::string& m : methods) allow += (allow.empty() ? "" : ", ") + m;
+            status = 405;
+            detail = req.method + " is not allowed here; allowed: " + allow;
+            res.set_header("Allow", allow);
+            break;
+        }
+        if (detail.empty()) {
+            switch (status) {
+                case 404:
+                    detail =
+                        "no route for " + req.method + " " + req.path + " (see /v1/openapi.json)";
+                    break;
+                case 413:
+                    detail = "the request body exceeds the limit of " +
+                             std::to_string(options.max_body_bytes >> 20) + " MiB (--max-body-mb)";
+                    break;
+                case 400:
+                    detail = req.has_header("Content-Length") || req.has_header("Transfer-Encoding")
+                                 ? "malformed HTTP request"
+                                 : "malformed HTTP request (a " + req.method +
+                                       " needs a body with Content-Length or chunked encoding)";
+                    break;
+                default:
+                    detail = "HTTP status " + std::to_string(status);
+                    break;
+            }
+        }
+        write_problem(res, kind_of_status(status), detail, "", req.path);
+        res.status = status;
+        return httplib::Server::HandlerResponse::Handled;
+    }));
+    server.set_logger([this](const Request& req, const Response& res) {
+        services.metrics.record_response(res.status);
+        if (options.access_log) log(req.method + " " + req.path + " " + std::to_string(res.status));
+    });
+    server.set_payload_max_length(options.max_body_bytes);
+    server.set_keep_alive_timeout(2);
+    server.set_read_timeout(30);
+    server.set_write_timeout(30);
+    const int threads = std::max(options.http_threads, 4);
+    server.new_task_queue = [threads] {
+        return new httplib::ThreadPool(static_cast<size_t>(threads));
+    };
+}
+
+// ---------------------------------------------------------------------------------------------
+// Jobs
+
+void HttpServer::Impl::submit_job(const Request& req, Response& res) {
+    const protocol::Job job = decode_job(req.body);
+    const std::string key = req.get_header_value("Idempotency-Key");
+    if (key.size() > 256)
+        throw ServiceError(ErrorKind::MalformedRequest,
+                           "Idempotency-Key: longer than 256 characters");
+    const JobManager::Submitted submitted = services.jobs.submit(job, key);
+    res.set_header("Location", "/v1/jobs/" + submitted.status.id);
+    send_json(res, protocol::to_json(submitted.status), submitted.created ? 202 : 200);
+}
+
+void HttpServer::Impl::list_jobs(const Request& req, Response& res) {
+    std::optional<protocol::JobState> state;
+    if (req.has_param("state")) {
+        state = protocol::parse_job_state(req.get_param_value("state"));
+        if (!state)
+            throw ServiceError(ErrorKind::MalformedRequest,
+                               "state: expected queued, running, done, failed or cancelled");
+    }
+    size_t limit = 1000;
+    if (req.has_param("limit")) {
+        const auto value = parse_number<size_t>(req.get_param_value("limit"));
+        if (!value || *value == 0)
+            throw ServiceError(ErrorKind::MalformedRequest, "limit: expected a positive integer");
+        limit = *value;
+    }
+    json jobs = json::array();
+    for (const protocol::JobStatus& status : services.jobs.list(state, limit))
+        jobs.push_back(protocol::to_json(status));
+    send_json(res, {{"jobs", std::move(jobs)}});
+}
+
+void HttpServer::Impl::get_job(const Request& req, Response& res) {
+    send_json(res, protocol::to_json(services.jobs.status(req.matches[1])));
+}
+
+void HttpServer::Impl::cancel_job(const Request& req, Response& res) {
+    const protocol::JobStatus status =
+        services.jobs.cancel(req.matches[1], std::chrono::seconds(5));
+    // 202: the render was asked to stop but has not finished its current tile yet.
+    send_json(res, protocol::to_json(status),
+              status.state == protocol::JobState::Cancelled ? 200 : 202);
+}
+
+void HttpServer::Impl::job_events(const Request& req, Response& res) {
+    const std::string id = req.matches[1];
+    (void)services.jobs.status(id);  // 404 before the stream starts
+    uint64_t last_id = 0;
+    std::string resume = req.get_header_value("Last-Event-ID");
+    if (resume.empty() && req.has_param("last_event_id"))
+        resume = req.get_param_value("last_event_id");
+    if (!resume.empty()) {
+        const auto value = parse_number<uint64_t>(resume);
+        if (!value)
+            throw ServiceError(ErrorKind::MalformedRequest,
+                               "Last-Event-ID: expected an event id (an integer)");
+        last_id = *value;
+    }
+    res.set_header("Cache-Control", "no-cache");
+    res.set_header("X-Accel-Buffering", "no");  // proxies (nginx) must not hold events back
+    auto cursor = std::make_shared<uint64_t>(last_id);
+    auto started = std::make_shared<bool>(false);
+    res.set_chunked_content_provider(
+        "text/event-stream", [this, id, cursor, started](size_t, httplib::DataSink& sink) {
+            std::string out;
+            if (!*started) {
+                *started = true;
+                out = ": events of job " + id + "\nretry: 2000\n\n";
+            }
+            JobManager::EventBatch batch;
+            try {
+                batch = services.jobs.wait_events(id, *cursor, options.keep_alive_interval);
+            } catch (const ServiceError&) {
+                sink.done();
+                return true;
+            }
+            for (const protocol::JobEvent& event : batch.events) {
+                out += protocol::format_sse(event);
+                *cursor = event.id;
+            }
+            if (out.empty()) out = ": keep-alive\n\n";  // also finds out when the client has gone
+            if (!sink.write(out.data(), out.size())) return false;
+            if (batch.ended) sink.done();
+            return true;
+        });
+}
+
+void HttpServer::Impl::job_tile(const Request& req, Response& res) {
+    const std::string id = req.matches[1];
+    const auto tx = parse_number<int>(req.matches[2].str());
+    const auto ty = parse_number<int>(req.matches[3].str());
+    const protocol::TileIndex tile{tx.value_or(-1), ty.value_or(-1)};
+    const auto geometry = services.jobs.tile_geometry(id, tile);
+    if (!geometry)
+        throw ServiceError(ErrorKind::NotFound, "tile (" + req.matches[2].str() + ", " +
+                                                    req.matches[3].str() +
+                                                    ") is outside the tile grid of job " + id);
+    auto bytes = services.jobs.tile_exr(id, tile);
+    if (!bytes) {
+        const protocol::JobStatus status = services.jobs.status(id);
+        throw ServiceError(
+            ErrorKind::NotFound,
+            protocol::is_terminal(status.state)
+                ? "job " + id + " is " + std::string(protocol::to_string(status.state)) +
+                      ": its tiles are gone"
+                : "tile (" + std::to_string(tile.tx) + ", " + std::to_string(tile.ty) +
+                      ") of job " + id + " is not finished yet");
+    }
+    res.set_header("X-Tile-X", std::to_string(tile.tx));
+    res.set_header("X-Tile-Y", std::to_string(tile.ty));
+    res.set_header("X-Tile-Rect", rect_header(geometry->rect));
+    send_bytes(res, std::move(*bytes), kExrType);
+}
+
+void HttpServer::Impl::job_tile_stream(const Request& req, Response& res) {
+    const std::string id = req.matches[1];
+    (void)services.jobs.status(id);  // 404 before the stream starts
+    const std::string boundary = random_boundary();
+    res.set_header("Cache-Control", "no-cache");
+    res.set_header("X-Accel-Buffering", "no");
+    auto next = std::make_shared<size_t>(0);
+    res.set_chunked_content_provider(
+        "multipart/mixed; boundary=" + boundary,
+        [this, id, boundary, next](size_t, httplib::DataSink& sink) {
+            JobManager::TileBatch batch;
+            try {
+                batch = services.jobs.wait_tiles(id, *next, options.keep_alive_interval);
+            } catch (const ServiceError&) {
+                sink.done();
+                return true;
+            }
+            for (const protocol::TileIndex& tile : batch.tiles) {
+                const auto geometry = services.jobs.tile_geometry(id, tile);
+                auto bytes = services.jobs.tile_exr(id, tile);
+                if (!geometry || !bytes) continue;  // freed meanwhile (cancelled)
+                std::string head =
+                    "--" + boundary + "\r\nContent-Type: image/x-exr\r\nContent-Length: " +
+                    std::to_string(bytes->size()) + "\r\nX-Tile-X: " + std::to_string(tile.tx) +
+                    "\r\nX-Tile-Y: " + std::to_string(tile.ty) +
+                    "\r\nX-Tile-Rect: " + rect_header(geometry->rect) + "\r\n\r\n";
+                head.append(reinterpret_cast<const char*>(bytes->data()), bytes->size());
+                head += "\r\n";
+                if (!sink.write(head.data(), head.size())) return false;
+            }
+            *next = batch.next;
+            if (batch.ended) {
+                const std::string closing = "--" + boundary + "--\r\n";
+                if (!sink.write(closing.data(), closing.size())) return false;
+                sink.done();
+            }
+            return true;
+        });
+}
+
+void HttpServer::Impl::job_image(const Request& req, Response& res) {
+    const std::string id = req.matches[1];
+    if (req.has_param("wait") && is_true(req.get_param_value("wait"))) {
+        for (;;) {
+            const protocol::JobStatus status =
+                services.jobs.wait_finished(id, std::chrono::seconds(1));
+            if (protocol::is_terminal(status.state)) break;
+            if (services.jobs.stopping())
+                throw ServiceError(ErrorKind::Unavailable, "the daemon is shutting down; job " +
+                                                               id + " runs again when it restarts")
+                    .with_header("Retry-After", "10");
+        }
+    }
+    const std::filesystem::path file = services.jobs.image_file(id);
+    std::error_code error;
+    const auto size = std::filesystem::file_size(file, error);
+    if (error) throw ServiceError(ErrorKind::Internal, file.string() + ": cannot be read");
+    auto in = std::make_shared<std::ifstream>(file, std::ios::binary);
+    if (!*in) throw ServiceError(ErrorKind::Internal, file.string() + ": cannot be read");
+    res.set_header("Content-Disposition", "attachment; filename=\"" + id + ".exr\"");
+    res.set_content_provider(
+        size, kExrType, [in](size_t offset, size_t length, httplib::DataSink& sink) {
+            std::vector<char> buffer(std::min<size_t>(length, size_t{1} << 20));
+            in->seekg(static_cast<std::streamoff>(offset));
+            in->read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+            const auto got = static_cast<size_t>(in->gcount());
+            return got > 0 && sink.write(buffer.data(), got);
+        });
+}
+
+void HttpServer::Impl::job_preview(const Request& req, Response& res) {
+    res.set_header("Cache-Control", "no-cache");
+    send_bytes(res, services.jobs.preview_png(req.matches[1]), "image/png");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Scenes and photon maps
+
+void HttpServer::Impl::upload_scene(const Request& req, Response& res) {
+    const std::span<const uint8_t> bytes(reinterpret_cast<const uint8_t*>(req.body.data()),
+                                         req.body.size());
+    auto added = services.scenes.add(bytes);
+    if (!added) throw ServiceError(ErrorKind::InvalidField, added.error().message);
+    res.set_header("Location", "/v1/scenes/" + added->info.id);
+    send_json(res, to_json(added->info), added->created ? 201 : 200);
+}
+
+void HttpServer::Impl::list_scenes(const Request&, Response& res) {
+    json scenes = json::array();
+    for (const SceneInfo& info : services.scenes.list()) scenes.push_back(to_json(info));
+    send_json(res, {{"scenes", std::move(scenes)}});
+}
+
+void HttpServer::Impl::get_scene(const Request& req, Response& res) {
+    const std::string id = req.matches[1];
+    const auto info = services.scenes.info(id);
+    if (!info) throw ServiceError(ErrorKind::NotFound, "no uploaded scene '" + id + "'");
+    send_json(res, to_json(*info));
+}
+
+void HttpServer::Impl::delete_scene(const Request& req, Response& res) {
+    const std::string id = req.matches[1];
+    if (!services.scenes.remove(id))
+        throw ServiceError(ErrorKind::NotFound, "no uploaded scene '" + id + "'");
+    res.status = 204;
+}
+
+void HttpServer::Impl::list_photon_maps(const Request&, Response& res) {
+    send_json(res, {{"keys", services.photon_maps.keys()}});
+}
+
+void HttpServer::Impl::export_photon_maps(const Request& req, Response& res) {
+    const std::string key = req.matches[1];
+    auto bytes = services.photon_maps.export_maps(key);
+    if (!bytes)
+        throw ServiceError(ErrorKind::NotFound,
+                           PhotonMapCache::is_valid_key(key)
+                               ? "no photon maps for key " + key + " here"
+                               : "'" + key + "' is not a photon-map key (pm1-<64 hex digits>)");
+    res.set_header("Content-Disposition", "attachment; filename=\"" + key + ".pm\"");
+    send_bytes(res, std::move(*bytes), "application/octet-stream");
+}
+
+void HttpServer::Impl::import_photon_maps(const Request& req, Response& res) {
+    const std::string key = req.matches[1];
+    if (!PhotonMapCache::is_valid_key(key))
+        throw ServiceError(ErrorKind::NotFound,
+                           "'" + key + "' is not a photon-map key (pm1-<64 hex digits>)");
+    const std::span<const uint8_t> bytes(reinterpret_cast<const uint8_t*>(req.body.data()),
+                                         req.body.size());
+    auto imported = services.photon_maps.import_maps(key, bytes);
+    if (!imported) throw ServiceError(ErrorKind::InvalidField, imported.error().message);
+    send_json(res, {{"key", key}, {"created", *imported}}, *imported ? 201 : 200);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Operations
+
+void HttpServer::Impl::healthz(const Request&, Response& res) {
+    res.set_content("ok\n", "text/plain");
+}
+
+void HttpServer::Impl::readyz(const Request&, Response& res) {
+    if (services.jobs.stopping())
+        throw ServiceError(ErrorKind::Unavailable, "the daemon is shutting down");
+    if (!services.jobs.worker_running())
+        throw ServiceError(ErrorKind::Unavailable, "the render worker is not running");
+    if (!services.jobs.cache_dir_writable())
+        throw ServiceError(ErrorKind::Unavailable, "the cache directory is not writable");
+    send_json(res, {{"status", "ready"}});
+}
+
+void HttpServer::Impl::metrics(const Request&, Response& res) {
+    MetricsSnapshot snapshot;
+    services.jobs.fill_metrics(snapshot);
+    const PhotonMapCache::Counters cache = services.photon_maps.counters();
+    snapshot.photon_cache_hits = cache.hits;
+    snapshot.photon_cache_misses = cache.misses;
+    snapshot.photon_cache_bytes = cache.memory_bytes;
+    snapshot.photon_cache_entries = cache.memory_entries;
+    res.set_content(services.metrics.render(snapshot), "text/plain; version=0.0.4; charset=utf-8");
+}
+
+void HttpServer::Impl::openapi(const Request&, Response& res) {
+    send_json(res, openapi_document());
+}
+
+// ---------------------------------------------------------------------------------------------
+
+HttpServer::HttpServer(HttpServerOptions options, HttpServices services)
+    : impl_(std::make_unique<Impl>(std::move(options), services)) {
+    impl_->register_routes();
+    impl_->install();
+}
+
+HttpServer::~HttpServer() { stop(); }
+
+Expected<int> HttpServer::bind() {
+    const std::string& host = impl_->options.host;
+    if (impl_->options.port == 0) {
+        const int port = impl_->server.bind_to_any_port(host);
+        if (port <= 0) return Error{"cannot listen on " + host + " (any port)"};
+        return port;
+    }
+    if (!impl_->server.bind_to_port(host, impl_->options.port))
+        return Error{"cannot listen on " + host + ":" + std::to_string(impl_->options.port) +
+                     " (in use, or not an address of this machine)"};
+    return impl_->options.port;
+}
+
+void HttpServer::serve() { impl_->server.listen_after_bind(); }
+
+void HttpServer::stop() { impl_->server.stop(); }
+
+bool HttpServer::running() const { return impl_->server.is_running(); }
+
+}  // namespace photond::service

@@ -1,0 +1,68 @@
+// The HTTP API v1 of `photond serve` (PRODUCT.md, "HTTP API v1") on cpp-httplib. Every route is
+// registered in one function (register_routes in http_server.cpp); handlers are thin: decode the
+// request, call the job manager or a store, encode the answer. Failures are thrown as
+// ServiceError and turned into RFC 9457 problem+json in one place, the server's exception
+// handler; errors that cpp-httplib raises itself (no route, body too large, malformed request)
+// get the same treatment in its error handler.
+//
+// httplib.h is kept out of this header: it must be compiled with the definitions that
+// PkgConfig::HTTPLIB carries (Debian builds the library with OpenSSL, zlib and Brotli support),
+// so only the .cpp files of the photond_daemon library include it.
+//
+// Thread safety: bind(), serve() and stop() may be called from different threads; stop() may be
+// called at any time, also before serve() starts.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "core/util/expected.h"
+
+namespace photond::service {
+
+class JobManager;
+class SceneStore;
+class PhotonMapCache;
+class Metrics;
+
+struct HttpServerOptions {
+    std::string host = "127.0.0.1";
+    int port = 8080;    // 0: any free port (bind() says which)
+    std::string token;  // bearer token; empty: no authentication
+    size_t max_body_bytes = size_t{256} << 20;
+    int http_threads = 128;  // connections served at once (streams hold one each)
+    std::chrono::milliseconds keep_alive_interval{15000};  // SSE comment while nothing happens
+    bool access_log = false;                               // one line per request to `log`
+    std::function<void(const std::string&)> log;
+};
+
+struct HttpServices {
+    JobManager& jobs;
+    SceneStore& scenes;
+    PhotonMapCache& photon_maps;
+    Metrics& metrics;
+};
+
+class HttpServer {
+public:
+    HttpServer(HttpServerOptions options, HttpServices services);
+    ~HttpServer();
+    HttpServer(const HttpServer&) = delete;
+    HttpServer& operator=(const HttpServer&) = delete;
+
+    /// Binds the listening socket; returns the port (the chosen one when options.port is 0).
+    Expected<int> bind();
+    /// Serves requests until stop(); call after a successful bind().
+    void serve();
+    void stop();
+    bool running() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace photond::service

@@ -1,0 +1,287 @@
+// What the daemon keeps: the photon-map cache (a second view of a scene skips photon tracing;
+// maps move between daemons by export and import; a corrupt file on disk is set aside and
+// rebuilt), finished jobs across a restart, jobs interrupted by a clean shutdown, and uploaded
+// scenes rendered by content id.
+#include <gtest/gtest.h>
+
+#include "core/image/exr_io.h"
+#include "tests/server/daemon_harness.h"
+
+namespace photond::test {
+namespace {
+
+json photon_job(json camera = nullptr) {
+    json job = {{"scene", {{"builtin", "cornell-box"}}},
+                {"integrator", "photon-map"},
+                {"image", {{"width", 48}, {"height", 32}, {"spp", 1}, {"tile_size", 16}}},
+                {"photons", {{"global", 3000}, {"caustic", 2000}, {"seed", 3}}}};
+    if (!camera.is_null()) job["camera"] = std::move(camera);
+    return job;
+}
+
+const json kOtherView = {
+    {"look_from", {1.5, 3.0, 9.0}}, {"look_at", {0.0, 2.0, 0.0}}, {"vfov_deg", 45}};
+
+json render(const HttpClient& client, const json& job) {
+    const HttpResponse submitted = client.post("/v1/jobs", job.dump());
+    EXPECT_EQ(submitted.status, 202) << submitted.body;
+    return wait_for_status(client, submitted.json_body().at("id"), is_terminal_state);
+}
+
+class DaemonCache : public ::testing::Test {
+protected:
+    TempDir dir_{"daemon_cache"};
+};
+
+TEST_F(DaemonCache, SecondViewOfASceneSkipsPhotonTracing) {
+    Daemon daemon(dir_.path() / "cache");
+    ASSERT_TRUE(daemon.started()) << daemon.log();
+    const HttpClient client = daemon.client();
+
+    const json first = render(client, photon_job());
+    ASSERT_EQ(first.at("state"), "done") << first.dump();
+    EXPECT_EQ(first.at("photons").at("cache"), "miss");
+    EXPECT_GT(first.at("timings").at("photon_tracing").get<double>(), 0.0);
+    const std::string key = first.at("photons").at("key");
+    EXPECT_EQ(key.rfind("pm1-", 0), 0u);
+    EXPECT_TRUE(fs::exists(dir_.path() / "cache" / "photon-maps" / (key + ".pm")));
+
+    const json second = render(client, photon_job(kOtherView));
+    ASSERT_EQ(second.at("state"), "done") << second.dump();
+    EXPECT_EQ(second.at("photons").at("cache"), "hit");
+    EXPECT_EQ(second.at("photons").at("key"), key);
+    EXPECT_EQ(second.at("timings").at("photon_tracing").get<double>(), 0.0);
+    EXPECT_EQ(second.at("timings").at("photon_kdtree").get<double>(), 0.0);
+    EXPECT_EQ(second.at("photons").at("stored_global"), first.at("photons").at("stored_global"));
+
+    // Other photon settings: another key, traced again.
+    json more = photon_job(kOtherView);
+    more["photons"]["seed"] = 4;
+    const json third = render(client, more);
+    EXPECT_EQ(third.at("photons").at("cache"), "miss");
+    EXPECT_NE(third.at("photons").at("key"), key);
+
+    const std::string metrics = client.get("/metrics").body;
+    EXPECT_NE(metrics.find("photond_photon_cache_hits_total 1\n"), std::string::npos) << metrics;
+    EXPECT_NE(metrics.find("photond_photon_cache_misses_total 2\n"), std::string::npos) << metrics;
+    EXPECT_EQ(metrics.find("photond_photon_cache_bytes 0\n"), std::string::npos) << metrics;
+    const json keys = client.get("/v1/photon-maps").json_body().at("keys");
+    EXPECT_EQ(keys.size(), 2u);
+    EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+}
+
+TEST_F(DaemonCache, PhotonMapsMoveBetweenDaemonsByExportAndImport) {
+    Daemon source(dir_.path() / "source");
+    Daemon target(dir_.path() / "target");
+    ASSERT_TRUE(source.started() && target.started()) << source.log() << target.log();
+    const json traced = render(source.client(), photon_job());
+    const std::string key = traced.at("photons").at("key");
+    const HttpResponse exported = source.client().get("/v1/photon-maps/" + key);
+    ASSERT_EQ(exported.status, 200);
+    EXPECT_EQ(exported.header("content-type"), "application/octet-stream");
+    EXPECT_EQ(exported.body.substr(0, 8), "PHOTONMP");
+
+    const HttpClient client = target.client();
+    // Refused: flipped bytes, a truncated file, and maps filed under another key.
+    std::string corrupt = exported.body;
+    corrupt[corrupt.size() / 2] ^= 0x5a;
+    EXPECT_EQ(client.request("PUT", "/v1/photon-maps/" + key, corrupt).status, 422);
+    EXPECT_EQ(client
+                  .request("PUT", "/v1/photon-maps/" + key,
+                           exported.body.substr(0, exported.body.size() / 3))
+                  .status,
+              422);
+    const std::string other_key = "pm1-" + std::string(64, 'c');
+    const HttpResponse foreign =
+        client.request("PUT", "/v1/photon-maps/" + other_key, exported.body);
+    EXPECT_EQ(foreign.status, 422);
+    EXPECT_EQ(client.get("/v1/photon-maps/" + other_key).status, 404);
+    EXPECT_EQ(client.get("/v1/photon-maps/" + key).status, 404);
+
+    const HttpResponse imported = client.request("PUT", "/v1/photon-maps/" + key, exported.body);
+    EXPECT_EQ(imported.status, 201) << imported.body;
+    EXPECT_EQ(client.request("PUT", "/v1/photon-maps/" + key, exported.body).status, 200);
+    EXPECT_EQ(client.get("/v1/photon-maps/" + key).body, exported.body);
+
+    const json rendered = render(client, photon_job(kOtherView));
+    ASSERT_EQ(rendered.at("state"), "done");
+    EXPECT_EQ(rendered.at("photons").at("cache"), "hit");
+    EXPECT_EQ(rendered.at("timings").at("photon_tracing").get<double>(), 0.0);
+}
+
+TEST_F(DaemonCache, CorruptMapOnDiskIsSetAsideAndRebuilt) {
+    std::string key;
+    {
+        Daemon daemon(dir_.path() / "cache");
+        ASSERT_TRUE(daemon.started()) << daemon.log();
+        key = render(daemon.client(), photon_job()).at("photons").at("key");
+        ASSERT_EQ(daemon.stop(), 0);
+    }
+    const fs::path file = dir_.path() / "cache" / "photon-maps" / (key + ".pm");
+    std::string bytes = read_file(file);
+    ASSERT_GT(bytes.size(), 100u);
+    bytes.resize(bytes.size() - 40);  // a truncated write
+    write_file(file, bytes);
+
+    Daemon daemon(dir_.path() / "cache");
+    ASSERT_TRUE(daemon.started()) << daemon.log();
+    const json rebuilt = render(daemon.client(), photon_job(kOtherView));
+    ASSERT_EQ(rebuilt.at("state"), "done") << rebuilt.dump();
+    EXPECT_EQ(rebuilt.at("photons").at("cache"), "miss");
+    EXPECT_TRUE(fs::exists(file.string() + ".corrupt"));
+    EXPECT_GT(fs::file_size(file), bytes.size());
+    const json again = render(daemon.client(), photon_job());
+    EXPECT_EQ(again.at("photons").at("cache"), "hit");
+    EXPECT_NE(daemon.log().find("moved aside"), std::string::npos) << daemon.log();
+}
+
+TEST_F(DaemonCache, FinishedJobsSurviveARestartAndInterruptedJobsRunAgain) {
+    std::string done_id, interrupted_id, image;
+    {
+        Daemon daemon(dir_.path() / "cache");
+        ASSERT_TRUE(daemon.started()) << daemon.log();
+        const HttpClient client = daemon.client();
+        const json done = render(client, photon_job());
+        ASSERT_EQ(done.at("state"), "done");
+        done_id = done.at("id");
+        image = client.get("/v1/jobs/" + done_id + "/image.exr").body;
+        ASSERT_FALSE(image.empty());
+        // A job of a few seconds, interrupted by the shutdown.
+        const json long_job = {
+            {"scene", {{"builtin", "cornell-box"}}},
+            {"integrator", "path"},
+            {"image", {{"width", 192}, {"height", 128}, {"spp", 32}, {"tile_size", 16}}}};
+        interrupted_id = client.post("/v1/jobs", long_job.dump()).json_body().at("id");
+        wait_for_status(client, interrupted_id,
+                        [](const json& s) { return s.at("progress").at("tiles_done") > 0; });
+        EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+    }
+    Daemon daemon(dir_.path() / "cache");
+    ASSERT_TRUE(daemon.started()) << daemon.log();
+    const HttpClient client = daemon.client();
+    const json status = client.get("/v1/jobs/" + done_id).json_body();
+    EXPECT_EQ(status.at("state"), "done");
+    EXPECT_EQ(status.at("photons").at("cache"), "miss");
+    EXPECT_EQ(client.get("/v1/jobs/" + done_id + "/image.exr").body, image);
+    // Tiles and events of the restored job, from its image on disk.
+    const HttpResponse tile = client.get("/v1/jobs/" + done_id + "/tiles/2/1.exr");
+    ASSERT_EQ(tile.status, 200);
+    const auto decoded =
+        decode_tile_exr({reinterpret_cast<const uint8_t*>(tile.body.data()), tile.body.size()});
+    ASSERT_TRUE(decoded.has_value());
+    EXPECT_EQ(decoded->rect, (PixelRect{32, 16, 48, 32}));
+    const auto events = parse_sse(client.get("/v1/jobs/" + done_id + "/events").body);
+    ASSERT_FALSE(events.empty());
+    EXPECT_EQ(events.back().type, "done");
+    EXPECT_EQ(client.get("/v1/jobs/" + done_id + "/preview.png").status, 200);
+
+    // The interrupted job runs again and finishes.
+    const HttpResponse finished = client.get("/v1/jobs/" + interrupted_id + "/image.exr?wait=true");
+    EXPECT_EQ(finished.status, 200) << finished.body;
+    EXPECT_EQ(client.get("/v1/jobs/" + interrupted_id).json_body().at("state"), "done");
+    // (Both daemons log to the same file.)
+    EXPECT_NE(daemon.log().find("interrupted by shutdown"), std::string::npos) << daemon.log();
+    EXPECT_NE(daemon.log().find("restored 2 job(s)"), std::string::npos) << daemon.log();
+    EXPECT_NE(daemon.log().find("(1 queued)"), std::string::npos) << daemon.log();
+}
+
+TEST_F(DaemonCache, TwoDaemonsShareOneCacheDirectory) {
+    // Render farms share photon maps through a common --cache-dir: both daemons trace the same
+    // key at the same time, each renames its complete file into place, neither reads half a file.
+    Daemon first(dir_.path() / "shared");
+    Daemon second(dir_.path() / "shared");
+    ASSERT_TRUE(first.started() && second.started()) << first.log();
+    const std::string a = first.client().post("/v1/jobs", photon_job().dump()).json_body().at("id");
+    const std::string b =
+        second.client().post("/v1/jobs", photon_job(kOtherView).dump()).json_body().at("id");
+    const json done_a = wait_for_status(first.client(), a, is_terminal_state);
+    const json done_b = wait_for_status(second.client(), b, is_terminal_state);
+    ASSERT_EQ(done_a.at("state"), "done") << done_a.dump();
+    ASSERT_EQ(done_b.at("state"), "done") << done_b.dump();
+    EXPECT_EQ(done_a.at("photons").at("key"), done_b.at("photons").at("key"));
+    const fs::path maps = dir_.path() / "shared" / "photon-maps";
+    for (const auto& entry : fs::directory_iterator(maps))
+        EXPECT_EQ(entry.path().extension(), ".pm")
+            << entry.path();  // no temporary or corrupt files
+    // A third view on a fresh daemon of the farm: a hit from the shared directory.
+    Daemon third(dir_.path() / "shared", {"--photon-cache-mb", "0"});
+    ASSERT_TRUE(third.started());
+    const json hit = render(third.client(), photon_job(kOtherView));
+    EXPECT_EQ(hit.at("photons").at("cache"), "hit");
+    EXPECT_NE(third.client().get("/metrics").body.find("photond_photon_cache_bytes 0\n"),
+              std::string::npos);
+}
+
+TEST_F(DaemonCache, JobRunningWhenTheDaemonDiedFailsWithItsReason) {
+    // What a crash leaves behind: status.json still says "running".
+    {
+        Daemon daemon(dir_.path() / "cache");
+        ASSERT_TRUE(daemon.started());
+        const json job = {{"scene", {{"builtin", "cornell-box"}}},
+                          {"integrator", "path"},
+                          {"image", {{"width", 256}, {"height", 192}, {"spp", 64}}}};
+        const std::string id = daemon.client().post("/v1/jobs", job.dump()).json_body().at("id");
+        wait_for_status(daemon.client(), id,
+                        [](const json& s) { return s.value("state", "") == "running"; });
+        daemon.stop();
+        // Turn the clean "queued again" into the state a crash leaves.
+        const fs::path status_file = dir_.path() / "cache" / "jobs" / id / "status.json";
+        json status = json::parse(read_file(status_file));
+        ASSERT_EQ(status.at("state"), "queued");
+        status["state"] = "running";
+        write_file(status_file, status.dump());
+    }
+    Daemon daemon(dir_.path() / "cache");
+    ASSERT_TRUE(daemon.started()) << daemon.log();
+    const json jobs = daemon.client().get("/v1/jobs").json_body().at("jobs");
+    ASSERT_EQ(jobs.size(), 1u);
+    EXPECT_EQ(jobs[0].at("state"), "failed");
+    EXPECT_NE(jobs[0].at("error").get<std::string>().find("daemon restarted"), std::string::npos);
+    EXPECT_EQ(daemon.client()
+                  .get("/v1/jobs/" + jobs[0].at("id").get<std::string>() + "/image.exr")
+                  .status,
+              409);
+}
+
+TEST_F(DaemonCache, UploadedScenesAreStoredByContentAndRenderedById) {
+    Daemon daemon(dir_.path() / "cache");
+    ASSERT_TRUE(daemon.started()) << daemon.log();
+    const HttpClient client = daemon.client();
+    const std::string gltf = read_file(fs::path(PHOTOND_TEST_DATA_DIR) / "gltf" / "lights.gltf");
+    const HttpResponse created =
+        client.post("/v1/scenes", gltf, {{"Content-Type", "model/gltf+json"}});
+    ASSERT_EQ(created.status, 201) << created.body;
+    const json info = created.json_body();
+    const std::string id = info.at("id");
+    EXPECT_EQ(id.rfind("sha256:", 0), 0u);
+    EXPECT_EQ(id.size(), 7u + 64u);
+    EXPECT_EQ(created.header("location"), "/v1/scenes/" + id);
+    EXPECT_EQ(info.at("format"), "gltf");
+    EXPECT_EQ(info.at("bytes"), gltf.size());
+    EXPECT_GT(info.at("triangles").get<int>(), 0);
+    EXPECT_GT(info.at("lights").get<int>(), 0);
+    EXPECT_EQ(client.post("/v1/scenes", gltf).status, 200);  // the same bytes again
+    EXPECT_EQ(client.get("/v1/scenes/" + id).json_body().at("triangles"), info.at("triangles"));
+
+    const std::string glb =
+        read_file(fs::path(PHOTOND_TEST_DATA_DIR) / "gltf" / "textured_quad.glb");
+    const HttpResponse binary =
+        client.post("/v1/scenes", glb, {{"Content-Type", "model/gltf-binary"}});
+    ASSERT_EQ(binary.status, 201) << binary.body;
+    EXPECT_EQ(binary.json_body().at("format"), "glb");
+    EXPECT_EQ(client.get("/v1/scenes").json_body().at("scenes").size(), 2u);
+
+    const json job = {{"scene", {{"id", id}}},
+                      {"integrator", "direct"},
+                      {"image", {{"width", 16}, {"height", 16}, {"spp", 1}}}};
+    const json rendered = render(client, job);
+    EXPECT_EQ(rendered.at("state"), "done") << rendered.dump();
+
+    EXPECT_EQ(client.request("DELETE", "/v1/scenes/" + id).status, 204);
+    EXPECT_EQ(client.get("/v1/scenes/" + id).status, 404);
+    EXPECT_EQ(client.request("DELETE", "/v1/scenes/" + id).status, 404);
+    EXPECT_EQ(client.post("/v1/jobs", job.dump()).status, 422);
+}
+
+}  // namespace
+}  // namespace photond::test

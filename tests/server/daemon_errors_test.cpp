@@ -1,0 +1,252 @@
+// Bad requests against the real daemon: each gets its 4xx as RFC 9457 problem+json with a
+// message (and the offending field's path for job fields), and the daemon keeps serving.
+#include <gtest/gtest.h>
+
+#include "tests/server/daemon_harness.h"
+
+namespace photond::test {
+namespace {
+
+const json kSmallJob = {{"scene", {{"builtin", "cornell-box"}}},
+                        {"integrator", "direct"},
+                        {"image", {{"width", 16}, {"height", 16}, {"spp", 1}}}};
+
+// A render of a few seconds on 2 cores, to hold the worker busy.
+const json kLongJob = {
+    {"scene", {{"builtin", "cornell-box"}}},
+    {"integrator", "path"},
+    {"image", {{"width", 256}, {"height", 192}, {"spp", 64}, {"tile_size", 16}}}};
+
+/// Checks a problem answer, then that the daemon still answers /healthz.
+void expect_problem(const HttpClient& client, const HttpResponse& response, int status,
+                    const std::string& field = {}, const std::string& detail_part = {}) {
+    EXPECT_EQ(response.status, status) << response.body;
+    EXPECT_EQ(response.header("content-type"), "application/problem+json") << response.body;
+    const json problem = response.json_body();
+    ASSERT_TRUE(problem.is_object()) << response.body;
+    EXPECT_EQ(problem.value("status", 0), status);
+    EXPECT_FALSE(problem.value("title", "").empty());
+    EXPECT_FALSE(problem.value("type", "").empty());
+    const std::string detail = problem.value("detail", "");
+    EXPECT_FALSE(detail.empty());
+    if (!field.empty()) {
+        EXPECT_EQ(problem.value("field", ""), field) << detail;
+    }
+    if (!detail_part.empty()) {
+        EXPECT_NE(detail.find(detail_part), std::string::npos) << detail;
+    }
+    const HttpResponse health = client.get("/healthz");
+    EXPECT_EQ(health.status, 200) << "the daemon stopped serving after a " << status;
+}
+
+json with(json job, const std::string& pointer, json value) {
+    job[json::json_pointer(pointer)] = std::move(value);
+    return job;
+}
+
+class DaemonErrors : public ::testing::Test {
+protected:
+    TempDir dir_{"daemon_errors"};
+};
+
+TEST_F(DaemonErrors, BadJobsAndUploadsGetProblemsAndTheDaemonKeepsServing) {
+    const fs::path root = dir_.path() / "scenes";
+    fs::create_directories(root / "sub");
+    fs::copy_file(fs::path(PHOTOND_TEST_DATA_DIR) / "gltf" / "lights.gltf",
+                  root / "sub" / "lights.gltf");
+    write_file(dir_.path() / "outside.gltf",
+               read_file(fs::path(PHOTOND_TEST_DATA_DIR) / "gltf" / "lights.gltf"));
+    fs::create_symlink(dir_.path() / "outside.gltf", root / "escape.gltf");
+    Daemon daemon(dir_.path() / "cache", {"--scene-root", root.string(), "--max-body-mb", "1"});
+    ASSERT_TRUE(daemon.started()) << daemon.log();
+    const HttpClient client = daemon.client();
+
+    // Malformed JSON: 400 with line and column.
+    expect_problem(client, client.post("/v1/jobs", R"({"scene": {"builtin": "cornell-box"},)"), 400,
+                   "", "line 1");
+    expect_problem(client, client.post("/v1/jobs", ""), 400);
+    // Unknown fields, by their path.
+    expect_problem(client, client.post("/v1/jobs", with(kSmallJob, "/image/sppp", 4).dump()), 422,
+                   "image.sppp", "unknown field");
+    expect_problem(client, client.post("/v1/jobs", with(kSmallJob, "/colour", "red").dump()), 422,
+                   "colour");
+    // Wrong types.
+    expect_problem(client, client.post("/v1/jobs", with(kSmallJob, "/image/width", "big").dump()),
+                   422, "image.width");
+    expect_problem(client,
+                   client.post("/v1/jobs", with(kSmallJob, "/priority", json::array()).dump()), 422,
+                   "priority");
+    expect_problem(client, client.post("/v1/jobs", json::array({1, 2}).dump()), 422);
+    // Out of range and absurd sizes.
+    expect_problem(client, client.post("/v1/jobs", with(kSmallJob, "/image/width", 1000000).dump()),
+                   422, "image.width");
+    expect_problem(client, client.post("/v1/jobs", with(kSmallJob, "/photons/global", 1e12).dump()),
+                   422, "photons.global");
+    expect_problem(client,
+                   client.post("/v1/jobs", with(kSmallJob, "/irradiance_cache/a", 2).dump()), 422,
+                   "irradiance_cache.a");
+    expect_problem(client, client.post("/v1/jobs", with(kSmallJob, "/image/spp", -1).dump()), 422,
+                   "image.spp");
+    // Missing scenes.
+    expect_problem(
+        client,
+        client.post("/v1/jobs", with(kSmallJob, "/scene", {{"builtin", "cornel-box"}}).dump()), 422,
+        "scene.builtin", "cornell-box");
+    expect_problem(
+        client,
+        client.post("/v1/jobs", with(kSmallJob, "/scene", {{"path", "nothing.glb"}}).dump()), 422,
+        "scene.path", "nothing.glb");
+    expect_problem(
+        client,
+        client.post("/v1/jobs",
+                    with(kSmallJob, "/scene", {{"id", "sha256:" + std::string(64, '0')}}).dump()),
+        422, "scene.id", "POST /v1/scenes");
+    // Paths outside --scene-root: by "..", absolutely, and through a symbolic link.
+    expect_problem(
+        client,
+        client.post("/v1/jobs", with(kSmallJob, "/scene", {{"path", "../outside.gltf"}}).dump()),
+        422, "scene.path");
+    expect_problem(
+        client,
+        client.post("/v1/jobs", with(kSmallJob, "/scene", {{"path", "/etc/passwd"}}).dump()), 422,
+        "scene.path");
+    expect_problem(
+        client,
+        client.post("/v1/jobs", with(kSmallJob, "/scene", {{"path", "escape.gltf"}}).dump()), 422,
+        "scene.path", "outside the scene root");
+    // A path inside the root is accepted and renders.
+    const HttpResponse inside =
+        client.post("/v1/jobs", with(kSmallJob, "/scene", {{"path", "sub/lights.gltf"}}).dump());
+    ASSERT_EQ(inside.status, 202) << inside.body;
+    const json done = wait_for_status(client, inside.json_body().at("id"), is_terminal_state);
+    EXPECT_EQ(done.at("state"), "done") << done.dump();
+
+    // A scene that passes the checks at submission but cannot be loaded: the job fails with the
+    // loader's message, on its status and as its last event.
+    fs::copy_file(fs::path(PHOTOND_TEST_DATA_DIR) / "gltf" / "broken" / "index_out_of_range.gltf",
+                  root / "broken.gltf");
+    const HttpResponse broken =
+        client.post("/v1/jobs", with(kSmallJob, "/scene", {{"path", "broken.gltf"}}).dump());
+    ASSERT_EQ(broken.status, 202) << broken.body;
+    const std::string broken_id = broken.json_body().at("id");
+    const json failed = wait_for_status(client, broken_id, is_terminal_state);
+    EXPECT_EQ(failed.at("state"), "failed");
+    EXPECT_NE(failed.value("error", "").find("broken.gltf"), std::string::npos) << failed.dump();
+    const auto events = parse_sse(client.get("/v1/jobs/" + broken_id + "/events").body);
+    ASSERT_FALSE(events.empty());
+    EXPECT_EQ(events.back().type, "failed");
+    EXPECT_EQ(events.back().data.value("error", ""), failed.value("error", ""));
+    expect_problem(client, client.get("/v1/jobs/" + broken_id + "/image.exr?wait=true"), 409, "",
+                   "failed");
+
+    // Broken glTF uploads: the loader's message.
+    expect_problem(client, client.post("/v1/scenes", "this is not a scene"), 422, "", "glTF");
+    expect_problem(client,
+                   client.post("/v1/scenes", read_file(fs::path(PHOTOND_TEST_DATA_DIR) / "gltf" /
+                                                       "broken" / "truncated.glb")),
+                   422);
+    expect_problem(client,
+                   client.post("/v1/scenes", read_file(fs::path(PHOTOND_TEST_DATA_DIR) / "gltf" /
+                                                       "broken" / "external_buffer.gltf")),
+                   422);
+    expect_problem(client, client.post("/v1/scenes", ""), 422, "", "empty");
+
+    // Too large a body: 413 (--max-body-mb 1).
+    expect_problem(client, client.post("/v1/scenes", std::string(size_t{2} << 20, 'x')), 413, "",
+                   "max-body-mb");
+    expect_problem(client, client.post("/v1/jobs", std::string(size_t{3} << 20, ' ')), 413);
+
+    // Unknown things: 404; wrong methods: 405 with Allow.
+    expect_problem(client, client.get("/v1/jobs/no-such-job"), 404, "", "no-such-job");
+    expect_problem(client, client.request("DELETE", "/v1/jobs/no-such-job"), 404);
+    expect_problem(client, client.get("/v1/jobs/no-such-job/image.exr"), 404);
+    expect_problem(client, client.get("/v1/jobs/no-such-job/tiles/0/0.exr"), 404);
+    expect_problem(client, client.get("/v1/no-such-route"), 404, "", "no route");
+    expect_problem(client, client.get("/v1/scenes/sha256:" + std::string(64, 'a')), 404);
+    expect_problem(client, client.get("/v1/photon-maps/pm1-" + std::string(64, 'a')), 404);
+    expect_problem(client, client.get("/v1/photon-maps/..%2F..%2Fetc"), 404);
+    const HttpResponse not_allowed = client.request("PATCH", "/v1/jobs", "{}");
+    expect_problem(client, not_allowed, 405);
+    EXPECT_EQ(not_allowed.header("allow"), "GET, POST");
+    const HttpResponse put_health = client.request("PUT", "/healthz");
+    expect_problem(client, put_health, 405);
+    EXPECT_EQ(put_health.header("allow"), "GET");
+
+    // Tiles out of the grid, and results of a job that has none.
+    const std::string id = inside.json_body().at("id");
+    expect_problem(client, client.get("/v1/jobs/" + id + "/tiles/99/0.exr"), 404, "",
+                   "outside the tile grid");
+    expect_problem(client, client.request("DELETE", "/v1/jobs/" + id), 409, "", "already done");
+    // A corrupt photon-map import.
+    expect_problem(
+        client,
+        client.request("PUT", "/v1/photon-maps/pm1-" + std::string(64, 'b'), "PHOTONMP garbage"),
+        422);
+
+    EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+}
+
+TEST_F(DaemonErrors, FullQueueAnswers429WithRetryAfter) {
+    Daemon daemon(dir_.path() / "cache", {"--max-queued", "1"});
+    ASSERT_TRUE(daemon.started()) << daemon.log();
+    const HttpClient client = daemon.client();
+    const std::string running = client.post("/v1/jobs", kLongJob.dump()).json_body().at("id");
+    wait_for_status(client, running,
+                    [](const json& s) { return s.value("state", "") == "running"; });
+    const HttpResponse queued = client.post("/v1/jobs", kSmallJob.dump());
+    ASSERT_EQ(queued.status, 202) << queued.body;
+    const HttpResponse refused = client.post("/v1/jobs", kSmallJob.dump());
+    expect_problem(client, refused, 429, "", "max-queued");
+    EXPECT_GE(std::stoi(refused.header("retry-after")), 1);
+    const std::string metrics = client.get("/metrics").body;
+    EXPECT_NE(metrics.find("photond_queue_depth 1"), std::string::npos) << metrics;
+    // Cancelling makes room again.
+    EXPECT_EQ(client.request("DELETE", "/v1/jobs/" + queued.json_body().at("id").get<std::string>())
+                  .status,
+              200);
+    EXPECT_EQ(client.post("/v1/jobs", kSmallJob.dump()).status, 202);
+    client.request("DELETE", "/v1/jobs/" + running);
+    EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+}
+
+TEST_F(DaemonErrors, BearerTokenIsRequiredWhenConfigured) {
+    write_file(dir_.path() / "token", "s3cret-token\n");
+    Daemon daemon(dir_.path() / "cache", {"--token-file", (dir_.path() / "token").string()});
+    ASSERT_TRUE(daemon.started()) << daemon.log();
+
+    const HttpClient anonymous = daemon.client();
+    const HttpResponse missing = anonymous.get("/v1/jobs");
+    expect_problem(anonymous, missing, 401);
+    EXPECT_EQ(missing.header("www-authenticate").rfind("Bearer", 0), 0u);
+    expect_problem(anonymous, anonymous.post("/v1/jobs", kSmallJob.dump()), 401);
+
+    const HttpClient wrong = daemon.client("s3cret-tokem");
+    const HttpResponse invalid = wrong.get("/v1/jobs");
+    expect_problem(wrong, invalid, 401);
+    EXPECT_NE(invalid.header("www-authenticate").find("invalid_token"), std::string::npos);
+
+    const HttpClient right = daemon.client("s3cret-token");
+    EXPECT_EQ(right.get("/v1/jobs").status, 200);
+    EXPECT_EQ(right.post("/v1/jobs", kSmallJob.dump()).status, 202);
+    EXPECT_EQ(anonymous.get("/readyz").status, 200);  // health checks stay open
+    EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+}
+
+TEST_F(DaemonErrors, RefusesToListenBeyondLoopbackWithoutAToken) {
+    const auto [code, output] =
+        run_command(kPhotondBinary + " serve --listen 0.0.0.0:0 --cache-dir " +
+                    (dir_.path() / "cache").string());
+    EXPECT_EQ(code, 2);
+    EXPECT_NE(output.find("--token-file"), std::string::npos) << output;
+    const auto [usage_code, usage] = run_command(kPhotondBinary + " serve --listen nowhere");
+    EXPECT_EQ(usage_code, 2);
+    EXPECT_NE(usage.find("--listen"), std::string::npos) << usage;
+    const auto [empty_code, empty] =
+        run_command("touch " + (dir_.path() / "empty").string() + " && " + kPhotondBinary +
+                    " serve --token-file " + (dir_.path() / "empty").string());
+    EXPECT_EQ(empty_code, 2);
+    EXPECT_NE(empty.find("empty"), std::string::npos) << empty;
+}
+
+}  // namespace
+}  // namespace photond::test

@@ -1,0 +1,256 @@
+// The job manager through the real daemon: cancellation mid-render, clients that hang up in the
+// middle of a stream, 50 concurrent status and event clients, priorities, and what a running
+// job serves.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <mutex>
+
+#include "core/image/exr_io.h"
+#include "tests/server/daemon_harness.h"
+
+namespace photond::test {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+json path_job(int width, int height, int spp, int priority = 50) {
+    return {{"scene", {{"builtin", "cornell-box"}}},
+            {"integrator", "path"},
+            {"priority", priority},
+            {"image", {{"width", width}, {"height", height}, {"spp", spp}, {"tile_size", 16}}}};
+}
+
+/// Follows a job's SSE stream, calling `on_event` for each event; returns false from `on_event`
+/// to hang up. Returns the events seen.
+std::vector<SseEvent> follow_events(const HttpClient& client, const std::string& id,
+                                    const std::function<bool(const SseEvent&)>& on_event) {
+    std::vector<SseEvent> events;
+    std::string pending;
+    HttpResponse response;
+    client.stream("GET", "/v1/jobs/" + id + "/events", {}, {}, std::chrono::seconds(60), response,
+                  [&](std::string_view data) {
+                      pending.append(data);
+                      size_t consumed = 0;
+                      for (SseEvent& e : parse_sse(pending, &consumed)) {
+                          events.push_back(e);
+                          if (!on_event(e)) return false;
+                      }
+                      pending.erase(0, consumed);
+                      return true;
+                  });
+    return events;
+}
+
+class DaemonJobs : public ::testing::Test {
+protected:
+    TempDir dir_{"daemon_jobs"};
+};
+
+TEST_F(DaemonJobs, CancelMidRenderStopsWithinAboutATile) {
+    Daemon daemon(dir_.path() / "cache");
+    ASSERT_TRUE(daemon.started()) << daemon.log();
+    const HttpClient client = daemon.client();
+    // About 6 s of rendering on 2 cores, 192 tiles.
+    const HttpResponse submitted = client.post("/v1/jobs", path_job(256, 192, 64).dump());
+    ASSERT_EQ(submitted.status, 202);
+    const std::string id = submitted.json_body().at("id");
+
+    json first_tile;
+    double cancel_seconds = -1.0;
+    const std::vector<SseEvent> events = follow_events(client, id, [&](const SseEvent& e) {
+        if (e.type != "tile" || !first_tile.is_null()) return true;
+        first_tile = e.data;
+        // While rendering: a finished tile is served, the image is not ready, the preview is.
+        const HttpResponse tile = client.get(e.data.at("url"));
+        EXPECT_EQ(tile.status, 200);
+        EXPECT_EQ(tile.header("content-type"), "image/x-exr");
+        const HttpResponse image = client.get("/v1/jobs/" + id + "/image.exr");
+        EXPECT_EQ(image.status, 409);
+        EXPECT_NE(image.body.find("wait=true"), std::string::npos) << image.body;
+        const HttpResponse preview = client.get("/v1/jobs/" + id + "/preview.png");
+        EXPECT_EQ(preview.status, 200);
+        EXPECT_EQ(preview.body.substr(1, 3), "PNG");
+        const json running = client.get("/v1/jobs/" + id).json_body();
+        EXPECT_EQ(running.at("state"), "running");
+        EXPECT_EQ(running.at("pass"), "render");
+
+        const auto start = Clock::now();
+        const HttpResponse cancelled = client.request("DELETE", "/v1/jobs/" + id);
+        const json status = wait_for_status(client, id, is_terminal_state, std::chrono::seconds(5));
+        cancel_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+        EXPECT_TRUE(cancelled.status == 200 || cancelled.status == 202) << cancelled.body;
+        EXPECT_EQ(status.at("state"), "cancelled");
+        return true;  // read on: the stream must end by itself
+    });
+    ASSERT_FALSE(first_tile.is_null());
+    EXPECT_GE(cancel_seconds, 0.0);
+    EXPECT_LT(cancel_seconds, 2.0);
+    ASSERT_FALSE(events.empty());
+    EXPECT_EQ(events.back().type, "cancelled");
+
+    const json status = client.get("/v1/jobs/" + id).json_body();
+    EXPECT_EQ(status.at("state"), "cancelled");
+    EXPECT_LT(status.at("progress").at("tiles_done").get<int>(), 192);
+    EXPECT_TRUE(status.at("statistics").at("cancelled").get<bool>());
+    // Its pixels are freed: no tiles, no image.
+    EXPECT_EQ(client.get(first_tile.at("url")).status, 404);
+    EXPECT_EQ(client.get("/v1/jobs/" + id + "/image.exr?wait=true").status, 409);
+    EXPECT_EQ(client.request("DELETE", "/v1/jobs/" + id).status, 200);  // again: harmless
+
+    // A queued job is cancelled at once; the daemon goes on with the next job.
+    const std::string blocker =
+        client.post("/v1/jobs", path_job(256, 192, 64).dump()).json_body().at("id");
+    const std::string queued =
+        client.post("/v1/jobs", path_job(32, 32, 1).dump()).json_body().at("id");
+    const HttpResponse dequeued = client.request("DELETE", "/v1/jobs/" + queued);
+    EXPECT_EQ(dequeued.status, 200);
+    EXPECT_EQ(dequeued.json_body().at("state"), "cancelled");
+    client.request("DELETE", "/v1/jobs/" + blocker);
+    const std::string after =
+        client.post("/v1/jobs", path_job(32, 32, 1).dump()).json_body().at("id");
+    EXPECT_EQ(wait_for_status(client, after, is_terminal_state).at("state"), "done");
+    EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+}
+
+TEST_F(DaemonJobs, ClientsHangingUpMidStreamDoNotDisturbTheJob) {
+    Daemon daemon(dir_.path() / "cache");
+    ASSERT_TRUE(daemon.started()) << daemon.log();
+    const HttpClient client = daemon.client();
+    const json job = path_job(128, 96, 24);  // 48 tiles, about a second
+    const std::string id = client.post("/v1/jobs", job.dump()).json_body().at("id");
+
+    // An SSE client that leaves after the first tile event.
+    const std::vector<SseEvent> partial =
+        follow_events(client, id, [](const SseEvent& e) { return e.type != "tile"; });
+    EXPECT_EQ(partial.back().type, "tile");
+    // A multipart client that leaves in the middle of its first part.
+    HttpResponse response;
+    size_t received = 0;
+    client.stream("GET", "/v1/jobs/" + id + "/tiles", {}, {}, std::chrono::seconds(30), response,
+                  [&](std::string_view data) {
+                      received += data.size();
+                      return received < 100;
+                  });
+    EXPECT_EQ(response.status, 200);
+    EXPECT_GE(received, 100u);
+    // Several more that hang up at once.
+    for (int i = 0; i < 5; ++i) {
+        HttpResponse r;
+        client.stream("GET", "/v1/jobs/" + id + (i % 2 ? "/tiles" : "/events"), {}, {},
+                      std::chrono::seconds(30), r, [](std::string_view) { return false; });
+    }
+
+    const json status = wait_for_status(client, id, is_terminal_state);
+    EXPECT_EQ(status.at("state"), "done") << status.dump();
+    EXPECT_EQ(status.at("progress").at("tiles_done"), 48);
+    // A full stream afterwards has every tile and its closing boundary.
+    const HttpResponse stream = client.get("/v1/jobs/" + id + "/tiles");
+    const std::string type = stream.header("content-type");
+    bool closed = false;
+    const auto parts = parse_multipart(stream.body, type.substr(type.find('=') + 1), &closed);
+    EXPECT_EQ(parts.size(), 48u);
+    EXPECT_TRUE(closed);
+    // And the daemon serves new work as before.
+    const std::string next =
+        client.post("/v1/jobs", path_job(32, 32, 1).dump()).json_body().at("id");
+    EXPECT_EQ(wait_for_status(client, next, is_terminal_state).at("state"), "done");
+    EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+}
+
+TEST_F(DaemonJobs, FiftyConcurrentStatusAndEventClientsWhileAJobRenders) {
+    Daemon daemon(dir_.path() / "cache");
+    ASSERT_TRUE(daemon.started()) << daemon.log();
+    const HttpClient client = daemon.client();
+    const std::string id =
+        client.post("/v1/jobs", path_job(160, 120, 32).dump()).json_body().at("id");
+    const int tiles = 10 * 8;
+
+    std::atomic<int> failures{0};
+    std::mutex mutex;
+    std::vector<std::string> messages;
+    auto fail = [&](const std::string& message) {
+        ++failures;
+        std::lock_guard lock(mutex);
+        messages.push_back(message);
+    };
+    std::vector<std::thread> threads;
+    for (int i = 0; i < 25; ++i) {
+        threads.emplace_back([&, i] {  // event clients: each sees the whole history and the end
+            const std::vector<SseEvent> events =
+                follow_events(client, id, [](const SseEvent&) { return true; });
+            int tile_events = 0;
+            for (size_t k = 0; k < events.size(); ++k) {
+                if (events[k].id != k + 1)
+                    return fail("event client " + std::to_string(i) + ": ids not consecutive");
+                tile_events += events[k].type == "tile";
+            }
+            if (events.empty() || events.back().type != "done")
+                return fail("event client " + std::to_string(i) + ": no done");
+            if (tile_events != tiles)
+                return fail("event client " + std::to_string(i) + ": " +
+                            std::to_string(tile_events) + " tiles");
+        });
+        threads.emplace_back([&, i] {  // status clients: progress never goes back
+            uint64_t last = 0;
+            for (;;) {
+                const HttpResponse r = client.get("/v1/jobs/" + id);
+                if (r.status != 200)
+                    return fail("status client " + std::to_string(i) + ": " +
+                                std::to_string(r.status));
+                const json s = r.json_body();
+                const uint64_t done = s.at("progress").at("tiles_done");
+                if (done < last)
+                    return fail("status client " + std::to_string(i) + ": progress went back");
+                last = done;
+                if (is_terminal_state(s)) {
+                    if (s.at("state") != "done")
+                        fail("status client: state " + s.at("state").get<std::string>());
+                    return;
+                }
+                std::this_thread::sleep_for(std::chrono::milliseconds(50));
+            }
+        });
+    }
+    for (std::thread& t : threads) t.join();
+    EXPECT_EQ(failures.load(), 0) << (messages.empty() ? "" : messages.front());
+    EXPECT_EQ(client.get("/healthz").status, 200);
+    EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+}
+
+TEST_F(DaemonJobs, HigherPriorityRunsFirstThenArrivalOrder) {
+    Daemon daemon(dir_.path() / "cache");
+    ASSERT_TRUE(daemon.started()) << daemon.log();
+    const HttpClient client = daemon.client();
+    const std::string blocker =
+        client.post("/v1/jobs", path_job(128, 96, 24).dump()).json_body().at("id");
+    wait_for_status(client, blocker,
+                    [](const json& s) { return s.value("state", "") == "running"; });
+    const std::string low =
+        client.post("/v1/jobs", path_job(16, 16, 1, 10).dump()).json_body().at("id");
+    const std::string high =
+        client.post("/v1/jobs", path_job(16, 16, 1, 90).dump()).json_body().at("id");
+    const std::string high_later =
+        client.post("/v1/jobs", path_job(16, 16, 1, 90).dump()).json_body().at("id");
+    // Newest first in the list.
+    const json list = client.get("/v1/jobs?state=queued").json_body().at("jobs");
+    ASSERT_EQ(list.size(), 3u);
+    EXPECT_EQ(list[0].at("id"), high_later);
+    EXPECT_EQ(list[2].at("id"), low);
+
+    const json s_low = wait_for_status(client, low, is_terminal_state);
+    const json s_high = client.get("/v1/jobs/" + high).json_body();
+    const json s_later = client.get("/v1/jobs/" + high_later).json_body();
+    ASSERT_EQ(s_low.at("state"), "done");
+    ASSERT_EQ(s_high.at("state"), "done");
+    ASSERT_EQ(s_later.at("state"), "done");
+    // RFC 3339 timestamps of one format compare as strings.
+    EXPECT_LE(s_high.at("finished_at").get<std::string>(),
+              s_later.at("started_at").get<std::string>());
+    EXPECT_LE(s_later.at("finished_at").get<std::string>(),
+              s_low.at("started_at").get<std::string>());
+    EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+}
+
+}  // namespace
+}  // namespace photond::test
