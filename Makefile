@@ -38,6 +38,27 @@ tsan: deps
 	cmake --build $(BUILD)-tsan -j$(JOBS) --target irradiance_cache_test
 	TSAN_OPTIONS=halt_on_error=1 $(BUILD)-tsan/tests/irradiance_cache_test --gtest_filter='IrradianceCache.Concurrent*:IrradianceCache.Octree*'
 
+# The stress suite and the fast core tests under AddressSanitizer and UndefinedBehaviorSanitizer
+# (run by CI). Embree and oneTBB are not instrumented, so leak checking is off. Every test runs;
+# a sanitizer report stops the run at once (exit code 86), other failures are listed at the end.
+ASAN_TESTS := degenerate_geometry_test fireflies_test \
+	scene_transform_test builtin_scenes_test gltf_loader_test emission_test analytic_lighting_test \
+	tile_renderer_test photon_test kd_tree_test photon_map_io_test photon_tracer_test \
+	final_gather_test exr_io_test png_preview_test
+
+.PHONY: asan
+asan: deps
+	cmake -S . -B $(BUILD)-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPHOTOND_SANITIZE=address,undefined
+	cmake --build $(BUILD)-asan -j$(JOBS) --target $(ASAN_TESTS)
+	@failed=""; for t in $(ASAN_TESTS); do \
+		echo "== $$t (ASan + UBSan)"; \
+		ASAN_OPTIONS=detect_leaks=0:exitcode=86 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1:exitcode=86 \
+			$(BUILD)-asan/tests/$$t --gtest_brief=1; rc=$$?; \
+		if [ $$rc -eq 86 ]; then echo "$$t: sanitizer error"; exit 1; fi; \
+		if [ $$rc -ne 0 ]; then failed="$$failed $$t"; fi; \
+	done; \
+	if [ -n "$$failed" ]; then echo "tests failed (no sanitizer report):$$failed"; exit 1; fi
+
 demo: build
 	./deploy/demo.sh $(BUILD) $(OUT)
 

@@ -6,7 +6,7 @@ DirectIntegrator::DirectIntegrator(std::shared_ptr<const RenderScene> scene, int
     : scene_(std::move(scene)), max_specular_depth_(max_specular_depth) {}
 
 Color DirectIntegrator::radiance(const CameraRay& ray, SampleContext& context) const {
-    return radiance_along(Ray{ray.origin, ray.direction}, 0, context);
+    return radiance_along(primary_ray(*scene_, ray), 0, context);
 }
 
 Color DirectIntegrator::radiance_along(const Ray& ray, int depth, SampleContext& context) const {

@@ -57,6 +57,12 @@ inline std::optional<Hit> trace_ray(const RenderScene& rs, const Ray& ray, RayCo
     return rs.tracer->intersect(ray);
 }
 
+/// The ray of a camera sample. It starts a self-intersection offset away from the camera, so that
+/// a camera placed exactly on a surface sees past it instead of hitting it at t = 0.
+inline Ray primary_ray(const RenderScene& rs, const CameraRay& ray) {
+    return Ray{ray.origin, ray.direction, rs.tracer->offset_distance(ray.origin)};
+}
+
 /// A ray leaving the surface point of `si` in `direction`, offset against self-intersection.
 inline Ray spawn_ray(const RenderScene& rs, const SurfaceInteraction& si, const Vec3& direction) {
     return Ray{rs.tracer->offset_origin(si.p, si.geometric_normal, direction), direction};

@@ -61,6 +61,19 @@ IrradianceRecord make_irradiance_record(const FinalGatherer& gatherer, const Dif
     r.irradiance = g.irradiance;
     r.rotation_gradient = g.rotation_gradient;
     r.translation_gradient = g.translation_gradient;
+    // Gradient limiting: across its domain (distance a R, normal deviation about a) a record may
+    // change its irradiance by at most the irradiance itself. Gathers right at an edge see hit
+    // distances near zero and return enormous translation gradients; extrapolated over a radius
+    // raised to the pixel minimum they would blow up (Krivanek et al. 2006 limit R by the
+    // gradient; here R is pinned to the pixel limits, so the gradient yields instead).
+    const float reach = settings.cache.accuracy * r.radius;
+    for (int c = 0; c < 3; ++c) {
+        const float limit = r.irradiance[c];
+        const float translation = glm::length(r.translation_gradient[c]) * reach;
+        if (translation > limit) r.translation_gradient[c] *= translation > 0.0f ? limit / translation : 0.0f;
+        const float rotation = glm::length(r.rotation_gradient[c]) * settings.cache.accuracy;
+        if (rotation > limit) r.rotation_gradient[c] *= rotation > 0.0f ? limit / rotation : 0.0f;
+    }
     return r;
 }
 
@@ -107,7 +120,7 @@ std::unique_ptr<IrradianceCache> build_irradiance_cache(const RenderScene& rs, c
                 Candidate& c = candidates[i];
                 const CameraRay ray = camera.generate_ray(c.x + 0.5f, c.y + 0.5f);
                 std::vector<DiffusePoint> points;
-                collect_diffuse_points(rs, Ray{ray.origin, ray.direction}, 0.0f, pixel_spread(ray), 0,
+                collect_diffuse_points(rs, primary_ray(rs, ray), 0.0f, pixel_spread(ray), 0,
                                        settings.max_specular_depth, c.counters, points);
                 c.points = points.size();
                 for (size_t k = 0; k < points.size(); ++k) {

@@ -10,7 +10,7 @@ Color PathIntegrator::radiance(const CameraRay& camera_ray, SampleContext& conte
     const RenderScene& rs = *scene_;
     Color radiance(0.0f);
     Color throughput(1.0f);
-    Ray ray{camera_ray.origin, camera_ray.direction};
+    Ray ray = primary_ray(rs, camera_ray);
     bool previous_was_delta = true;  // the camera ray counts as specular: emission is taken whole
     float previous_bsdf_pdf = 0.0f;
     Vec3 previous_point = camera_ray.origin;

@@ -42,7 +42,7 @@ void PhotonMapIntegrator::prepare(const Camera& camera, CacheBuildStatistics* st
 }
 
 Color PhotonMapIntegrator::radiance(const CameraRay& ray, SampleContext& context) const {
-    return radiance_along(Ray{ray.origin, ray.direction}, 0, 0.0f, pixel_spread(ray), context);
+    return radiance_along(primary_ray(*scene_, ray), 0, 0.0f, pixel_spread(ray), context);
 }
 
 Color PhotonMapIntegrator::indirect_irradiance(const DiffusePoint& point, SampleContext& context) const {

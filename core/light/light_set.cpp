@@ -26,10 +26,15 @@ LightSet::LightSet(const Scene& scene) : scene_(&scene) {
                 break;
             case PunctualLightType::Spot: {
                 e.kind = LightKind::Spot;
-                // Integral of the falloff over the sphere: full inside the inner cone, and
-                // ((c - cos_outer) / (cos_inner - cos_outer))^2 between the cones.
-                const float ci = l.cos_inner, co = std::min(l.cos_outer, l.cos_inner);
-                e.power = 2.0f * kPi * l.intensity * ((1.0f - ci) + (ci - co) / 3.0f);
+                // Integral over the sphere of spot_falloff: ((c - cos_outer) / w)^2 on a ramp of
+                // width w = max(0.001, cos_inner - cos_outer) in the cosine c, full beyond it;
+                // for very narrow cones the ramp never reaches full (it ends at c = 1).
+                const double co = std::min(l.cos_outer, l.cos_inner);
+                const double w = std::max(0.001, static_cast<double>(l.cos_inner) - co);
+                const double full_from = co + w;
+                const double integral = full_from <= 1.0 ? (1.0 - full_from) + w / 3.0
+                                                         : (1.0 - co) * (1.0 - co) * (1.0 - co) / (3.0 * w * w);
+                e.power = 2.0f * kPi * l.intensity * static_cast<float>(integral);
                 break;
             }
             case PunctualLightType::Directional:
