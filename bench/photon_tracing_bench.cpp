@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <map>
 
+#include "bench/bare_embree.h"
 #include "core/math/rng.h"
 #include "core/math/sampling.h"
 #include "core/photon/photon_tracer.h"
@@ -56,13 +57,7 @@ void BM_BareEmbreeIncoherent(benchmark::State& state) {
     RTCScene scene = rs.tracer->handle();
     uint64_t hits = 0;
     for (auto _ : state) {
-        for (const Ray& ray : rays) {
-            RTCIntersectContext context;
-            rtcInitIntersectContext(&context);
-            RTCRayHit rh = to_rtc_rayhit(ray);
-            rtcIntersect1(scene, &context, &rh);
-            hits += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
-        }
+        hits += intersect_bare(scene, rays);
     }
     benchmark::DoNotOptimize(hits);
     state.counters["rays_per_s"] = benchmark::Counter(static_cast<double>(state.iterations() * rays.size()),

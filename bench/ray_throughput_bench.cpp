@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bare_embree.h"
 #include "core/accel/ray_tracer.h"
 #include "core/camera/camera.h"
 #include "core/math/rng.h"
@@ -71,13 +72,7 @@ void BM_BareEmbree_Intersect(benchmark::State& state) {
     const std::vector<Ray>& rays = rays_for(static_cast<int>(state.range(0)));
     uint64_t hits = 0;
     for (auto _ : state) {
-        for (const Ray& ray : rays) {
-            RTCIntersectContext context;
-            rtcInitIntersectContext(&context);
-            RTCRayHit rh = to_rtc_rayhit(ray);
-            rtcIntersect1(scene, &context, &rh);
-            hits += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
-        }
+        hits += intersect_bare(scene, rays);
     }
     benchmark::DoNotOptimize(hits);
     state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * rays.size()));
