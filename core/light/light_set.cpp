@@ -7,10 +7,14 @@
 namespace photond {
 
 float LightSet::spot_falloff(const PunctualLight& light, float cos_angle) {
-    // KHR_lights_punctual, "Inner and Outer Cone Angles": smooth quadratic attenuation.
-    const float scale = 1.0f / std::max(0.001f, light.cos_inner - light.cos_outer);
-    const float offset = -light.cos_outer * scale;
-    const float t = std::clamp(cos_angle * scale + offset, 0.0f, 1.0f);
+    return spot_falloff_from_axis(light, 1.0f - cos_angle);
+}
+
+float LightSet::spot_falloff_from_axis(const PunctualLight& light, float one_minus_cos) {
+    // KHR_lights_punctual, "Inner and Outer Cone Angles": smooth quadratic attenuation, written
+    // in 1 - cos so that cones of a fraction of a degree keep their float precision.
+    const float width = std::max(0.001f, light.cos_inner - light.cos_outer);
+    const float t = std::clamp(((1.0f - light.cos_outer) - one_minus_cos) / width, 0.0f, 1.0f);
     return t * t;
 }
 
@@ -163,9 +167,12 @@ std::optional<EmissionSample> LightSet::sample_emission(float u_select, const Ve
             const PunctualLight& l = scene_->lights[e.index];
             const float cos_max = std::min(l.cos_outer, l.cos_inner);
             const Vec3 local = sample_uniform_cone(u_direction, cos_max);
+            // The falloff from the sample's 1 - cos, exact where local.z has rounded to 1.
+            const float one_minus_cos = u_direction.x * (1.0f - cos_max);
             s.origin = l.position;
             s.direction = Frame(l.direction).to_world(local);
-            s.flux_weight = l.intensity * spot_falloff(l, local.z) / (uniform_cone_pdf(cos_max) * choice_pdf);
+            s.flux_weight = l.intensity * spot_falloff_from_axis(l, one_minus_cos) /
+                            (uniform_cone_pdf(cos_max) * choice_pdf);
             break;
         }
         case LightKind::Directional: {

@@ -65,6 +65,8 @@ public:
 
     /// Spot light angular falloff of KHR_lights_punctual (quadratic in the cosine).
     static float spot_falloff(const PunctualLight& light, float cos_angle);
+    /// The same falloff from 1 - cos(angle to the axis), precise for narrow cones.
+    static float spot_falloff_from_axis(const PunctualLight& light, float one_minus_cos);
 
 private:
     struct Entry {

@@ -42,8 +42,10 @@ inline Vec3 sample_uniform_sphere(const Vec2& u) {
 /// Uniform direction in the cone around +z with cos(half angle) = cos_max;
 /// pdf = 1 / (2 pi (1 - cos_max)).
 inline Vec3 sample_uniform_cone(const Vec2& u, float cos_max) {
-    const float cos_theta = (1.0f - u.x) + u.x * cos_max;
-    const float sin_theta = safe_sqrt(1.0f - cos_theta * cos_theta);
+    // Through 1 - cos(theta), exact for narrow cones where cos(theta) itself has few float steps.
+    const float one_minus_cos = u.x * (1.0f - cos_max);
+    const float cos_theta = 1.0f - one_minus_cos;
+    const float sin_theta = safe_sqrt(one_minus_cos * (2.0f - one_minus_cos));
     const float phi = 2.0f * kPi * u.y;
     return {sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta};
 }
