@@ -14,8 +14,8 @@ Bsdf make_bsdf(const Scene& scene, const SurfaceInteraction& si, const Vec3& wo)
 
 Color sample_direct_light(const RenderScene& rs, const SurfaceInteraction& si, const Bsdf& bsdf,
                           const Vec3& wo, SampleContext& context, bool use_mis, LobeMask mask) {
-    const float u_select = context.rng.next_float();
-    const Vec2 u = context.rng.next_vec2();
+    const float u_select = context.next_1d();
+    const Vec2 u = context.next_2d();
     const std::optional<LightSample> ls = rs.lights->sample_incident(si.p, u_select, u);
     if (!ls || !(ls->pdf > 0.0f) || is_black(ls->radiance)) return Color(0.0f);
     const Color f = bsdf.eval(wo, ls->wi, TransportMode::Radiance, mask);

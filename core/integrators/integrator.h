@@ -8,6 +8,7 @@
 #include "core/accel/ray_tracer.h"
 #include "core/camera/camera.h"
 #include "core/material/bsdf.h"
+#include "core/math/low_discrepancy.h"
 #include "core/math/rng.h"
 #include "core/render/render_scene.h"
 #include "core/scene/interaction.h"
@@ -30,10 +31,28 @@ struct RayCounters {
     }
 };
 
-/// What one camera sample may use: its own random stream and counters.
+/// What one camera sample may use: its own random stream and counters. A camera sample also
+/// carries its place in its pixel's sample pattern: then its first kStratifiedDraws draws of
+/// next_1d/next_2d come from scrambled Sobol' points shared out over the pixel's samples (one
+/// independent pattern per draw), so the pixel's samples of, say, the light at the first hit are
+/// stratified; later draws, and contexts without a pattern, use the random stream.
 struct SampleContext {
+    static constexpr uint32_t kStratifiedDraws = 8;  // deeper dimensions gain little
+
     Rng& rng;
     RayCounters& counters;
+    uint64_t pattern_seed = 0;  // 0: no pattern (not a camera sample)
+    uint32_t sample_index = 0;  // this sample's index within its pixel
+    uint32_t draws = 0;         // next_1d/next_2d calls so far
+
+    float next_1d() {
+        if (pattern_seed == 0 || draws >= kStratifiedDraws) return rng.next_float();
+        return scrambled_sobol_1d(sample_index, hash_indices(pattern_seed, draws++));
+    }
+    Vec2 next_2d() {
+        if (pattern_seed == 0 || draws >= kStratifiedDraws) return rng.next_vec2();
+        return scrambled_sobol_2d(sample_index, hash_indices(pattern_seed, draws++));
+    }
 };
 
 /// Computes the radiance arriving at the camera along a ray. Implementations are immutable

@@ -35,8 +35,8 @@ Color PathIntegrator::radiance(const CameraRay& camera_ray, SampleContext& conte
         if (bsdf.has_non_delta())
             radiance += throughput * sample_direct_light(rs, si, bsdf, wo, context, true);
 
-        const float u_lobe = context.rng.next_float();
-        const Vec2 u = context.rng.next_vec2();
+        const float u_lobe = context.next_1d();
+        const Vec2 u = context.next_2d();
         const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u);
         if (!s || !(s->pdf > 0.0f) || is_black(s->weight)) break;
         throughput *= s->weight;
@@ -48,7 +48,7 @@ Color PathIntegrator::radiance(const CameraRay& camera_ray, SampleContext& conte
         if (depth + 1 >= roulette_start_depth_) {
             // Survive with the throughput's largest channel (capped), compensating survivors.
             const float survive = std::min(0.95f, max_component(throughput));
-            if (!(survive > 0.0f) || context.rng.next_float() >= survive) break;
+            if (!(survive > 0.0f) || context.next_1d() >= survive) break;
             throughput /= survive;
         }
     }

@@ -8,6 +8,11 @@
 
 namespace photond {
 
+namespace {
+// Distinguishes the pixel sample pattern's hash from the samples' random streams.
+constexpr uint64_t kPatternStream = 0x7061747465726e00ull;
+}  // namespace
+
 std::vector<PixelRect> make_tiles(const PixelRect& area, int tile_size) {
     std::vector<PixelRect> tiles;
     const int size = std::max(tile_size, 1);
@@ -41,10 +46,12 @@ TileRenderResult render_tiles(const Integrator& integrator, const Camera& camera
             for (int x = tile.x0; x < tile.x1; ++x) {
                 const uint64_t pixel = static_cast<uint64_t>(y) * static_cast<uint64_t>(width) + x;
                 DVec3 sum(0.0);
+                // The pixel's sample pattern (never 0, which means "none").
+                const uint64_t pattern_seed = hash_indices(settings.seed, pixel, kPatternStream) | 1u;
                 for (int s = 0; s < spp; ++s) {
                     Rng rng = Rng::for_stream(settings.seed, pixel, static_cast<uint64_t>(s));
-                    SampleContext context{rng, local};
-                    const Vec2 jitter = rng.next_vec2();
+                    SampleContext context{rng, local, pattern_seed, static_cast<uint32_t>(s)};
+                    const Vec2 jitter = context.next_2d();
                     const CameraRay ray = camera.generate_ray(static_cast<float>(x) + jitter.x,
                                                               static_cast<float>(y) + jitter.y);
                     const Color L = integrator.radiance(ray, context);

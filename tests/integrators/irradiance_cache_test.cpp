@@ -132,7 +132,9 @@ TEST(IrradianceCache, OctreeLookupEqualsLinearSearch) {
         Color e(0.0f);
         const bool found = cache.interpolate(p, Vec3(0, 0, 1), &e);
         ASSERT_EQ(found, weight > 0.0) << q;
-        if (found) ASSERT_NEAR(e.x, sum / weight, 1e-4) << q;
+        if (found) {
+            ASSERT_NEAR(e.x, sum / weight, 1e-4) << q;
+        }
     }
 }
 
