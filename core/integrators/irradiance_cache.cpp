@@ -72,9 +72,13 @@ bool IrradianceCache::interpolate(const Vec3& p, const Vec3& n, Color* irradianc
     const auto add = [&](uint32_t index) {
         const IrradianceRecord& r = records_[index];
         const Vec3 offset = p - r.position;
-        const float distance = glm::length(offset);
+        // Cheap rejections first: eps < a needs both |P - P_i| < a R_i and 1 - n.n_i < a^2.
+        const float reach = a * r.radius;
+        const float distance2 = glm::dot(offset, offset);
+        if (!(distance2 < reach * reach)) return;
         const float cos_normals = std::min(1.0f, glm::dot(n, r.normal));
-        const float epsilon = distance / r.radius + safe_sqrt(1.0f - cos_normals);
+        if (!(1.0f - cos_normals < a * a)) return;
+        const float epsilon = std::sqrt(distance2) / r.radius + safe_sqrt(1.0f - cos_normals);
         if (!(epsilon < a)) return;
         // In front of P: the record sees a different hemisphere (Ward et al. 1988).
         if (glm::dot(offset, 0.5f * (n + r.normal)) < -kFrontTolerance * r.radius) return;
