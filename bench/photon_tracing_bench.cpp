@@ -32,6 +32,7 @@ void BM_PhotonTracing(benchmark::State& state) {
     settings.global_photons = 200000;
     settings.caustic_photons = state.range(0) == 0 ? 50000 : 0;
     settings.threads = 1;
+    settings.irradiance_stride = 0;  // the precomputed irradiance is not tracing
     uint64_t emitted = 0, rays = 0;
     for (auto _ : state) {
         const PhotonMaps maps = trace_photons(rs, settings).value();
