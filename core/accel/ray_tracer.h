@@ -47,6 +47,9 @@ struct Ray {
     Vec3 direction{0.0f, 0.0f, 1.0f};  // need not be unit for occlusion, must be for intersect's t
     float tmin = 0.0f;
     float tmax = std::numeric_limits<float>::infinity();
+    /// The origin is a viewpoint (a camera's exact position), not a point computed on a surface;
+    /// RayTracer::intersect then puts a viewpoint that lies on a surface on its front side.
+    bool from_viewpoint = false;
 };
 
 struct Hit {
@@ -90,8 +93,22 @@ public:
     RayTracer(const RayTracer&) = delete;
     RayTracer& operator=(const RayTracer&) = delete;
 
+    /// The nearest hit in [tmin, tmax]. For a ray from_viewpoint, a viewpoint within
+    /// offset_distance of a surface counts as lying on it, on its front side (the limit from the
+    /// side its normal points to): the ray sees the surface at the viewpoint's foot when it heads
+    /// into the surface, and passes it when it heads away (back-face hits that close to the
+    /// viewpoint are skipped). Farther surfaces are hit as they are, whichever face.
     std::optional<Hit> intersect(const Ray& ray) const;
+    /// Whether anything lies in [tmin, tmax] (from_viewpoint is not looked at).
     bool occluded(const Ray& ray) const;
+
+    /// The ray of a camera at `origin`: no offset (a camera position is exact, unlike a computed
+    /// hit point), and from_viewpoint set.
+    static Ray viewpoint_ray(const Vec3& origin, const Vec3& direction) {
+        Ray ray{origin, direction};
+        ray.from_viewpoint = true;
+        return ray;
+    }
 
     /// Distance by which to move a ray origin off a surface at p so that it does not hit the
     /// surface it leaves: a few float ulps of p's largest coordinate plus a tiny share of the
@@ -114,6 +131,8 @@ public:
     // from the origin: 64 eps moved rays 0.76 units off surfaces at 1e5 (tests/stress).
     static constexpr float kCoordinateUlps = 4.0f * std::numeric_limits<float>::epsilon();
     static constexpr float kSceneRelativeOffset = 1e-5f;
+    /// Back faces a viewpoint ray may skip (a viewpoint on a vertex or an edge may see several).
+    static constexpr int kMaxViewpointSkips = 8;
 
 private:
     RayTracer() = default;

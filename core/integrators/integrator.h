@@ -76,10 +76,10 @@ inline std::optional<Hit> trace_ray(const RenderScene& rs, const Ray& ray, RayCo
     return rs.tracer->intersect(ray);
 }
 
-/// The ray of a camera sample. It starts a self-intersection offset away from the camera, so that
-/// a camera placed exactly on a surface sees past it instead of hitting it at t = 0.
-inline Ray primary_ray(const RenderScene& rs, const CameraRay& ray) {
-    return Ray{ray.origin, ray.direction, rs.tracer->offset_distance(ray.origin)};
+/// The ray of a camera sample: from the camera itself, which RayTracer::intersect puts on the front
+/// side of a surface it lies on (so a camera on a floor sees the room, and the floor below it).
+inline Ray primary_ray(const RenderScene&, const CameraRay& ray) {
+    return RayTracer::viewpoint_ray(ray.origin, ray.direction);
 }
 
 /// A ray leaving the surface point of `si` in `direction`, offset against self-intersection.

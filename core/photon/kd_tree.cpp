@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstdio>
 #include <limits>
 #include <string>
@@ -12,7 +13,7 @@
 namespace photond {
 namespace {
 
-// What the build sorts: 16 bytes (moved faster than 20-byte photons), and the input index that
+// What the build sorts: 16 bytes (moved faster than 24-byte photons), and the input index that
 // breaks ties between equal coordinates.
 struct BuildItem {
     Vec3 position;
@@ -202,6 +203,26 @@ Expected<PhotonKdTree> PhotonKdTree::from_tree_order(std::vector<Photon> photons
 }
 
 void PhotonKdTree::k_nearest(const Vec3& p, uint32_t k, float max_radius, KnnResult& out) const {
+    k_nearest_impl(p, k, max_radius, out, [&p](const Vec3& q) { return distance2(p, q); });
+}
+
+void PhotonKdTree::k_nearest_in_disc(const Vec3& p, const Vec3& normal, float flattening,
+                                     uint32_t k, float max_radius, KnnResult& out) const {
+    const float stretch2 = flattening > 1.0f ? flattening * flattening - 1.0f : 0.0f;
+    if (!is_finite(normal) || !std::isfinite(stretch2)) {
+        out.clear();
+        return;
+    }
+    k_nearest_impl(p, k, max_radius, out, [&](const Vec3& q) {
+        return disc_distance2(p, q, normal, stretch2);
+    });
+}
+
+template <class Distance2>
+void PhotonKdTree::k_nearest_impl(const Vec3& p, uint32_t k, float max_radius, KnnResult& out,
+                                  Distance2 distance2_to) const {
+    // distance2_to(q) >= distance2(p, q) for every q: a subtree beyond the splitting plane by
+    // more than the current radius holds no closer photon in either metric.
     out.clear();
     if (k == 0 || photons_.empty() || !is_finite(p) || !(max_radius >= 0.0f)) return;
     std::vector<KnnNeighbor>& heap = out.neighbors;
@@ -244,7 +265,7 @@ void PhotonKdTree::k_nearest(const Vec3& p, uint32_t k, float max_radius, KnnRes
         while (hi - lo > kLeafSize) {
             const uint32_t mid = lo + (hi - lo) / 2;
             const Photon& node = photons_[mid];
-            consider(mid, distance2(p, node.position));
+            consider(mid, distance2_to(node.position));
             const uint32_t axis = node.split_axis();
             const float plane = p[axis] - node.position[axis];
             const float plane2 = plane * plane;
@@ -256,7 +277,7 @@ void PhotonKdTree::k_nearest(const Vec3& p, uint32_t k, float max_radius, KnnRes
                 lo = mid + 1;
             }
         }
-        for (uint32_t i = lo; i < hi; ++i) consider(i, distance2(p, photons_[i].position));
+        for (uint32_t i = lo; i < hi; ++i) consider(i, distance2_to(photons_[i].position));
     }
     out.radius2 = full ? heap[0].dist2 : farthest2;
 }

@@ -52,7 +52,7 @@ struct KnnResult {
 /// subtree of index range [lo, hi) has its split photon at mid = lo + (hi - lo) / 2 (split axis
 /// in the photon's flags, split value its coordinate), left subtree [lo, mid), right subtree
 /// [mid + 1, hi); ranges of at most kLeafSize photons are leaves scanned linearly. Each subtree
-/// is contiguous in memory and no pointers or extra node records are stored: 20 bytes per photon,
+/// is contiguous in memory and no pointers or extra node records are stored: 24 bytes per photon,
 /// like Jensen's left-balanced heap, and faster to query (bench/kd_tree_bench.cpp measures both).
 /// Split axis: the largest extent of the subtree's bounding box (lowest axis on ties); split at
 /// the median of (coordinate, input index), so equal coordinates are ordered deterministically.
@@ -83,6 +83,13 @@ public:
     /// or a negative or NaN max_radius; max_radius may be +infinity.
     void k_nearest(const Vec3& p, uint32_t k, float max_radius, KnnResult& out) const;
 
+    /// k_nearest in a disc instead of a sphere (Jensen 2001, section 7.2: the search sphere
+    /// compressed along the surface normal): distances are disc_distance2's, an ellipsoid whose
+    /// axis along the unit `normal` is 1 / flattening of the others (flattening >= 1; 1 is
+    /// k_nearest). The same guarantees: ties by index, exactly a brute-force search.
+    void k_nearest_in_disc(const Vec3& p, const Vec3& normal, float flattening, uint32_t k,
+                           float max_radius, KnnResult& out) const;
+
     /// Calls f(uint32_t index, float dist2) for every photon with distance <= radius to p, in a
     /// deterministic order. Nothing for a non-finite p or a negative or NaN radius.
     template <class F>
@@ -102,8 +109,19 @@ public:
         const float dx = a.x - b.x, dy = a.y - b.y, dz = a.z - b.z;
         return dx * dx + dy * dy + dz * dz;
     }
+    /// The squared disc distance of k_nearest_in_disc: |a - b|^2 + (f^2 - 1) ((a - b) . n)^2,
+    /// given stretch2 = f^2 - 1 >= 0. Never below distance2, which keeps the tree's pruning valid.
+    static float disc_distance2(const Vec3& a, const Vec3& b, const Vec3& normal, float stretch2) {
+        const float dx = a.x - b.x, dy = a.y - b.y, dz = a.z - b.z;
+        const float along = dx * normal.x + dy * normal.y + dz * normal.z;
+        return dx * dx + dy * dy + dz * dz + stretch2 * (along * along);
+    }
 
 private:
+    template <class Distance2>
+    void k_nearest_impl(const Vec3& p, uint32_t k, float max_radius, KnnResult& out,
+                        Distance2 distance2_to) const;
+
     // Deeper than any balanced tree over < 2^32 photons (depth <= 32).
     static constexpr int kMaxStackDepth = 64;
 

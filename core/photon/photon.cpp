@@ -1,5 +1,6 @@
 #include "core/photon/photon.h"
 
+#include <algorithm>
 #include <cfloat>
 #include <cmath>
 
@@ -47,11 +48,33 @@ float sanitize_channel(float c) {
     return std::min(c, FLT_MAX);
 }
 
+// Octahedral normal codes (Meyer et al. 2010): the unit octahedron |x| + |y| + |z| = 1 folded
+// onto the square [-1, 1]^2, 16 bits per coordinate.
+constexpr float kNormalScale = 65535.0f;
+
+float sign_not_zero(float v) { return v >= 0.0f ? 1.0f : -1.0f; }
+
+uint16_t normal_code(float c) {
+    return uint16_t(std::lround(std::clamp(c * 0.5f + 0.5f, 0.0f, 1.0f) * kNormalScale));
+}
+
 }  // namespace
+
+Vec3 Photon::normal() const {
+    if (!has_normal()) return Vec3(0.0f);
+    const float x = float(normal_u_) * (2.0f / kNormalScale) - 1.0f;
+    const float y = float(normal_v_) * (2.0f / kNormalScale) - 1.0f;
+    Vec3 n(x, y, 1.0f - std::abs(x) - std::abs(y));
+    if (n.z < 0.0f) {
+        n.x = (1.0f - std::abs(y)) * sign_not_zero(x);
+        n.y = (1.0f - std::abs(x)) * sign_not_zero(y);
+    }
+    return glm::normalize(n);  // |n| >= 1 / sqrt(3): never zero
+}
 
 constinit const PhotonDirectionTables kPhotonDirectionTables = make_direction_tables();
 
-Photon make_photon(Vec3 position, Vec3 direction, Color flux, uint8_t user_flags) {
+Photon make_photon(Vec3 position, Vec3 direction, Color flux, uint8_t user_flags, Vec3 normal) {
     Photon p;
     p.position = position;
     p.flags_ = uint8_t((user_flags << 2) | 3u);
@@ -84,6 +107,21 @@ Photon make_photon(Vec3 position, Vec3 direction, Color flux, uint8_t user_flags
     if (phi < 0.0f) phi += 2.0f * kPi;
     p.theta_ = uint8_t(std::min(255, int(theta * (256.0f / kPi))));
     p.phi_ = uint8_t(int(phi * (256.0f / (2.0f * kPi))) & 255);  // phi = 2 pi wraps to bin 0
+
+    // Normal: projected onto the octahedron, the lower half folded over the diagonals.
+    const float l1 = std::abs(normal.x) + std::abs(normal.y) + std::abs(normal.z);
+    if (l1 > 0.0f && std::isfinite(l1)) {
+        float x = normal.x / l1, y = normal.y / l1;
+        if (normal.z < 0.0f) {
+            const float folded_x = (1.0f - std::abs(y)) * sign_not_zero(x);
+            y = (1.0f - std::abs(x)) * sign_not_zero(y);
+            x = folded_x;
+        }
+        p.normal_u_ = normal_code(x);
+        p.normal_v_ = normal_code(y);
+        // (0, 0) is "no normal"; it decodes to -z, as does the opposite corner.
+        if (p.normal_u_ == 0 && p.normal_v_ == 0) p.normal_u_ = p.normal_v_ = 65535;
+    }
     return p;
 }
 

@@ -1,6 +1,9 @@
-// A compact photon for photon maps: 20 bytes, as in Jensen, "Realistic Image Synthesis Using
+// A compact photon for photon maps: 24 bytes. Jensen's 20 ("Realistic Image Synthesis Using
 // Photon Mapping" (2001), section 6.3: position (3 floats), flux in a shared-exponent format,
-// direction as two bytes (theta, phi) decoded through tables, and one byte of flags.
+// direction as two bytes (theta, phi) decoded through tables, one byte of flags) and the surface
+// normal in 4 bytes, which Jensen suggests storing so that an estimate can refuse photons of
+// other surfaces (section 7.2): photons on the inside of a thin closed object otherwise light its
+// outside near the edges.
 #pragma once
 
 #include <algorithm>
@@ -33,6 +36,9 @@ extern const PhotonDirectionTables kPhotonDirectionTables;
 ///   saturates; decoding never yields NaN or Inf.
 /// - Direction: theta and phi in 256 bins each, decoded at the bin centre: angular error
 ///   <= 0.8 degrees (half a theta bin, 0.35 deg, combined with half a phi bin, 0.70 deg).
+/// - Normal: octahedral map (Meyer et al. 2010, "On floating-point normal vectors"), 16 bits per
+///   coordinate, rounded to nearest: angular error < 0.01 degrees. The code (0, 0) means "no
+///   normal" (the encoder never writes it: that corner and (65535, 65535) both decode to -z).
 struct Photon {
     Vec3 position{0.0f};
 
@@ -55,6 +61,11 @@ struct Photon {
                 t.cos_theta[theta_]};
     }
 
+    /// The unit surface normal on the side the photon arrived from, or zero when the photon was
+    /// made without one.
+    Vec3 normal() const;
+    bool has_normal() const { return normal_u_ != 0 || normal_v_ != 0; }
+
     /// Six bits for the caller (e.g. which map, caustic or not), given to make_photon.
     uint8_t user_flags() const { return flags_ >> 2; }
     /// The kd-tree split axis (0, 1, 2) of a photon that is an inner node of a PhotonKdTree;
@@ -66,12 +77,15 @@ struct Photon {
     uint8_t flux_exponent() const { return flux_exponent_; }
     uint8_t theta_bin() const { return theta_; }
     uint8_t phi_bin() const { return phi_; }
+    uint16_t normal_u() const { return normal_u_; }
+    uint16_t normal_v() const { return normal_v_; }
 
     static constexpr int kMinFluxExponent = -100;  // smallest shared exponent (byte value 1)
     static constexpr int kMaxFluxExponent = 127;   // largest; byte value 0 means zero flux
 
 private:
-    friend Photon make_photon(Vec3 position, Vec3 direction, Color flux, uint8_t user_flags);
+    friend Photon make_photon(Vec3 position, Vec3 direction, Color flux, uint8_t user_flags,
+                              Vec3 normal);
     friend class PhotonKdTree;
 
     void set_split_axis(uint32_t axis) { flags_ = uint8_t((flags_ & ~3u) | (axis & 3u)); }
@@ -81,13 +95,18 @@ private:
     uint8_t theta_ = 0;            // floor(theta * 256 / pi), theta = acos(direction.z)
     uint8_t phi_ = 0;              // floor(phi * 256 / (2 pi)), phi = atan2(y, x) in [0, 2 pi)
     uint8_t flags_ = 3;            // bits 0-1 split axis, bits 2-7 user flags
+    uint16_t normal_u_ = 0;        // octahedral normal, both 0 = none
+    uint16_t normal_v_ = 0;
 };
 
-static_assert(sizeof(Photon) == 20, "Photon must stay 20 bytes (Jensen's layout)");
+// 24 = 12 + 4 + 4 x 1 + 2 x 2: the fields fill it, no padding.
+static_assert(sizeof(Photon) == 24, "Photon must stay 24 bytes (Jensen's 20 and a normal)");
 static_assert(std::is_trivially_copyable_v<Photon>);
 
 /// Packs a photon. direction need not be unit (it is normalised; a zero or non-finite one
-/// becomes +z); user_flags keeps its low 6 bits.
-Photon make_photon(Vec3 position, Vec3 direction, Color flux, uint8_t user_flags = 0);
+/// becomes +z); user_flags keeps its low 6 bits; normal need not be unit either (zero or
+/// non-finite: the photon has none).
+Photon make_photon(Vec3 position, Vec3 direction, Color flux, uint8_t user_flags = 0,
+                   Vec3 normal = Vec3(0.0f));
 
 }  // namespace photond

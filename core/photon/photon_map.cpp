@@ -28,6 +28,14 @@ double estimate_radius2(const KnnResult& found, uint32_t k, float max_radius) {
     return static_cast<double>(found.radius2);
 }
 
+/// Whether a photon may count in an estimate at a surface point with unit normal n (on the side
+/// of the viewer): it arrived from that side, and it was stored on a surface facing the same way
+/// (photons made without a normal only have the first test).
+bool photon_counts(const Photon& photon, const Vec3& n) {
+    if (glm::dot(-photon.direction(), n) <= 0.0f) return false;
+    return !photon.has_normal() || glm::dot(photon.normal(), n) > kPhotonNormalCosine;
+}
+
 }  // namespace
 
 Color PhotonMap::estimate_radiance(const Vec3& p, const Vec3& normal, const Bsdf& bsdf,
@@ -36,7 +44,7 @@ Color PhotonMap::estimate_radiance(const Vec3& p, const Vec3& normal, const Bsdf
     KnnResult& found = thread_scratch();
     const float max_radius = options.max_radius > 0.0f ? options.max_radius
                                                        : std::numeric_limits<float>::infinity();
-    tree_.k_nearest(p, options.k, max_radius, found);
+    tree_.k_nearest_in_disc(p, normal, kPhotonDiscFlattening, options.k, max_radius, found);
     // The estimate's own radius decides (a pile of photons at p inside a finite search ball has
     // one); zero only when k photons sit exactly at p, where the density is undefined.
     const double radius2 = estimate_radius2(found, options.k, max_radius);
@@ -48,8 +56,8 @@ Color PhotonMap::estimate_radiance(const Vec3& p, const Vec3& normal, const Bsdf
     for (const KnnNeighbor& n : found.neighbors) {
         const Photon& photon = tree_.photon(n.index);
         if (photon.user_flags() & options.exclude_flags) continue;
+        if (!photon_counts(photon, normal)) continue;
         const Vec3 wi = -photon.direction();
-        if (glm::dot(wi, normal) <= 0.0f) continue;
         const Color f = bsdf.eval(wo, wi, TransportMode::Radiance, options.lobes);
         DVec3 contribution = DVec3(f) * DVec3(photon.flux());
         if (options.cone_filter) contribution *= 1.0 - std::sqrt(static_cast<double>(n.dist2)) / (kCone * r);
@@ -65,14 +73,13 @@ Color PhotonMap::estimate_irradiance(const Vec3& p, const Vec3& normal, uint32_t
     if (tree_.empty()) return Color(0.0f);
     KnnResult& found = thread_scratch();
     max_radius = max_radius > 0.0f ? max_radius : std::numeric_limits<float>::infinity();
-    tree_.k_nearest(p, k, max_radius, found);
+    tree_.k_nearest_in_disc(p, normal, kPhotonDiscFlattening, k, max_radius, found);
     const double radius2 = estimate_radius2(found, k, max_radius);  // see estimate_radiance
     if (found.size() < kMinPhotonsPerEstimate || !(radius2 > 0.0)) return Color(0.0f);
     DVec3 sum(0.0);
     for (const KnnNeighbor& n : found.neighbors) {
         const Photon& photon = tree_.photon(n.index);
-        if (photon.user_flags() & exclude_flags) continue;
-        if (glm::dot(-photon.direction(), normal) <= 0.0f) continue;
+        if ((photon.user_flags() & exclude_flags) || !photon_counts(photon, normal)) continue;
         sum += DVec3(photon.flux());
     }
     return Color(sum / (kPiDouble * radius2));
@@ -83,10 +90,13 @@ bool PhotonMap::nearest_irradiance(const Vec3& p, const Vec3& normal, float max_
     if (tree_.empty()) return false;
     constexpr uint32_t kCandidates = 4;
     KnnResult& found = thread_scratch();
-    tree_.k_nearest(p, kCandidates, max_radius > 0.0f ? max_radius : std::numeric_limits<float>::infinity(), found);
+    if (!(max_radius > 0.0f)) max_radius = std::numeric_limits<float>::infinity();
+    tree_.k_nearest_in_disc(p, normal, kPhotonDiscFlattening, kCandidates, max_radius, found);
     const KnnNeighbor* best = nullptr;
     for (const KnnNeighbor& n : found.neighbors) {
-        if (glm::dot(tree_.photon(n.index).direction(), normal) <= kIrradianceNormalCosine) continue;
+        const Photon& photon = tree_.photon(n.index);
+        const Vec3 photon_normal = photon.has_normal() ? photon.normal() : photon.direction();
+        if (glm::dot(photon_normal, normal) <= kIrradianceNormalCosine) continue;
         // Nearest first; ties go to the smaller index so the choice is deterministic.
         if (!best || n.dist2 < best->dist2 || (n.dist2 == best->dist2 && n.index < best->index)) best = &n;
     }

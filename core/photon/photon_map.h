@@ -1,8 +1,10 @@
 // A photon map: photons with their flux already divided by the number of photons emitted for
 // this map, in a kd-tree, and the radiance estimate of Jensen (2001, eq. 7.6):
 //   L_o(x, w_o) ~ 1 / (pi r^2) * sum_p f_r(x, w_p, w_o) dPhi_p
-// over the k nearest photons, r the distance to the farthest. Immutable after construction;
-// every const member may be called concurrently.
+// over the k nearest photons, r the distance to the farthest, found in a disc around x rather than
+// a sphere and counting only photons stored on a surface that faces like x's (Jensen 2001,
+// section 7.2; kPhotonDiscFlattening, kPhotonNormalCosine). Immutable after construction; every
+// const member may be called concurrently.
 #pragma once
 
 #include <cstdint>
@@ -27,6 +29,21 @@ inline constexpr uint32_t kMinPhotonsPerEstimate = 8;
 /// Minimum cosine between a query's normal and a precomputed-irradiance photon's normal.
 inline constexpr float kIrradianceNormalCosine = 0.9f;
 
+/// Minimum cosine between a query's normal and the surface normal a photon was stored with, for
+/// the photon to count in an estimate (Jensen 2001, section 7.2: photons of other surfaces are
+/// refused). Surfaces meeting at an edge (90 degrees: cosine 0) or the two sides of a thin wall
+/// (cosine -1) are refused; a curved surface's own photons pass while its normal turns by less
+/// than 60 degrees across the search radius.
+inline constexpr float kPhotonNormalCosine = 0.5f;
+
+/// Estimates gather photons from a disc, not a sphere (Jensen 2001, section 7.2): an ellipsoid
+/// whose axis along the query's normal is this many times shorter than its radius, so that a
+/// parallel surface facing the same way (the floor inside a box, seen from a surface under the
+/// box) is read only where it lies closer than 1 / kPhotonDiscFlattening of the search radius.
+/// On a curved surface the disc stretches distances by sqrt(1 + (f r / 2R)^2) at radius r for a
+/// curvature radius R: 3% at r = R / 10.
+inline constexpr float kPhotonDiscFlattening = 5.0f;
+
 struct RadianceEstimateOptions {
     uint32_t k = 50;                 // nearest photons to gather
     float max_radius = 0.0f;         // search radius cap (world units); <= 0 means unbounded
@@ -46,18 +63,21 @@ public:
     PhotonMap(PhotonKdTree tree, uint64_t emitted);
 
     /// Reflected radiance at p towards wo; `normal` is the shading normal on wo's side. Photons
-    /// arriving from behind the surface (dot(-direction, normal) <= 0) are skipped.
+    /// arriving from behind the surface (dot(-direction, normal) <= 0) are skipped, and so are
+    /// photons stored with a surface normal that disagrees with `normal` (cosine <=
+    /// kPhotonNormalCosine): those on the other side of a thin wall or on another surface.
     Color estimate_radiance(const Vec3& p, const Vec3& normal, const Bsdf& bsdf, const Vec3& wo,
                             const RadianceEstimateOptions& options) const;
 
-    /// Irradiance at p (photon flux per area), for diffuse reflection L = rho / pi * E.
+    /// Irradiance at p (photon flux per area), for diffuse reflection L = rho / pi * E. Photons
+    /// are skipped as in estimate_radiance.
     Color estimate_irradiance(const Vec3& p, const Vec3& normal, uint32_t k, float max_radius,
                               uint8_t exclude_flags = 0) const;
 
     /// Precomputed irradiance (Christensen 1999, "Faster photon map global illumination"): in a
-    /// map whose photons hold irradiance (flux) and surface normal (direction), the nearest one
-    /// within max_radius whose normal agrees with `normal` (cosine > kIrradianceNormalCosine).
-    /// Returns false when none is near.
+    /// map whose photons hold irradiance (flux) and surface normal (normal, or direction for
+    /// photons without one), the nearest one within max_radius whose normal agrees with `normal`
+    /// (cosine > kIrradianceNormalCosine). Returns false when none is near.
     bool nearest_irradiance(const Vec3& p, const Vec3& normal, float max_radius, Color* irradiance) const;
 
     bool empty() const { return tree_.empty(); }

@@ -7,7 +7,7 @@
 //   "PHOTONMP"                               8 bytes
 //   format version                           u32 (kPhotonMapFormatVersion)
 //   byte-order marker                        u32 0x01020304 in the writer's byte order
-//   sizeof(Photon)                           u32 (20)
+//   sizeof(Photon)                           u32 (24)
 //   key length, key bytes                    u32, then that many bytes (at most kMaxPhotonMapKey)
 //   statistics                               PhotonTracingStatistics: emitted, emitted_global,
 //                                            emitted_caustic, stored_global, stored_caustic, rays,
@@ -35,8 +35,9 @@
 
 namespace photond {
 
-/// Bump when the layout changes; files of any other version are refused.
-inline constexpr uint32_t kPhotonMapFormatVersion = 1;
+/// Bump when the layout changes; files of any other version are refused. Version 2: photons
+/// carry their surface normal (24 bytes, was 20).
+inline constexpr uint32_t kPhotonMapFormatVersion = 2;
 /// The longest key a file may carry (photon_map_key gives 68 characters).
 inline constexpr uint32_t kMaxPhotonMapKey = 4096;
 

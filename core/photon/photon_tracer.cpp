@@ -122,7 +122,7 @@ std::shared_ptr<const PhotonMap> precompute_irradiance(const PhotonMap& global, 
     tbb::parallel_for(size_t(0), count, [&](size_t i) {
         const TracedPhoton& t = traced[i * settings.irradiance_stride];
         const Color e = global.estimate_irradiance(t.position, t.normal, settings.k_irradiance, max_radius);
-        points[i] = make_photon(t.position, t.normal, e);
+        points[i] = make_photon(t.position, t.normal, e, 0, t.normal);
     });
     return std::make_shared<const PhotonMap>(std::move(points), 0);
 }
@@ -132,7 +132,8 @@ std::shared_ptr<const PhotonMap> finish_map(MapBuilder& builder) {
     packed.reserve(builder.photons.size());
     const double scale = builder.emitted > 0 ? 1.0 / static_cast<double>(builder.emitted) : 0.0;
     for (const TracedPhoton& p : builder.photons) {
-        packed.push_back(make_photon(p.position, p.direction, Color(DVec3(p.flux) * scale), p.flags));
+        packed.push_back(make_photon(p.position, p.direction, Color(DVec3(p.flux) * scale),
+                                     p.flags, p.normal));
     }
     return std::make_shared<const PhotonMap>(std::move(packed), builder.emitted);
 }

@@ -52,7 +52,8 @@ struct PhotonTracingStatistics {
 };
 
 /// Both maps of a scene; a map not asked for is null. `irradiance` holds precomputed irradiance
-/// at a subset of the global photons (photon flux = irradiance, direction = surface normal).
+/// at a subset of the global photons (photon flux = irradiance, direction and normal = surface
+/// normal).
 struct PhotonMaps {
     std::shared_ptr<const PhotonMap> global;
     std::shared_ptr<const PhotonMap> caustic;

@@ -45,8 +45,9 @@ TEST(FinalGather, StratifiedEstimateAgreesWithIndependentSampling) {
     GatherSettings settings;
     settings.rays = 4096;
     const FinalGatherer gatherer(f.scene, f.maps, settings);
-    // A point on the floor, normal up.
-    const Vec3 p(2.0f, 0.0f, 2.5f), n(0.0f, 1.0f, 0.0f);
+    // A point on the floor, normal up, in the open: (2.0, 0, 2.5) lay under the short block
+    // (its footprint reaches z = 2.60 at x = 2.0), in the dark inside of a closed box.
+    const Vec3 p(2.0f, 0.0f, 3.5f), n(0.0f, 1.0f, 0.0f);
     GatherResult stratified = gather_at(gatherer, p, n, 3, false);
     for (uint64_t seed = 4; seed < 7; ++seed) stratified.irradiance += gather_at(gatherer, p, n, seed, false).irradiance;
     stratified.irradiance /= 4.0f;

@@ -108,6 +108,65 @@ TEST(PhotonKdTree, RandomPointsMatchBruteForce) {
     EXPECT_GT(total, 0u);
 }
 
+TEST(PhotonKdTree, DiscQueriesMatchBruteForce) {
+    // k_nearest_in_disc: the same search with the flattened distance, against brute force.
+    const PhotonKdTree tree(photons_at(random_points(50000, 21)));
+    Rng rng(22, 23);
+    KnnResult result;
+    size_t full = 0;
+    for (int q = 0; q < 200; ++q) {
+        const Vec3 p(rng.next_float(), rng.next_float(), rng.next_float());
+        const Vec3 n = sample_uniform_sphere(rng.next_vec2());
+        const float flattening = q % 4 == 0 ? 1.0f : 1.0f + 9.0f * rng.next_float();
+        const uint32_t k = 1 + rng.next_u32() % 100;
+        const float max_radius = q % 3 == 0 ? kInf : 0.15f * rng.next_float();
+        tree.k_nearest_in_disc(p, n, flattening, k, max_radius, result);
+        const float stretch2 = flattening * flattening - 1.0f;
+        std::vector<KnnNeighbor> expected;
+        for (uint32_t i = 0; i < tree.size(); ++i) {
+            const float d2 = PhotonKdTree::disc_distance2(p, tree.photon(i).position, n, stretch2);
+            if (d2 <= max_radius * max_radius) expected.push_back({i, d2});
+        }
+        std::sort(expected.begin(), expected.end(), closer);
+        if (expected.size() > k) expected.resize(k);
+        result.sort_by_distance();
+        ASSERT_EQ(result.size(), expected.size()) << q;
+        for (size_t i = 0; i < expected.size(); ++i) {
+            ASSERT_EQ(result.neighbors[i].index, expected[i].index) << q << " neighbour " << i;
+            ASSERT_EQ(result.neighbors[i].dist2, expected[i].dist2) << q << " neighbour " << i;
+        }
+        full += result.size() == k;
+    }
+    EXPECT_GT(full, 100u);
+    EXPECT_LT(full, 200u);
+
+    // Photons on two parallel planes 0.1 apart: a sphere of radius 0.2 reads both, a disc
+    // flattened 5 times (its half-thickness 0.04) only the query's own plane.
+    std::vector<Vec3> planes;
+    for (int i = 0; i < 40; ++i)
+        for (int j = 0; j < 40; ++j)
+            for (const float y : {0.0f, 0.1f}) planes.push_back(Vec3(0.025f * i, y, 0.025f * j));
+    const PhotonKdTree layered(photons_at(planes));
+    const Vec3 p(0.5f, 0.0f, 0.5f), up(0.0f, 1.0f, 0.0f);
+    layered.k_nearest(p, 1000, 0.2f, result);
+    const auto count_above = [&] {
+        size_t count = 0;
+        for (const KnnNeighbor& n : result.neighbors)
+            count += layered.photon(n.index).position.y > 0.0f;
+        return count;
+    };
+    const size_t above = count_above();
+    EXPECT_GT(above, 50u);
+    layered.k_nearest_in_disc(p, up, 5.0f, 1000, 0.2f, result);
+    EXPECT_GT(result.size(), 150u);
+    EXPECT_EQ(count_above(), 0u);
+    // A flattening of 1 is the sphere; a non-finite normal finds nothing.
+    layered.k_nearest_in_disc(p, up, 1.0f, 1000, 0.2f, result);
+    EXPECT_EQ(count_above(), above);
+    layered.k_nearest_in_disc(p, Vec3(kNaN, 1.0f, 0.0f), 5.0f, 10, kInf, result);
+    EXPECT_TRUE(result.empty());
+}
+
 TEST(PhotonKdTree, QueriesOnThePhotonsThemselves) {
     const PhotonKdTree tree(photons_at(random_points(20000, 9)));
     KnnResult result;

@@ -446,22 +446,23 @@ TEST(PhotonMapIo, ForeignDataIsRefused) {
 }
 
 TEST(PhotonMapIo, OtherVersionsAndPhotonSizesAreRefused) {
-    for (uint32_t version : {0u, 2u, 1000u}) {
+    // Version 1 stored 20-byte photons without a normal.
+    for (uint32_t version : {0u, 1u, 3u, 1000u}) {
         std::vector<uint8_t> bytes = cornell_bytes();
         for (int i = 0; i < 4; ++i) bytes[8 + i] = uint8_t(version >> (8 * i));
         reseal(bytes);  // a well-formed file of that version
         Expected<PhotonMaps> result = deserialize_photon_maps(bytes, kKey);
         ASSERT_FALSE(result);
         EXPECT_EQ(result.error().message, "unsupported photon-map format version " +
-                                              std::to_string(version) + " (this build reads 1)");
+                                              std::to_string(version) + " (this build reads 2)");
         EXPECT_EQ(read_photon_map_key(bytes), "");
     }
     std::vector<uint8_t> bytes = cornell_bytes();
-    bytes[16] = 24;  // photon size
+    bytes[16] = 20;  // photon size: version 1's
     reseal(bytes);
     Expected<PhotonMaps> result = deserialize_photon_maps(bytes, kKey);
     ASSERT_FALSE(result);
-    EXPECT_NE(result.error().message.find("24-byte photons"), std::string::npos);
+    EXPECT_NE(result.error().message.find("20-byte photons"), std::string::npos);
 }
 
 TEST(PhotonMapIo, KeysMustMatchUnlessImporting) {

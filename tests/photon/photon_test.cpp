@@ -1,4 +1,5 @@
-// The packed photon: size, flux and direction quantisation errors, robustness of the encoding.
+// The packed photon: size, flux, direction and normal quantisation errors, robustness of the
+// encoding.
 #include "core/photon/photon.h"
 
 #include <gtest/gtest.h>
@@ -24,7 +25,8 @@ float angle_degrees(const Vec3& a, const Vec3& b) {
 
 Color decoded_flux(const Color& flux) { return make_photon(Vec3(0), Vec3(0, 0, 1), flux).flux(); }
 
-TEST(Photon, IsTwentyBytes) { EXPECT_EQ(sizeof(Photon), 20u); }
+// Jensen's 20 bytes and a 4-byte surface normal (photon.h).
+TEST(Photon, IsTwentyFourBytes) { EXPECT_EQ(sizeof(Photon), 24u); }
 
 TEST(Photon, PositionAndUserFlagsRoundTrip) {
     const Photon p = make_photon(Vec3(1.5f, -2.25f, 1e6f), Vec3(1, 0, 0), Color(1), 0x2a);
@@ -155,6 +157,74 @@ TEST(Photon, DirectionSpecialCases) {
     for (const Vec3& d : {Vec3(0), Vec3(kNaN, 0, 1), Vec3(kInf, 0, 0)}) {
         EXPECT_LT(angle_degrees(Vec3(0, 0, 1), make_photon(Vec3(0), d, Color(1)).direction()),
                   0.8f);
+    }
+}
+
+TEST(Photon, NormalErrorBelowOneHundredthOfADegree) {
+    Rng rng(7, 8);
+    float worst = 0.0f;
+    for (int i = 0; i < 200000; ++i) {
+        const Vec3 n = sample_uniform_sphere(rng.next_vec2());
+        // Not unit: the encoding normalises.
+        const float length = 0.5f + rng.next_float();
+        const Photon p = make_photon(Vec3(0), Vec3(0, 0, 1), Color(1), 0, n * length);
+        ASSERT_TRUE(p.has_normal());
+        const Vec3 decoded = p.normal();
+        ASSERT_NEAR(glm::length(decoded), 1.0f, 1e-6f);
+        worst = std::max(worst, angle_degrees(n, decoded));
+    }
+    EXPECT_LT(worst, 0.01f);
+    EXPECT_GT(worst, 0.0005f);  // quantised to 16 bits per coordinate, not stored exactly
+}
+
+TEST(Photon, NormalSpecialCases) {
+    // Axes, the folded corner (-z) and normals next to it on every side, near-axis normals.
+    const Vec3 normals[] = {
+        Vec3(1, 0, 0),           Vec3(-1, 0, 0),           Vec3(0, 1, 0),
+        Vec3(0, -1, 0),          Vec3(0, 0, 1),            Vec3(0, 0, -1),
+        Vec3(-1e-7f, -1e-7f, -1), Vec3(1e-7f, -1e-7f, -1), Vec3(-1e-7f, 1e-7f, -1),
+        Vec3(-0.0f, -0.0f, -1),  Vec3(1, -1e-7f, 0),       Vec3(0, 0, -1e-30f),
+    };
+    for (const Vec3& n : normals) {
+        const Photon p = make_photon(Vec3(0), Vec3(0, 0, 1), Color(1), 0, n);
+        EXPECT_TRUE(p.has_normal()) << n.x << " " << n.y << " " << n.z;
+        EXPECT_LT(angle_degrees(n, p.normal()), 0.01f) << n.x << " " << n.y << " " << n.z;
+    }
+    // No normal given, or none to give: the photon has none, and normal() is zero.
+    EXPECT_FALSE(make_photon(Vec3(0), Vec3(0, 0, 1), Color(1)).has_normal());
+    EXPECT_EQ(make_photon(Vec3(0), Vec3(0, 0, 1), Color(1)).normal(), Vec3(0.0f));
+    for (const Vec3& n : {Vec3(0), Vec3(kNaN, 0, 1), Vec3(kInf, 0, 0), Vec3(-kInf, 1, 1)}) {
+        const Photon p = make_photon(Vec3(0), Vec3(0, 0, 1), Color(1), 0, n);
+        EXPECT_FALSE(p.has_normal()) << n.x << " " << n.y << " " << n.z;
+        EXPECT_EQ(p.normal(), Vec3(0.0f));
+    }
+    // The normal leaves the other fields alone.
+    const Photon with = make_photon(Vec3(1, 2, 3), Vec3(0, 1, 0), Color(0.5f), 0x15, Vec3(1, 0, 0));
+    const Photon without = make_photon(Vec3(1, 2, 3), Vec3(0, 1, 0), Color(0.5f), 0x15);
+    EXPECT_EQ(with.position, without.position);
+    EXPECT_EQ(with.flux(), without.flux());
+    EXPECT_EQ(with.direction(), without.direction());
+    EXPECT_EQ(with.user_flags(), without.user_flags());
+}
+
+TEST(Photon, EveryNormalCodeDecodesToAUnitVector) {
+    for (uint32_t u = 0; u < 65536; u += 257) {
+        for (uint32_t v = 0; v < 65536; v += 255) {
+            if (u == 0 && v == 0) continue;  // "no normal"
+            Photon p = make_photon(Vec3(0), Vec3(0, 0, 1), Color(1));
+            unsigned char bytes[sizeof(Photon)];
+            std::memcpy(bytes, &p, sizeof(p));
+            const uint16_t codes[2] = {uint16_t(u), uint16_t(v)};
+            std::memcpy(bytes + 20, codes, sizeof(codes));
+            std::memcpy(&p, bytes, sizeof(p));
+            ASSERT_EQ(p.normal_u(), u);  // the offsets above are the fields'
+            ASSERT_EQ(p.normal_v(), v);
+            ASSERT_NEAR(glm::length(p.normal()), 1.0f, 1e-6f) << u << " " << v;
+            // Re-encoding the decoded normal keeps it (the code may change: the square's border
+            // folds onto itself, (0, v) and (0, 65535 - v) are the same normal).
+            const Photon again = make_photon(Vec3(0), Vec3(0, 0, 1), Color(1), 0, p.normal());
+            ASSERT_LT(angle_degrees(again.normal(), p.normal()), 0.005f) << u << " " << v;
+        }
     }
 }
 

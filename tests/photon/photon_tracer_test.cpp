@@ -61,6 +61,40 @@ TEST(PhotonTracer, FirstHitsCarryTheLightsTotalPower) {
     EXPECT_EQ(maps->statistics.stored_global, maps->global->size());
 }
 
+TEST(PhotonTracer, PhotonsKeepTheNormalOfTheSideTheyLandedOn) {
+    // In the closed room every photon lies on a wall and arrived from the inside: its normal is
+    // the wall's inward one, and the precomputed irradiance photons carry it too.
+    auto rs = make_render_scene(closed_room(0.5f, Vec3(0.3f, 1.0f, -0.2f), Color(1.0f)));
+    PhotonTracingSettings settings;
+    settings.global_photons = 20000;
+    settings.caustic_photons = 0;
+    const auto maps = trace_photons(*rs, settings);
+    ASSERT_TRUE(maps.has_value()) << maps.error().message;
+    ASSERT_TRUE(maps->irradiance);
+    const auto inward_normal = [](const Vec3& p) {
+        int axis = 0;
+        for (int a = 1; a < 3; ++a)
+            if (std::abs(p[a]) > std::abs(p[axis])) axis = a;
+        Vec3 n(0.0f);
+        n[axis] = p[axis] > 0.0f ? -1.0f : 1.0f;
+        return n;
+    };
+    for (const PhotonMap* map : {maps->global.get(), maps->irradiance.get()}) {
+        for (const Photon& photon : map->tree().photons()) {
+            ASSERT_TRUE(photon.has_normal());
+            const Vec3 n = inward_normal(photon.position);
+            ASSERT_GT(glm::dot(photon.normal(), n), 0.99999f)
+                << photon.position.x << " " << photon.position.y << " " << photon.position.z;
+            if (map == maps->global.get()) {
+                // Arrived from the inside, up to the direction's 0.8 degree (0.014) bins.
+                ASSERT_GT(glm::dot(-photon.direction(), n), -0.015f);
+            } else {
+                ASSERT_GT(glm::dot(photon.direction(), n), 0.999f);  // 0.8 degree bins
+            }
+        }
+    }
+}
+
 TEST(PhotonTracer, MapsAreBitIdenticalForAnyThreadCount) {
     auto rs = make_render_scene(make_builtin_scene("cornell-box").value());
     PhotonTracingSettings settings;
