@@ -6,7 +6,7 @@ JOBS ?= $(shell nproc)
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 DEBIAN_PACKAGES := cmake g++ make pkg-config libembree-dev libtbb-dev libopenexr-dev libimath-dev \
 	libtinygltf-dev libcpp-httplib-dev nlohmann-json3-dev libglm-dev libpng-dev libssl-dev libgtest-dev \
-	libbenchmark-dev curl
+	libbenchmark-dev curl python3 gnuplot-nox
 OUT ?= out
 
 .PHONY: all deps configure build test tsan demo bench clean format
@@ -41,9 +41,9 @@ tsan: deps
 # The stress suite and the fast core tests under AddressSanitizer and UndefinedBehaviorSanitizer
 # (run by CI). Embree and oneTBB are not instrumented, so leak checking is off. Every test runs;
 # a sanitizer report stops the run at once (exit code 86), other failures are listed at the end.
-ASAN_TESTS := degenerate_geometry_test fireflies_test \
+ASAN_TESTS := degenerate_geometry_test degenerate_light_test scale_invariance_test fireflies_test \
 	scene_transform_test builtin_scenes_test gltf_loader_test emission_test analytic_lighting_test \
-	tile_renderer_test photon_test kd_tree_test photon_map_io_test photon_tracer_test \
+	tile_renderer_test photon_test kd_tree_test photon_map_test photon_map_io_test photon_tracer_test \
 	final_gather_test exr_io_test png_preview_test
 
 .PHONY: asan
@@ -62,11 +62,16 @@ asan: deps
 demo: build
 	./deploy/demo.sh $(BUILD) $(OUT)
 
+# The micro-benchmarks, then the run-time-against-error sweep (bench/README.md): prints the
+# table and writes bench/results/ (CSV, Markdown, error_vs_time.png). BENCH_ARGS=--quick for a
+# short sweep; BENCH_ARGS="--scenes cornell-box-diffuse --repeats 5" and so on.
+BENCH_ARGS ?=
 bench: build
 	$(BUILD)/bench/ray_throughput_bench
 	$(BUILD)/bench/photon_tracing_bench
 	$(BUILD)/bench/kd_tree_bench
 	$(BUILD)/bench/http_bench
+	python3 bench/run_benchmark.py --photond $(BUILD)/server/photond $(BENCH_ARGS)
 
 format:
 	find core protocol server clients tests bench -name '*.h' -o -name '*.cpp' | xargs clang-format -i

@@ -1,6 +1,8 @@
 #include "server/image_commands.h"
 
+#include <cmath>
 #include <cstdio>
+#include <string>
 
 #include "core/image/exr_io.h"
 #include "core/image/image_metrics.h"
@@ -10,15 +12,19 @@ namespace photond::service {
 
 int run_compare_command(std::span<const std::string> args) {
     constexpr const char* kUsage =
-        "usage: photond compare IMAGE.exr REFERENCE.exr [--region x0,y0,x1,y1] [--epsilon E] [--block N]\n"
+        "usage: photond compare IMAGE.exr REFERENCE.exr [--region x0,y0,x1,y1] [--epsilon E] "
+        "[--block N]\n"
+        "                       [--error-png F] [--json]\n"
         "prints relMSE, RMSE, the 99th percentile of per-pixel absolute error, and the mean bias;\n"
         "--block N compares N x N block averages (the region in block units then);\n"
-        "--error-png F writes the per-pixel relative squared error as a PNG (white = 1 or more)\n";
+        "--error-png F writes the per-pixel relative squared error as a PNG (white = 1 or more);\n"
+        "--json prints the figures as one JSON object (bias as a fraction, not in percent)\n";
     std::vector<std::string> files;
     std::optional<PixelRect> region;
     double epsilon = 0.01;
     int block = 1;
     std::string error_png;
+    bool json = false;
     for (size_t i = 0; i < args.size(); ++i) {
         if (args[i] == "--region" && i + 1 < args.size()) {
             PixelRect r;
@@ -33,6 +39,8 @@ int run_compare_command(std::span<const std::string> args) {
             error_png = args[++i];
         } else if (args[i] == "--block" && i + 1 < args.size()) {
             block = std::max(1, std::atoi(args[++i].c_str()));
+        } else if (args[i] == "--json") {
+            json = true;
         } else if (args[i] == "-h" || args[i] == "--help") {
             std::fputs(kUsage, stdout);
             return 0;
@@ -47,7 +55,8 @@ int run_compare_command(std::span<const std::string> args) {
     auto image = read_exr(files[0]);
     auto reference = read_exr(files[1]);
     if (!image || !reference) {
-        std::fprintf(stderr, "photond compare: %s\n", (!image ? image.error() : reference.error()).message.c_str());
+        std::fprintf(stderr, "photond compare: %s\n",
+                     (!image ? image.error() : reference.error()).message.c_str());
         return 1;
     }
     if (!error_png.empty() && image->beauty.width() == reference->beauty.width() &&
@@ -56,7 +65,8 @@ int run_compare_command(std::span<const std::string> args) {
         for (size_t p = 0; p < error.pixel_count(); ++p) {
             const Color d = image->beauty.pixels()[p] - reference->beauty.pixels()[p];
             const Color r = reference->beauty.pixels()[p];
-            error.pixels()[p] = Color(average(d * d / (r * r + Color(static_cast<float>(epsilon)))));
+            error.pixels()[p] =
+                Color(average(d * d / (r * r + Color(static_cast<float>(epsilon)))));
         }
         if (Status st = write_png_preview(error_png, error); !st) {
             std::fprintf(stderr, "photond compare: %s\n", st.error().message.c_str());
@@ -66,22 +76,42 @@ int run_compare_command(std::span<const std::string> args) {
     if (region && block > 1)
         region = PixelRect{region->x0 / block, region->y0 / block, (region->x1 + block - 1) / block,
                            (region->y1 + block - 1) / block};
-    auto e = block > 1 ? compare_images(downsample(image->beauty, block), downsample(reference->beauty, block), region, epsilon)
+    auto e = block > 1 ? compare_images(downsample(image->beauty, block),
+                                        downsample(reference->beauty, block), region, epsilon)
                        : compare_images(image->beauty, reference->beauty, region, epsilon);
     if (!e) {
         std::fprintf(stderr, "photond compare: %s\n", e.error().message.c_str());
         return 1;
     }
-    std::printf("relmse %.6g rmse %.6g p99 %.6g mean %.6g reference_mean %.6g bias %+.4f%% pixels %zu\n",
-                e->relative_mse, e->rmse, e->p99_abs_error, e->mean, e->reference_mean, 100.0 * e->mean_bias,
-                e->pixels);
+    if (json) {
+        // JSON has no NaN or infinity: such a figure becomes null.
+        const auto number = [](double v) {
+            char text[32];
+            if (!std::isfinite(v)) return std::string("null");
+            std::snprintf(text, sizeof text, "%.9g", v);
+            return std::string(text);
+        };
+        std::printf(
+            "{\"relmse\": %s, \"rmse\": %s, \"p99\": %s, \"mean\": %s, \"reference_mean\": %s, "
+            "\"bias\": %s, \"pixels\": %zu, \"epsilon\": %s, \"block\": %d}\n",
+            number(e->relative_mse).c_str(), number(e->rmse).c_str(),
+            number(e->p99_abs_error).c_str(), number(e->mean).c_str(),
+            number(e->reference_mean).c_str(), number(e->mean_bias).c_str(), e->pixels,
+            number(epsilon).c_str(), block);
+        return 0;
+    }
+    std::printf(
+        "relmse %.6g rmse %.6g p99 %.6g mean %.6g reference_mean %.6g bias %+.4f%% pixels %zu\n",
+        e->relative_mse, e->rmse, e->p99_abs_error, e->mean, e->reference_mean,
+        100.0 * e->mean_bias, e->pixels);
     return 0;
 }
 
 int run_average_command(std::span<const std::string> args) {
     constexpr const char* kUsage =
         "usage: photond average -o OUT.exr [--half] IN.exr [IN.exr ...]\n"
-        "writes the per-pixel mean of renders with equal sample counts and other seeds (float EXR,\n"
+        "writes the per-pixel mean of renders with equal sample counts and other seeds (float "
+        "EXR,\n"
         "or half with --half)\n";
     std::string output;
     std::vector<std::string> inputs;
@@ -115,11 +145,12 @@ int run_average_command(std::span<const std::string> args) {
             sum = Image(beauty.width(), beauty.height());
             accumulated.assign(beauty.pixel_count(), DVec3(0.0));
         } else if (beauty.width() != sum.width() || beauty.height() != sum.height()) {
-            std::fprintf(stderr, "photond average: %s is %dx%d, the first input %dx%d\n", input.c_str(),
-                         beauty.width(), beauty.height(), sum.width(), sum.height());
+            std::fprintf(stderr, "photond average: %s is %dx%d, the first input %dx%d\n",
+                         input.c_str(), beauty.width(), beauty.height(), sum.width(), sum.height());
             return 1;
         }
-        for (size_t p = 0; p < beauty.pixel_count(); ++p) accumulated[p] += DVec3(beauty.pixels()[p]);
+        for (size_t p = 0; p < beauty.pixel_count(); ++p)
+            accumulated[p] += DVec3(beauty.pixels()[p]);
     }
     for (size_t p = 0; p < accumulated.size(); ++p)
         sum.pixels()[p] = Color(accumulated[p] / static_cast<double>(inputs.size()));

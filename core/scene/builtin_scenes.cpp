@@ -282,10 +282,109 @@ Expected<Scene> make_furnace() {
     return finish(builder, st, "furnace");
 }
 
+/// A copy of `unit` (a sphere of radius 1 about the origin) scaled by `radius`, its lowest point
+/// on y = floor_y at (x, z). Sharing one tessellation keeps the large scene quick to build.
+MeshData placed_sphere(const MeshData& unit, float floor_y, float x, float z, float radius) {
+    MeshData sphere = unit;
+    float lowest = 0.0f;
+    for (const Vec3& p : unit.positions) lowest = std::min(lowest, p.y);
+    const Vec3 offset(x, floor_y - radius * lowest, z);
+    for (Vec3& p : sphere.positions) p = radius * p + offset;
+    return sphere;
+}
+
+/// A box of footprint side `side` and `height` standing on y = 0 at (x, z), turned by `angle`
+/// (radians) about the vertical.
+MeshData standing_box(float x, float z, float side, float height, float angle) {
+    const float c = std::cos(angle), s = std::sin(angle);
+    std::array<Vec3, 8> corners;
+    for (int i = 0; i < 8; ++i) {
+        const float u = (i & 1) ? 0.5f * side : -0.5f * side;
+        const float w = (i & 4) ? 0.5f * side : -0.5f * side;
+        corners[i] = Vec3(x + c * u - s * w, (i & 2) ? height : 0.0f, z + s * u + c * w);
+    }
+    return make_box(corners);
+}
+
+/// "spheres-room": the large scene of the benchmark; see the header for the layout.
+Expected<Scene> make_spheres_room() {
+    SceneBuilder builder("spheres-room");
+    const uint32_t white = builder.add_material(lambertian("white", Color(0.75f)));
+    const uint32_t red = builder.add_material(lambertian("red", Color(0.75f, 0.25f, 0.25f)));
+    const uint32_t green = builder.add_material(lambertian("green", Color(0.25f, 0.6f, 0.25f)));
+    const uint32_t light =
+        builder.add_material(emitter("light", Color(0.75f), Color(kSpheresRoomLightRadiance)));
+    // The objects' palette, cycled over the grid.
+    const std::array<uint32_t, 5> palette = {
+        builder.add_material(lambertian("ivory", Color(0.8f, 0.78f, 0.7f))),
+        builder.add_material(lambertian("terracotta", Color(0.7f, 0.35f, 0.2f))),
+        builder.add_material(lambertian("teal", Color(0.15f, 0.5f, 0.5f))),
+        builder.add_material(lambertian("ochre", Color(0.75f, 0.6f, 0.15f))),
+        builder.add_material(lambertian("slate", Color(0.3f, 0.32f, 0.45f)))};
+
+    constexpr float kHalf = kSpheresRoomHalfWidth, kHeight = kSpheresRoomHeight;
+    constexpr float kLight = kSpheresRoomLightSide, kLightGap = 0.01f;
+    const Vec3 interior(0.0f, 0.5f * kHeight, 0.0f);
+    const Vec3 ex(2.0f * kHalf, 0.0f, 0.0f), ey(0.0f, kHeight, 0.0f), ez(0.0f, 0.0f, 2.0f * kHalf);
+    const Vec3 lower(-kHalf, 0.0f, -kHalf);
+    Status st;
+    // As "cornell-box": every wall faces the interior, the front (z = +kHalf) stays open.
+    if (st) st = add_mesh(builder, make_quad(lower, ex, ez, interior - lower), white);
+    if (st) st = add_mesh(builder, make_quad(lower + ey, ex, ez, interior - lower - ey), white);
+    if (st) st = add_mesh(builder, make_quad(lower, ex, ey, interior - lower), white);
+    if (st) st = add_mesh(builder, make_quad(lower, ey, ez, interior - lower), red);
+    if (st) st = add_mesh(builder, make_quad(lower + ex, ey, ez, interior - lower - ex), green);
+    const Vec3 light_corner(-0.5f * kLight, kHeight - kLightGap, -0.5f * kLight);
+    if (st) {
+        st = add_mesh(builder,
+                      make_quad(light_corner, Vec3(kLight, 0.0f, 0.0f), Vec3(0.0f, 0.0f, kLight),
+                                Vec3(0.0f, -1.0f, 0.0f)),
+                      light);
+    }
+
+    // The grid: spheres, and every third cell a turned box carrying a small sphere. Objects of
+    // one colour are merged into one mesh (fewer geometries, the same triangles).
+    const MeshData big = make_icosphere(Vec3(0.0f), 1.0f, kSpheresRoomSphereSubdivisions);
+    const MeshData small = make_icosphere(Vec3(0.0f), 1.0f, kSpheresRoomSphereSubdivisions - 1);
+    std::array<MeshData, 5> by_colour;
+    for (int row = 0; row < kSpheresRoomRows; ++row) {
+        for (int col = 0; col < kSpheresRoomColumns; ++col) {
+            const int cell = row * kSpheresRoomColumns + col;
+            const float x = kSpheresRoomSpacing * (col - 0.5f * (kSpheresRoomColumns - 1));
+            const float z = kSpheresRoomSpacing * (row - 0.5f * (kSpheresRoomRows - 1)) - 0.4f;
+            MeshData& mesh = by_colour[cell % palette.size()];
+            if ((row + col) % 3 == 0) {
+                const float height = 0.5f + 0.25f * static_cast<float>(cell % 4);
+                append_mesh(mesh, standing_box(x, z, 0.7f, height, 0.35f * cell));
+                append_mesh(mesh, placed_sphere(small, height, x, z, 0.25f));
+            } else {
+                const float radius = 0.4f + 0.05f * static_cast<float>(cell % 3);
+                append_mesh(mesh, placed_sphere(big, 0.0f, x, z, radius));
+            }
+        }
+    }
+    for (size_t c = 0; c < palette.size() && st; ++c) {
+        st = add_mesh(builder, by_colour[c], palette[c]);
+    }
+
+    CameraDesc camera;
+    camera.name = "camera";
+    // In front of the open side, looking down by 6 degrees: the view stays between the front
+    // edges of the ceiling and the floor (no black border) and shows the whole back wall.
+    camera.position = Vec3(0.0f, 3.2f, kHalf + 6.0f);
+    camera.look_at = Vec3(0.0f, 3.2f - 10.0f * std::tan(6.0f * kPi / 180.0f), 0.0f);
+    camera.up = Vec3(0.0f, 1.0f, 0.0f);
+    camera.vfov_deg = 40.0f;
+    camera.aspect = 0.0f;
+    builder.add_camera(camera);
+    return finish(builder, st, "spheres-room");
+}
+
 }  // namespace
 
 std::vector<std::string> builtin_scene_names() {
-    return {"cornell-box", "cornell-box-diffuse", "caustic", "caustic-area", "furnace"};
+    return {"cornell-box", "cornell-box-diffuse", "caustic", "caustic-area",
+            "furnace",     "spheres-room"};
 }
 
 Expected<Scene> make_builtin_scene(std::string_view name) {
@@ -294,6 +393,7 @@ Expected<Scene> make_builtin_scene(std::string_view name) {
     if (name == "caustic") return make_caustic(false);
     if (name == "caustic-area") return make_caustic(true);
     if (name == "furnace") return make_furnace();
+    if (name == "spheres-room") return make_spheres_room();
     std::string known;
     for (const std::string& n : builtin_scene_names()) known += (known.empty() ? "" : ", ") + n;
     return Error{"unknown built-in scene '" + std::string(name) + "'; known scenes: " + known};

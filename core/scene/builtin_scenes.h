@@ -39,6 +39,15 @@
 //                         to its centre, Lambertian with albedo kFurnaceAlbedo and emission
 //                         kFurnaceEmission; the camera at the centre. Every ray sees the radiance
 //                         Le / (1 - albedo) = kFurnaceRadiance = 2 (sum of the Neumann series).
+//  "spheres-room"         The benchmark's large scene (over 100 000 triangles, all Lambertian, so
+//                         that a path-traced reference converges): a room 8 x 5 x 8, x and z in
+//                         [-4, 4], y in [0, 5], open at z = +4 towards the camera, white floor,
+//                         ceiling and back wall, red left (-x) and green right (+x) walls, a
+//                         kSpheresRoomLightSide square ceiling light of radiance
+//                         kSpheresRoomLightRadiance. On the floor a kSpheresRoomColumns x
+//                         kSpheresRoomRows grid of objects in five colours: tessellated spheres
+//                         (level kSpheresRoomSphereSubdivisions, 5120 triangles each) and, every
+//                         third cell, a turned box carrying a small sphere (1280 triangles).
 #pragma once
 
 #include <string>
@@ -69,6 +78,16 @@ inline constexpr Vec3 kCausticLightPosition{-3.0f, 6.0f, -2.0f};
 inline constexpr float kCausticLightIntensity = 240.0f;
 /// "caustic-area": side of the square light replacing the point light.
 inline constexpr float kCausticAreaLightSide = 0.5f;
+
+/// "spheres-room": room size, light, and the grid of objects.
+inline constexpr float kSpheresRoomHalfWidth = 4.0f;
+inline constexpr float kSpheresRoomHeight = 5.0f;
+inline constexpr float kSpheresRoomLightSide = 2.0f;
+inline constexpr float kSpheresRoomLightRadiance = 20.0f;
+inline constexpr int kSpheresRoomColumns = 6;
+inline constexpr int kSpheresRoomRows = 5;
+inline constexpr float kSpheresRoomSpacing = 1.25f;
+inline constexpr int kSpheresRoomSphereSubdivisions = 4;
 
 /// The names make_builtin_scene accepts, in a fixed order.
 std::vector<std::string> builtin_scene_names();

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "core/integrators/path.h"
+#include "core/render/tile_renderer.h"
 #include "core/scene/shapes.h"
 
 namespace photond {
@@ -222,8 +224,8 @@ TEST(BuiltinScenes, NamesAreListedAndUnique) {
     const std::vector<std::string> names = builtin_scene_names();
     const std::set<std::string> unique(names.begin(), names.end());
     EXPECT_EQ(unique.size(), names.size());
-    for (const char* expected :
-         {"cornell-box", "cornell-box-diffuse", "caustic", "caustic-area", "furnace"}) {
+    for (const char* expected : {"cornell-box", "cornell-box-diffuse", "caustic", "caustic-area",
+                                 "furnace", "spheres-room"}) {
         EXPECT_TRUE(unique.contains(expected)) << expected;
     }
 }
@@ -541,6 +543,88 @@ TEST(BuiltinScenes, CamerasLookAtTheirScenes) {
     const CameraDesc& cam = caustic.cameras[0];
     const Vec3 forward = glm::normalize(cam.look_at - cam.position);
     EXPECT_NEAR(std::asin(-forward.y), glm::radians(30.0f), 1e-3f);  // looking down at 30 deg
+}
+
+TEST(BuiltinScenes, SpheresRoomIsLargeLambertianAndLitFromTheCeiling) {
+    const Scene scene = build_or_die("spheres-room");
+    // The benchmark's large scene: at least 100 000 triangles (20 spheres of 5120, 10 boxes of
+    // 12 carrying spheres of 1280, and 12 for the walls and the light).
+    EXPECT_GE(scene.triangles.size(), 100'000u);
+    EXPECT_EQ(scene.triangles.size(), 20u * 5120u + 10u * (12u + 1280u) + 12u);
+    EXPECT_TRUE(scene.lights.empty());
+    // Lambertian only, so that a path-traced reference converges.
+    for (const Material& m : scene.materials) {
+        EXPECT_EQ(m.specular, 0.0f) << m.name;
+        EXPECT_EQ(m.metallic, 0.0f) << m.name;
+        EXPECT_EQ(m.transmission, 0.0f) << m.name;
+        EXPECT_EQ(m.roughness, 1.0f) << m.name;
+        EXPECT_LE(max_component(m.base_color), 0.8f) << m.name;
+    }
+    // One light: the ceiling square, facing down, just below the ceiling.
+    double light_area = 0.0;
+    for (uint32_t i = 0; i < scene.triangles.size(); ++i) {
+        if (!scene.materials[scene.triangle_materials[i]].is_emissive()) continue;
+        light_area += scene.triangle_area(i);
+        EXPECT_LT(scene.triangle_normal(i).y, -0.9999f);
+        for (uint32_t v : {scene.triangles[i].x, scene.triangles[i].y, scene.triangles[i].z}) {
+            EXPECT_NEAR(scene.positions[v].y, kSpheresRoomHeight, 0.02f);
+        }
+    }
+    EXPECT_NEAR(light_area, kSpheresRoomLightSide * kSpheresRoomLightSide, 1e-5);
+    EXPECT_NEAR(area_light_power(scene),
+                kPi * kSpheresRoomLightRadiance * kSpheresRoomLightSide * kSpheresRoomLightSide,
+                1e-3);
+    // Well exposed: direct irradiance about pi at the floor's centre (ignoring the objects).
+    const float e = luminance(direct_irradiance(scene, Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f)));
+    EXPECT_GT(e, 0.85f * kPi);
+    EXPECT_LT(e, 1.15f * kPi);
+    // Every object stands inside the room, on or above the floor.
+    EXPECT_NEAR(scene.bounds.lower.y, 0.0f, 1e-5f);
+    EXPECT_NEAR(scene.bounds.upper.y, kSpheresRoomHeight, 1e-5f);
+    EXPECT_NEAR(scene.bounds.lower.x, -kSpheresRoomHalfWidth, 1e-5f);
+    EXPECT_NEAR(scene.bounds.upper.z, kSpheresRoomHalfWidth, 1e-5f);
+    // The spheres are closed and face outward, one mesh per colour.
+    for (const char* colour : {"ivory", "terracotta", "teal", "ochre", "slate"}) {
+        const std::vector<glm::uvec3> tris = triangles_of(scene, material_index(scene, colour));
+        EXPECT_GT(tris.size(), 5000u) << colour;
+        EXPECT_GT(signed_volume(scene.positions, tris), 0.0) << colour;
+    }
+}
+
+TEST(BuiltinScenes, SpheresRoomRendersFiniteAndFillsTheFrame) {
+    auto device = EmbreeDevice::create();
+    ASSERT_TRUE(device.has_value()) << device.error().message;
+    auto scene = std::make_shared<const Scene>(build_or_die("spheres-room"));
+    auto render_scene = RenderScene::create(*device, scene);
+    ASSERT_TRUE(render_scene.has_value()) << render_scene.error().message;
+    constexpr int kSize = 32;
+    auto camera = Camera::create(scene->cameras.at(0), kSize, kSize);
+    ASSERT_TRUE(camera.has_value());
+    PathIntegrator integrator(*render_scene);
+    TileSettings settings;
+    settings.tile_size = 16;
+    settings.samples_per_pixel = 8;
+    settings.seed = 7;
+    const TileRenderResult r = render_tiles(integrator, *camera, settings);
+    ASSERT_EQ(r.image.width(), kSize);
+    double total = 0.0;
+    std::vector<double> row_sum(kSize, 0.0);
+    for (int y = 0; y < kSize; ++y) {
+        for (int x = 0; x < kSize; ++x) {
+            const Color c = r.image.pixels()[static_cast<size_t>(y) * kSize + x];
+            ASSERT_TRUE(std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z));
+            ASSERT_GE(min_component(c), 0.0f);
+            row_sum[y] += average(c);
+        }
+        total += row_sum[y];
+    }
+    const double mean = total / (kSize * kSize);
+    EXPECT_GT(mean, 0.05);
+    EXPECT_LT(mean, 5.0);
+    // The camera frames the room: the top and bottom rows see walls and floor, not the void
+    // outside the open front.
+    EXPECT_GT(row_sum.front() / kSize, 0.1 * mean);
+    EXPECT_GT(row_sum.back() / kSize, 0.1 * mean);
 }
 
 }  // namespace
