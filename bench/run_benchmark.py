@@ -35,8 +35,8 @@ EPSILON = 0.01  # relMSE's epsilon, as in the literature
 PRESET_SETTINGS = {
     "preview": {"photons.global": 50_000, "photons.caustic": 25_000, "gather.rays": 128,
                 "irradiance_cache.a": 0.35, "image.spp": 4},
-    "final": {"photons.global": 200_000, "photons.caustic": 100_000, "gather.rays": 256,
-              "irradiance_cache.a": 0.25, "image.spp": 32},
+    "final": {"photons.global": 200_000, "photons.caustic": 50_000, "gather.rays": 256,
+              "irradiance_cache.a": 0.3, "image.spp": 16},
 }
 
 
@@ -116,12 +116,12 @@ def photon_map_points(quick):
         return points
     for g in (50_000, 800_000):
         points.append(Point("photon-map", f"final-photons-{count(g)}", "final",
-                            {"photons.global": g, "photons.caustic": g // 2}))
-    for rays in (64, 512):
+                            {"photons.global": g, "photons.caustic": g // 4}))
+    for rays in (128, 512):
         points.append(Point("photon-map", f"final-gather-{rays}", "final", {"gather.rays": rays}))
-    for a in (0.15, 0.4):
+    for a in (0.2, 0.45):
         points.append(Point("photon-map", f"final-a-{a:g}", "final", {"irradiance_cache.a": a}))
-    for spp in (16, 64):
+    for spp in (32, 64):
         points.append(Point("photon-map", f"final-{spp}spp", "final", {"image.spp": spp}))
     return points
 

@@ -3,11 +3,11 @@
 namespace photond::protocol {
 namespace {
 
-// Chosen by measurement on cornell-box-diffuse at 256 x 256 against a 4096-spp path reference
-// (README, "Presets"): the error of `final` is dominated by pixel sampling (antialiasing and
-// direct light), not by the cache, so it spends its time on samples per pixel and takes a
-// moderately coarse cache (a = 0.25, 256 gather rays): relMSE 0.0036 at 16 spp, 0.0022 at 32,
-// 0.0016 at 64, with 16 spp and a = 0.15 / 512 rays no better (0.0036).
+// Chosen by measurement at 256 x 256 against the path references of bench/references (README,
+// "Presets", and `make bench`). With stratified camera samples, `final` at 16 spp, a = 0.3 and
+// 256 gather rays gives relMSE 0.0016 on cornell-box-diffuse in 1.3 s on 2 cores (32 spp:
+// 0.0010 in 2.0 s) and 0.0024 on cornell-box in 2.5 s with 50k caustic photons (100k cost 1 s
+// more for no visible gain: the mirror sphere's caustic photons cover every wall).
 
 Job make_preset(std::string_view name, std::string integrator, ImageSpec image, PhotonSpec photons,
                 GatherSpec gather, IrradianceCacheSpec irradiance_cache) {
@@ -40,12 +40,12 @@ Job preview_preset() {
 
 Job final_preset() {
     return make_preset(
-        "final", "photon-map", ImageSpec{.width = 512, .height = 512, .tile_size = 32, .spp = 32},
+        "final", "photon-map", ImageSpec{.width = 512, .height = 512, .tile_size = 32, .spp = 16},
         PhotonSpec{
-            .global = 200'000, .caustic = 100'000, .k_global = 50, .k_caustic = 100, .seed = 1},
+            .global = 200'000, .caustic = 50'000, .k_global = 50, .k_caustic = 100, .seed = 1},
         GatherSpec{.rays = 256},
         IrradianceCacheSpec{.enabled = true,
-                            .a = 0.25,
+                            .a = 0.3,
                             .gradients = true,
                             .min_spacing_px = 1.5,
                             .max_spacing_px = 24.0});

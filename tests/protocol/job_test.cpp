@@ -82,16 +82,16 @@ TEST(JobPresets, FinalIsTheDefaultPresetWithItsValues) {
     EXPECT_EQ(job.image.width, 512);
     EXPECT_EQ(job.image.height, 512);
     EXPECT_EQ(job.image.tile_size, 32);
-    EXPECT_EQ(job.image.spp, 32);
+    EXPECT_EQ(job.image.spp, 16);
     EXPECT_FALSE(job.image.region.has_value());
     EXPECT_EQ(job.photons.global, 200000u);
-    EXPECT_EQ(job.photons.caustic, 100000u);
+    EXPECT_EQ(job.photons.caustic, 50000u);
     EXPECT_EQ(job.photons.k_global, 50u);
     EXPECT_EQ(job.photons.k_caustic, 100u);
     EXPECT_EQ(job.photons.seed, 1u);
     EXPECT_EQ(job.gather.rays, 256u);
     EXPECT_TRUE(job.irradiance_cache.enabled);
-    EXPECT_DOUBLE_EQ(job.irradiance_cache.a, 0.25);
+    EXPECT_DOUBLE_EQ(job.irradiance_cache.a, 0.3);
     EXPECT_TRUE(job.irradiance_cache.gradients);
     EXPECT_DOUBLE_EQ(job.irradiance_cache.min_spacing_px, 1.5);
     EXPECT_DOUBLE_EQ(job.irradiance_cache.max_spacing_px, 24.0);
@@ -194,7 +194,7 @@ TEST(JobRoundTrip, ToJsonFillsEveryDefault) {
         EXPECT_TRUE(document.contains(key)) << key;
     }
     EXPECT_FALSE(document.contains("camera"));  // absent means "the scene decides"
-    EXPECT_EQ(document["image"]["spp"], 32);
+    EXPECT_EQ(document["image"]["spp"], 16);
     EXPECT_EQ(document["irradiance_cache"]["max_spacing_px"], 24.0);
 }
 
@@ -747,8 +747,8 @@ TEST(JobSchema, CarriesTheLimitsAndPresetDefaults) {
     EXPECT_EQ(schema_nodes(schema, "output.aovs").at(0)["items"]["enum"].size(), kAovNames.size());
 
     json spp = schema_nodes(schema, "image.spp").at(0);
-    EXPECT_EQ(spp["default"], 32);
-    EXPECT_EQ(spp["x-preset-defaults"], json({{"preview", 4}, {"final", 32}, {"reference", 1024}}));
+    EXPECT_EQ(spp["default"], 16);
+    EXPECT_EQ(spp["x-preset-defaults"], json({{"preview", 4}, {"final", 16}, {"reference", 1024}}));
     EXPECT_EQ(schema_nodes(schema, "integrator").at(0)["x-preset-defaults"]["reference"], "path");
     EXPECT_EQ(schema_nodes(schema, "preset").at(0)["default"], "final");
 }
