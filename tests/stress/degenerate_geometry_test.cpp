@@ -18,27 +18,12 @@ namespace {
 
 using stress::make_room;
 using stress::RoomMaterials;
+using stress::render_ok;
+using stress::settings_for;
 using stress::StressRenderSettings;
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
-
-StressRenderSettings settings_for(const std::string& integrator) {
-    StressRenderSettings s;
-    s.integrator = integrator;
-    return s;
-}
-
-Image render_ok(Expected<Scene> scene, const StressRenderSettings& settings) {
-    EXPECT_TRUE(scene.has_value()) << (scene ? "" : scene.error().message);
-    if (!scene) return {};
-    auto rendered = stress::render_scene(std::move(scene).value(), settings);
-    EXPECT_TRUE(rendered.has_value()) << (rendered ? "" : rendered.error().message);
-    if (!rendered) return {};
-    EXPECT_EQ(stress::non_finite_pixels(rendered->image), 0u);
-    EXPECT_EQ(stress::negative_pixels(rendered->image), 0u);
-    return rendered->image;
-}
 
 class DegenerateGeometry : public testing::TestWithParam<std::string> {
 protected:

@@ -2,6 +2,8 @@
 // (the steps of server/render_pipeline.cpp, which tests do not link) and image statistics.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -331,6 +333,25 @@ inline OutlierStatistics isolated_outliers(const Image& image,
         }
     }
     return stats;
+}
+
+/// The settings of a small stress render with `integrator` (path, photon-map or direct).
+inline StressRenderSettings settings_for(const std::string& integrator) {
+    StressRenderSettings s;
+    s.integrator = integrator;
+    return s;
+}
+
+/// Renders a scene that must build and render, expecting every pixel finite and non-negative.
+inline Image render_ok(Expected<Scene> scene, const StressRenderSettings& settings) {
+    EXPECT_TRUE(scene.has_value()) << (scene ? "" : scene.error().message);
+    if (!scene) return {};
+    auto rendered = render_scene(std::move(scene).value(), settings);
+    EXPECT_TRUE(rendered.has_value()) << (rendered ? "" : rendered.error().message);
+    if (!rendered) return {};
+    EXPECT_EQ(non_finite_pixels(rendered->image), 0u);
+    EXPECT_EQ(negative_pixels(rendered->image), 0u);
+    return rendered->image;
 }
 
 }  // namespace photond::stress
