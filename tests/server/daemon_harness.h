@@ -50,6 +50,20 @@ inline std::string lower(std::string s) {
     return s;
 }
 
+/// Reads "Name: value" lines (CRLF or LF) into `headers`, names lower-cased; lines without a
+/// colon are skipped.
+inline void read_header_lines(std::istream& lines, std::map<std::string, std::string>& headers) {
+    std::string line;
+    while (std::getline(lines, line)) {
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        const size_t colon = line.find(':');
+        if (colon == std::string::npos) continue;
+        std::string value = line.substr(colon + 1);
+        value.erase(0, value.find_first_not_of(' '));
+        headers[lower(line.substr(0, colon))] = value;
+    }
+}
+
 inline std::string read_file(const fs::path& path) {
     std::ifstream in(path, std::ios::binary);
     std::ostringstream s;
@@ -270,14 +284,7 @@ private:
         std::string line;
         std::getline(lines, line);
         if (line.size() >= 12) response.status = std::stoi(line.substr(9, 3));
-        while (std::getline(lines, line)) {
-            if (!line.empty() && line.back() == '\r') line.pop_back();
-            const size_t colon = line.find(':');
-            if (colon == std::string::npos) continue;
-            std::string value = line.substr(colon + 1);
-            value.erase(0, value.find_first_not_of(' '));
-            response.headers[lower(line.substr(0, colon))] = value;
-        }
+        read_header_lines(lines, response.headers);
     }
 
     int port_;
@@ -342,15 +349,7 @@ inline std::vector<MultipartPart> parse_multipart(const std::string& body,
         if (head_end == std::string::npos) break;
         MultipartPart part;
         std::istringstream lines(body.substr(position, head_end - position));
-        std::string line;
-        while (std::getline(lines, line)) {
-            if (!line.empty() && line.back() == '\r') line.pop_back();
-            const size_t colon = line.find(':');
-            if (colon == std::string::npos) continue;
-            std::string value = line.substr(colon + 1);
-            value.erase(0, value.find_first_not_of(' '));
-            part.headers[lower(line.substr(0, colon))] = value;
-        }
+        read_header_lines(lines, part.headers);
         const size_t length = std::stoul(part.headers.at("content-length"));
         if (head_end + 4 + length > body.size()) break;
         part.body = body.substr(head_end + 4, length);
