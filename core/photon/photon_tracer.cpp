@@ -40,21 +40,37 @@ struct MapBuilder {
     bool active = false;      // still collecting
     bool complete = true;
     uint64_t emitted = 0;     // photons emitted for this map (set when it fills or stops)
-    std::vector<TracedPhoton> photons;
+    size_t count = 0;         // photons collected so far, over all parts
+    /// The collected photons in emission order: the chunks' own buffers, moved in rather than
+    /// copied (copying every photon into one fresh array cost about a fifth of tracing).
+    std::vector<std::vector<TracedPhoton>> parts;
 
-    /// Appends a batch's photons in order; stops at the one that fills the map.
-    void append(std::span<const ChunkOutput> chunks, std::vector<TracedPhoton> ChunkOutput::*member,
+    /// Takes a batch's photons in order; stops at the one that fills the map.
+    void append(std::span<ChunkOutput> chunks, std::vector<TracedPhoton> ChunkOutput::*member,
                 uint64_t batch_start) {
         if (!active) return;
-        for (const ChunkOutput& chunk : chunks) {
-            for (const TracedPhoton& p : chunk.*member) {
-                photons.push_back(p);
-                if (photons.size() >= target) {
-                    emitted = batch_start + p.path + 1;
-                    active = false;
-                    return;
-                }
+        for (ChunkOutput& chunk : chunks) {
+            std::vector<TracedPhoton>& photons = chunk.*member;
+            if (photons.empty()) continue;
+            if (count + photons.size() >= target) {
+                photons.resize(target - count);
+                emitted = batch_start + photons.back().path + 1;
+                active = false;
             }
+            count += photons.size();
+            parts.push_back(std::move(photons));
+            photons = {};
+            if (!active) return;
+        }
+    }
+
+    /// Calls f(photon) for every stride-th photon in emission order, with its running number.
+    template <typename F>
+    void for_each_strided(size_t stride, F&& f) const {
+        size_t index = 0, next = 0;
+        for (const std::vector<TracedPhoton>& part : parts) {
+            for (; next < index + part.size(); next += stride) f(part[next - index]);
+            index += part.size();
         }
     }
 };
@@ -115,12 +131,14 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
 
 /// Irradiance at every stride-th global photon (in photon order), estimated from the global map,
 /// packed as photons whose flux is the irradiance and whose direction is the surface normal.
-std::shared_ptr<const PhotonMap> precompute_irradiance(const PhotonMap& global, const std::vector<TracedPhoton>& traced,
+std::shared_ptr<const PhotonMap> precompute_irradiance(const PhotonMap& global, const MapBuilder& traced,
                                                        const PhotonTracingSettings& settings, float max_radius) {
-    const size_t count = (traced.size() + settings.irradiance_stride - 1) / settings.irradiance_stride;
-    std::vector<Photon> points(count);
-    tbb::parallel_for(size_t(0), count, [&](size_t i) {
-        const TracedPhoton& t = traced[i * settings.irradiance_stride];
+    std::vector<const TracedPhoton*> sites;
+    sites.reserve((traced.count + settings.irradiance_stride - 1) / settings.irradiance_stride);
+    traced.for_each_strided(settings.irradiance_stride, [&](const TracedPhoton& t) { sites.push_back(&t); });
+    std::vector<Photon> points(sites.size());
+    tbb::parallel_for(size_t(0), sites.size(), [&](size_t i) {
+        const TracedPhoton& t = *sites[i];
         const Color e = global.estimate_irradiance(t.position, t.normal, settings.k_irradiance, max_radius);
         points[i] = make_photon(t.position, t.normal, e, 0, t.normal);
     });
@@ -129,11 +147,13 @@ std::shared_ptr<const PhotonMap> precompute_irradiance(const PhotonMap& global, 
 
 std::shared_ptr<const PhotonMap> finish_map(MapBuilder& builder) {
     std::vector<Photon> packed;
-    packed.reserve(builder.photons.size());
+    packed.reserve(builder.count);
     const double scale = builder.emitted > 0 ? 1.0 / static_cast<double>(builder.emitted) : 0.0;
-    for (const TracedPhoton& p : builder.photons) {
-        packed.push_back(make_photon(p.position, p.direction, Color(DVec3(p.flux) * scale),
-                                     p.flags, p.normal));
+    for (const std::vector<TracedPhoton>& part : builder.parts) {
+        for (const TracedPhoton& p : part) {
+            packed.push_back(make_photon(p.position, p.direction, Color(DVec3(p.flux) * scale),
+                                         p.flags, p.normal));
+        }
     }
     return std::make_shared<const PhotonMap>(std::move(packed), builder.emitted);
 }
@@ -149,9 +169,6 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
     caustic.target = settings.caustic_photons;
     global.active = global.target > 0;
     caustic.active = caustic.target > 0;
-    // Room for the whole map up front: growing it while merging batches is serial copying.
-    global.photons.reserve(global.target);
-    caustic.photons.reserve(caustic.target);
     global.cap = static_cast<uint64_t>(global.target) * settings.max_emitted_per_stored;
     caustic.cap = static_cast<uint64_t>(caustic.target) * settings.max_emitted_per_stored;
 
@@ -167,8 +184,8 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
         uint64_t batch = 16384;
         for (const MapBuilder* m : {&global, &caustic}) {
             if (!m->active || emitted == 0) continue;
-            const double rate = static_cast<double>(m->photons.size()) / static_cast<double>(emitted);
-            const double remaining = static_cast<double>(m->target - m->photons.size());
+            const double rate = static_cast<double>(m->count) / static_cast<double>(emitted);
+            const double remaining = static_cast<double>(m->target - m->count);
             const double needed = rate > 0.0 ? 1.1 * remaining / rate : 1e18;
             batch = std::max<uint64_t>(batch, static_cast<uint64_t>(std::min(needed, 1048576.0)));
         }
@@ -177,9 +194,18 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
         const size_t chunk_count = (batch + kChunkSize - 1) / kChunkSize;
         // Chunk buffers are kept from batch to batch: their capacity is reused, not reallocated.
         if (chunks.size() < chunk_count) chunks.resize(chunk_count);
+        // Buffers taken by a map are gone; size the new ones from the store rate so far (growing
+        // them photon by photon is copying and page faults).
+        const auto expected = [&](const MapBuilder& m) {
+            if (!m.active || emitted == 0) return size_t(0);
+            return static_cast<size_t>(1.2 * kChunkSize * static_cast<double>(m.count) / static_cast<double>(emitted)) + 16;
+        };
+        const size_t expected_global = expected(global), expected_caustic = expected(caustic);
         for (size_t c = 0; c < chunk_count; ++c) {
             chunks[c].global.clear();
             chunks[c].caustic.clear();
+            chunks[c].global.reserve(expected_global);
+            chunks[c].caustic.reserve(expected_caustic);
             chunks[c].rays = 0;
         }
         arena.execute([&] {
@@ -195,14 +221,14 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
             });
         });
         if (settings.cancel && settings.cancel->load()) cancelled = true;
-        const std::span<const ChunkOutput> batch_chunks(chunks.data(), chunk_count);
+        const std::span<ChunkOutput> batch_chunks(chunks.data(), chunk_count);
         for (const ChunkOutput& c : batch_chunks) stats.rays += c.rays;
         global.append(batch_chunks, &ChunkOutput::global, emitted);
         caustic.append(batch_chunks, &ChunkOutput::caustic, emitted);
         emitted += batch;
         for (MapBuilder* m : {&global, &caustic}) {
             // A map that nothing reached after a fair trial will not fill: stop early.
-            const bool hopeless = m->photons.empty() && emitted >= std::max<uint64_t>(kEmptyMapTrial, m->target);
+            const bool hopeless = m->count == 0 && emitted >= std::max<uint64_t>(kEmptyMapTrial, m->target);
             if (m->active && (emitted >= m->cap || hopeless)) {  // keep what arrived, say so
                 m->active = false;
                 m->complete = false;
@@ -214,7 +240,7 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
     stats.emitted = emitted;
     stats.tracing_seconds = std::chrono::duration<double>(Clock::now() - start).count();
     for (const auto& [builder, name] : {std::pair{&global, "global"}, std::pair{&caustic, "caustic"}}) {
-        if (builder->target > 0 && builder->photons.empty()) {
+        if (builder->target > 0 && builder->count == 0) {
             return Error{std::string("photon pass: no photon reached a surface that stores it for the ") + name +
                          " map after " + std::to_string(emitted) +
                          " photons were emitted (lights facing away from the scene, or nothing reflects)"};
@@ -222,8 +248,8 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
     }
     stats.emitted_global = global.emitted;
     stats.emitted_caustic = caustic.emitted;
-    stats.stored_global = global.photons.size();
-    stats.stored_caustic = caustic.photons.size();
+    stats.stored_global = global.count;
+    stats.stored_caustic = caustic.count;
     stats.global_complete = global.complete;
     stats.caustic_complete = caustic.complete;
 
@@ -236,7 +262,7 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
     if (maps.global && settings.irradiance_stride > 0) {
         const Clock::time_point irradiance_start = Clock::now();
         const float max_radius = kIrradianceRadiusShare * rs.scene->bounds.radius();
-        arena.execute([&] { maps.irradiance = precompute_irradiance(*maps.global, global.photons, settings, max_radius); });
+        arena.execute([&] { maps.irradiance = precompute_irradiance(*maps.global, global, settings, max_radius); });
         stats.irradiance_photons = maps.irradiance->size();
         stats.irradiance_seconds = std::chrono::duration<double>(Clock::now() - irradiance_start).count();
     }
