@@ -16,7 +16,7 @@ Color DirectIntegrator::radiance_along(const Ray& ray, int depth, SampleContext&
     const SurfaceInteraction si = make_interaction(*rs.scene, *hit, ray.direction);
     const Vec3 wo = -ray.direction;
     Color radiance = rs.lights->emitted_radiance(si, wo);
-    const Bsdf bsdf = make_bsdf(*rs.scene, si, wo);
+    const Bsdf bsdf = make_bsdf(rs, si, wo);
     if (bsdf.has_non_delta()) radiance += sample_direct_light(rs, si, bsdf, wo, context, false);
     if (bsdf.has_delta() && depth < max_specular_depth_) {
         radiance += follow_delta_lobes(bsdf, wo, depth < kBranchDepth, context.rng, [&](const BsdfSample& s) {

@@ -57,7 +57,7 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
             if (!hit) return Color(0.0f);
             const SurfaceInteraction si = make_interaction(*rs.scene, *hit, r.direction);
             const Vec3 wo = -r.direction;
-            const Bsdf bsdf = make_bsdf(*rs.scene, si, wo);
+            const Bsdf bsdf = make_bsdf(rs, si, wo);
             Color radiance(0.0f);
             if (bsdf.has_non_delta()) radiance += radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_);
             if (bsdf.has_delta() && depth < g.settings_.max_specular_depth) {

@@ -89,7 +89,7 @@ inline Ray spawn_ray(const RenderScene& rs, const SurfaceInteraction& si, const 
 
 /// The BSDF at a hit seen from direction wo. Opaque materials are shaded two-sided (normals turned
 /// towards wo); transmissive ones keep the mesh's orientation, so the outside is the front side.
-Bsdf make_bsdf(const Scene& scene, const SurfaceInteraction& si, const Vec3& wo);
+Bsdf make_bsdf(const RenderScene& rs, const SurfaceInteraction& si, const Vec3& wo);
 
 /// Next-event estimation: one light sample with a shadow ray, lobes in `mask` only. With
 /// `use_mis`, area-light samples are weighted by the power heuristic against BSDF sampling.

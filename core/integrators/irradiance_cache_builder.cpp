@@ -32,7 +32,7 @@ void collect_diffuse_points(const RenderScene& rs, const Ray& ray, float path_le
     if (!hit) return;
     const SurfaceInteraction si = make_interaction(*rs.scene, *hit, ray.direction);
     const Vec3 wo = -ray.direction;
-    const Bsdf bsdf = make_bsdf(*rs.scene, si, wo);
+    const Bsdf bsdf = make_bsdf(rs, si, wo);
     const float length = path_length + hit->t;
     if (max_component(bsdf.diffuse_reflectance(wo)) > 0.0f) {
         const Vec3 n = glm::dot(si.shading_normal, wo) >= 0.0f ? si.shading_normal : -si.shading_normal;

@@ -31,7 +31,7 @@ Color PathIntegrator::radiance(const CameraRay& camera_ray, SampleContext& conte
             radiance += throughput * emitted * weight;
         }
 
-        const Bsdf bsdf = make_bsdf(*rs.scene, si, wo);
+        const Bsdf bsdf = make_bsdf(rs, si, wo);
         if (bsdf.has_non_delta())
             radiance += throughput * sample_direct_light(rs, si, bsdf, wo, context, true);
 

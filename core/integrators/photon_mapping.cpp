@@ -70,7 +70,7 @@ Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_
     const SurfaceInteraction si = make_interaction(*rs.scene, *hit, ray.direction);
     const Vec3 wo = -ray.direction;
     Color radiance = rs.lights->emitted_radiance(si, wo);
-    const Bsdf bsdf = make_bsdf(*rs.scene, si, wo);
+    const Bsdf bsdf = make_bsdf(rs, si, wo);
     const float length = path_length + hit->t;
     if (bsdf.has_non_delta()) {
         radiance += sample_direct_light(rs, si, bsdf, wo, context, false);

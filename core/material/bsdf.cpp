@@ -260,69 +260,69 @@ SpecularAlbedo specular_albedo_terms(int cell, float w_roughness, float mu) {
 
 }  // namespace
 
-Bsdf::Bsdf(const Material& material, const Color& base_color, const Frame& shading,
-           const Vec3& geometric_normal)
-    : frame_(shading), geometric_normal_(geometric_normal) {
+BsdfMaterial::BsdfMaterial(const Material& material) {
     // Clamp to the ranges the glTF spec allows, which is what the energy guarantee needs.
-    base_color_ = glm::clamp(base_color, Color(0.0f), Color(1.0f));
-    metallic_ = std::clamp(material.metallic, 0.0f, 1.0f);
-    transmission_ = std::clamp(material.transmission, 0.0f, 1.0f);
-    roughness_ = std::clamp(material.roughness, 0.0f, 1.0f);
-    ior_ = std::isfinite(material.ior) ? std::max(material.ior, 1.0f) : 1.5f;
+    metallic = std::clamp(material.metallic, 0.0f, 1.0f);
+    transmission = std::clamp(material.transmission, 0.0f, 1.0f);
+    roughness = std::clamp(material.roughness, 0.0f, 1.0f);
+    ior = std::isfinite(material.ior) ? std::max(material.ior, 1.0f) : 1.5f;
     const float specular = std::clamp(material.specular, 0.0f, 1.0f);
 
     // KHR_materials_specular: F0 = min(F0(ior) * specular_color, 1) * specular, F90 = specular.
     // Note F0 <= F90, so the layer albedo F0 total + (F90 - F0) schlick stays <= F90 <= 1.
-    const float f0_from_ior = sqr((ior_ - 1.0f) / (ior_ + 1.0f));
-    specular_f0_ =
-        glm::min(f0_from_ior * glm::max(material.specular_color, Color(0.0f)), Color(1.0f)) *
-        specular;
-    specular_f90_ = specular;
+    const float f0_from_ior = sqr((ior - 1.0f) / (ior + 1.0f));
+    specular_f0 = glm::min(f0_from_ior * glm::max(material.specular_color, Color(0.0f)), Color(1.0f)) * specular;
+    specular_f90 = specular;
 
-    layer_weight_ = (1.0f - metallic_) * (1.0f - transmission_);
-    glass_weight_ = (1.0f - metallic_) * transmission_;
-    smooth_ = roughness_ < kDeltaRoughness;
-    alpha_ = std::max(sqr(roughness_), kMinAlpha);
-    glass_delta_ = smooth_ || ior_ < 1.0f + kMinIorContrast;
-    specular_kind_ = microfacet_lobe_kind(roughness_);
-    glass_kind_ = glass_delta_ ? LobeKind::Delta : specular_kind_;
+    layer_weight = (1.0f - metallic) * (1.0f - transmission);
+    glass_weight = (1.0f - metallic) * transmission;
+    smooth = roughness < kDeltaRoughness;
+    alpha = std::max(sqr(roughness), kMinAlpha);
+    glass_delta = smooth || ior < 1.0f + kMinIorContrast;
+    specular_kind = microfacet_lobe_kind(roughness);
+    glass_kind = glass_delta ? LobeKind::Delta : specular_kind;
 
+    const bool reflects = metallic > 0.0f || (layer_weight > 0.0f && specular_f90 > 0.0f);
     // Rough reflection needs the albedo table (only the cell of this roughness is built).
     SpecularAlbedo avg{1.0f, 1.0f / 21.0f};  // ideal mirror: int (1 - mu)^5 2 mu dmu = 1/21
-    if (!smooth_ && (metallic_ > 0.0f || (layer_weight_ > 0.0f && specular_f90_ > 0.0f))) {
+    if (!smooth && reflects) {
         AlbedoTable& table = AlbedoTable::instance();
-        std::tie(albedo_cell_, albedo_cell_weight_) = table.locate_roughness(roughness_);
-        avg = table.average(albedo_cell_, albedo_cell_weight_);
+        std::tie(albedo_cell, albedo_cell_weight) = table.locate_roughness(roughness);
+        avg = table.average(albedo_cell, albedo_cell_weight);
     }
     // Normalisation of the coupled Lambertian lobe (see the top of this file).
-    const Color layer_avg =
-        specular_f0_ * avg.total + (Color(specular_f90_) - specular_f0_) * avg.schlick;
-    diffuse_weight_ = layer_weight_ * base_color_;
+    const Color layer_avg = specular_f0 * avg.total + (Color(specular_f90) - specular_f0) * avg.schlick;
     for (int ch = 0; ch < 3; ++ch) {
         const float remaining = 1.0f - layer_avg[ch];
-        diffuse_norm_[ch] = remaining > 1e-6f ? 1.0f / remaining : 0.0f;
-        diffuse_[ch] = diffuse_norm_[ch] > 0.0f ? diffuse_weight_[ch] * remaining : 0.0f;
+        diffuse_norm[ch] = remaining > 1e-6f ? 1.0f / remaining : 0.0f;
+        diffuse_remaining[ch] = diffuse_norm[ch] > 0.0f ? remaining : 0.0f;
     }
+    if (reflects) other_lobes |= mask_of(specular_kind);
+    if (glass_weight > 0.0f) other_lobes |= mask_of(glass_kind);
+    lambertian_only = other_lobes == 0 && metallic <= 0.0f && glass_weight <= 0.0f && specular_f90 <= 0.0f;
+}
 
+Bsdf::Bsdf(const BsdfMaterial& material, const Color& base_color, const Frame& shading,
+           const Vec3& geometric_normal)
+    : m_(material), frame_(shading), geometric_normal_(geometric_normal) {
+    base_color_ = glm::clamp(base_color, Color(0.0f), Color(1.0f));
+    diffuse_weight_ = m_.layer_weight * base_color_;
+    diffuse_ = diffuse_weight_ * m_.diffuse_remaining;
+    lobes_ = m_.other_lobes;
     if (max_component(diffuse_) > 0.0f) lobes_ |= mask_of(LobeKind::Diffuse);
-    if (metallic_ > 0.0f || (layer_weight_ > 0.0f && specular_f90_ > 0.0f)) {
-        lobes_ |= mask_of(specular_kind_);
-    }
-    if (glass_weight_ > 0.0f) lobes_ |= mask_of(glass_kind_);
-    pure_lambertian_ = lobes_ == mask_of(LobeKind::Diffuse) && metallic_ <= 0.0f && glass_weight_ <= 0.0f &&
-                       specular_f90_ <= 0.0f;
+    pure_lambertian_ = lobes_ == mask_of(LobeKind::Diffuse) && m_.lambertian_only;
 }
 
 Color Bsdf::layer_albedo(float cos_theta) const {
-    const SpecularAlbedo e = specular_albedo_terms(albedo_cell_, albedo_cell_weight_, cos_theta);
-    return specular_f0_ * e.total + (Color(specular_f90_) - specular_f0_) * e.schlick;
+    const SpecularAlbedo e = specular_albedo_terms(m_.albedo_cell, m_.albedo_cell_weight, cos_theta);
+    return m_.specular_f0 * e.total + (Color(m_.specular_f90) - m_.specular_f0) * e.schlick;
 }
 
 Color Bsdf::specular_albedo(float cos_theta) const {
     // Metal (F0 = c, F90 = 1) plus the dielectric layer; exact when smooth.
-    const SpecularAlbedo e = specular_albedo_terms(albedo_cell_, albedo_cell_weight_, cos_theta);
+    const SpecularAlbedo e = specular_albedo_terms(m_.albedo_cell, m_.albedo_cell_weight, cos_theta);
     const Color metal = base_color_ * e.total + (Color(1.0f) - base_color_) * e.schlick;
-    return metallic_ * metal + layer_weight_ * layer_albedo(cos_theta);
+    return m_.metallic * metal + m_.layer_weight * layer_albedo(cos_theta);
 }
 
 Color Bsdf::lambert_albedo(float cos_theta) const {
@@ -330,7 +330,7 @@ Color Bsdf::lambert_albedo(float cos_theta) const {
     const Color remaining = Color(1.0f) - layer_albedo(cos_theta);
     Color rho(0.0f);
     for (int ch = 0; ch < 3; ++ch) {
-        if (diffuse_norm_[ch] > 0.0f) rho[ch] = diffuse_weight_[ch] * remaining[ch];
+        if (m_.diffuse_norm[ch] > 0.0f) rho[ch] = diffuse_weight_[ch] * remaining[ch];
     }
     return rho;
 }
@@ -347,8 +347,8 @@ bool Bsdf::geometry_agrees(const Vec3& wo, const Vec3& wi, bool local_reflection
 }
 
 bool Bsdf::has_non_lambertian_non_delta() const {
-    const bool rough_reflection = !smooth_ && (metallic_ > 0.0f || (layer_weight_ > 0.0f && specular_f90_ > 0.0f));
-    const bool rough_glass = glass_weight_ > 0.0f && !glass_delta_;
+    const bool rough_reflection = !m_.smooth && (m_.metallic > 0.0f || (m_.layer_weight > 0.0f && m_.specular_f90 > 0.0f));
+    const bool rough_glass = m_.glass_weight > 0.0f && !m_.glass_delta;
     return rough_reflection || rough_glass;
 }
 
@@ -362,12 +362,12 @@ Bsdf::SlotProbabilities Bsdf::slot_probabilities(const Vec3& wo, bool outside,
         max_component(diffuse_) > 0.0f) {
         p[kSlotDiffuse] = average(lambert_albedo(mu));
     }
-    if (in_mask(mask, specular_kind_) && (metallic_ > 0.0f || layer_weight_ > 0.0f)) {
+    if (in_mask(mask, m_.specular_kind) && (m_.metallic > 0.0f || m_.layer_weight > 0.0f)) {
         p[kSlotSpecular] = average(specular_albedo(mu));
     }
-    if (in_mask(mask, glass_kind_) && glass_weight_ > 0.0f) {
+    if (in_mask(mask, m_.glass_kind) && m_.glass_weight > 0.0f) {
         const float f = fresnel_dielectric(mu, relative_ior(outside));
-        p[kSlotGlass] = glass_weight_ * (f + (1.0f - f) * average(base_color_));
+        p[kSlotGlass] = m_.glass_weight * (f + (1.0f - f) * average(base_color_));
     }
     const float sum = p[0] + p[1] + p[2];
     if (!(sum > 0.0f)) return {0.0f, 0.0f, 0.0f};
@@ -378,14 +378,14 @@ Bsdf::SlotProbabilities Bsdf::slot_probabilities(const Vec3& wo, bool outside,
 Color Bsdf::eval_local(const Vec3& wo, const Vec3& wi, bool outside, TransportMode mode,
                        LobeMask mask) const {
     Color f(0.0f);
-    const GgxDistribution ggx(alpha_);
+    const GgxDistribution ggx(m_.alpha);
     if (wi.z > 0.0f) {
         if (in_mask(mask, LobeKind::Diffuse) && !(mask & kExcludeLambertian)) {
             f += diffuse_weight_ * kInvPi * (Color(1.0f) - layer_albedo(wo.z)) *
-                 (Color(1.0f) - layer_albedo(wi.z)) * diffuse_norm_;
+                 (Color(1.0f) - layer_albedo(wi.z)) * m_.diffuse_norm;
         }
-        const bool specular = !smooth_ && in_mask(mask, specular_kind_);
-        const bool glass = !glass_delta_ && glass_weight_ > 0.0f && in_mask(mask, glass_kind_);
+        const bool specular = !m_.smooth && in_mask(mask, m_.specular_kind);
+        const bool glass = !m_.glass_delta && m_.glass_weight > 0.0f && in_mask(mask, m_.glass_kind);
         if (specular || glass) {
             // Torrance-Sparrow: F D G2 / (4 mu_o mu_i) (Walter et al. 2007, eq. 20).
             const Vec3 h = glm::normalize(wo + wi);
@@ -393,15 +393,15 @@ Color Bsdf::eval_local(const Vec3& wo, const Vec3& wi, bool outside, TransportMo
             const float common = ggx.d(h) * ggx.g2(wo, wi) / (4.0f * wo.z * wi.z);
             if (specular) {
                 const Color metal = fresnel_schlick(base_color_, Color(1.0f), cos_oh);
-                const Color layer = fresnel_schlick(specular_f0_, Color(specular_f90_), cos_oh);
-                f += (metallic_ * metal + layer_weight_ * layer) * common;
+                const Color layer = fresnel_schlick(m_.specular_f0, Color(m_.specular_f90), cos_oh);
+                f += (m_.metallic * metal + m_.layer_weight * layer) * common;
             }
             if (glass) {
-                f += Color(glass_weight_ * fresnel_dielectric(cos_oh, relative_ior(outside)) *
+                f += Color(m_.glass_weight * fresnel_dielectric(cos_oh, relative_ior(outside)) *
                            common);
             }
         }
-    } else if (wi.z < 0.0f && !glass_delta_ && glass_weight_ > 0.0f && in_mask(mask, glass_kind_)) {
+    } else if (wi.z < 0.0f && !m_.glass_delta && m_.glass_weight > 0.0f && in_mask(mask, m_.glass_kind)) {
         // Rough dielectric transmission (Walter et al. 2007, eq. 21) with the generalized half
         // vector h ~ wo + eta wi, eta = n_i / n_o (wi's side over wo's side).
         const float eta = relative_ior(outside);
@@ -416,16 +416,16 @@ Color Bsdf::eval_local(const Vec3& wo, const Vec3& wi, bool outside, TransportMo
                       eta * -cos_ih * cos_oh / (wo.z * -wi.z * denom * denom);
         // Radiance is scaled by (n_o / n_i)^2 crossing the interface (Veach 1997, eq. 5.13).
         if (mode == TransportMode::Radiance) value /= eta * eta;
-        f += glass_weight_ * value * base_color_;
+        f += m_.glass_weight * value * base_color_;
     }
     return f;
 }
 
 float Bsdf::pdf_local(const Vec3& wo, const Vec3& wi, bool outside,
                       const SlotProbabilities& slots) const {
-    const GgxDistribution ggx(alpha_);
-    const float p_specular = smooth_ ? 0.0f : slots[kSlotSpecular];
-    const float p_glass = glass_delta_ ? 0.0f : slots[kSlotGlass];
+    const GgxDistribution ggx(m_.alpha);
+    const float p_specular = m_.smooth ? 0.0f : slots[kSlotSpecular];
+    const float p_glass = m_.glass_delta ? 0.0f : slots[kSlotGlass];
     float pdf = 0.0f;
     if (wi.z > 0.0f) {
         pdf += slots[kSlotDiffuse] * cosine_hemisphere_pdf(wi.z);
@@ -526,7 +526,7 @@ std::optional<BsdfSample> Bsdf::sample(const Vec3& wo, float u_lobe, const Vec2&
 
     BsdfSample s;
     Vec3 i;
-    const bool delta = (slot == kSlotSpecular && smooth_) || (slot == kSlotGlass && glass_delta_);
+    const bool delta = (slot == kSlotSpecular && m_.smooth) || (slot == kSlotGlass && m_.glass_delta);
     if (delta) {
         // All delta lobes share the mirror direction: its weight is their total reflectance over
         // the total probability of choosing it.
@@ -536,17 +536,17 @@ std::optional<BsdfSample> Bsdf::sample(const Vec3& wo, float u_lobe, const Vec2&
         float probability = 0.0f;
         if (mirror) {
             i = Vec3(-o.x, -o.y, o.z);
-            if (smooth_ && slots[kSlotSpecular] > 0.0f) {
+            if (m_.smooth && slots[kSlotSpecular] > 0.0f) {
                 reflectance += specular_albedo(o.z);
                 probability += slots[kSlotSpecular];
             }
-            if (glass_delta_ && slots[kSlotGlass] > 0.0f) {
-                reflectance += Color(glass_weight_ * f_glass);
+            if (m_.glass_delta && slots[kSlotGlass] > 0.0f) {
+                reflectance += Color(m_.glass_weight * f_glass);
                 probability += slots[kSlotGlass] * f_glass;
             }
         } else {
             if (!refract(o, Vec3(0, 0, 1), eta, &i)) return std::nullopt;
-            reflectance = glass_weight_ * (1.0f - f_glass) * base_color_;
+            reflectance = m_.glass_weight * (1.0f - f_glass) * base_color_;
             if (mode == TransportMode::Radiance) reflectance /= eta * eta;
             probability = slots[kSlotGlass] * (1.0f - f_glass);
             s.is_transmission = true;
@@ -557,7 +557,7 @@ std::optional<BsdfSample> Bsdf::sample(const Vec3& wo, float u_lobe, const Vec2&
         s.pdf = probability;
         s.kind = LobeKind::Delta;
     } else {
-        const GgxDistribution ggx(alpha_);
+        const GgxDistribution ggx(m_.alpha);
         bool reflection = true;
         if (slot == kSlotDiffuse) {
             i = sample_cosine_hemisphere(u);
@@ -579,7 +579,7 @@ std::optional<BsdfSample> Bsdf::sample(const Vec3& wo, float u_lobe, const Vec2&
         s.weight = f * std::abs(i.z) / pdf;
         s.pdf = pdf;
         s.kind = slot == kSlotDiffuse ? LobeKind::Diffuse
-                                      : (slot == kSlotSpecular ? specular_kind_ : glass_kind_);
+                                      : (slot == kSlotSpecular ? m_.specular_kind : m_.glass_kind);
         s.is_transmission = i.z < 0.0f;
         s.eta = s.is_transmission ? eta : 1.0f;
     }
@@ -597,15 +597,15 @@ int Bsdf::delta_lobes(const Vec3& wo, std::array<BsdfSample, 2>& out, TransportM
     if (!outside) o.z = -o.z;
     const float eta = relative_ior(outside);
     const float f_glass =
-        glass_delta_ && glass_weight_ > 0.0f ? fresnel_dielectric(o.z, eta) : 0.0f;
+        m_.glass_delta && m_.glass_weight > 0.0f ? fresnel_dielectric(o.z, eta) : 0.0f;
     auto to_world = [&](Vec3 i) {
         if (!outside) i.z = -i.z;
         return frame_.to_world(i);
     };
     int count = 0;
     Color mirror(0.0f);
-    if (smooth_) mirror += specular_albedo(o.z);
-    mirror += Color(glass_weight_ * f_glass);
+    if (m_.smooth) mirror += specular_albedo(o.z);
+    mirror += Color(m_.glass_weight * f_glass);
     if (!is_black(mirror)) {
         BsdfSample s;
         s.wi = to_world(Vec3(-o.x, -o.y, o.z));
@@ -615,11 +615,11 @@ int Bsdf::delta_lobes(const Vec3& wo, std::array<BsdfSample, 2>& out, TransportM
         if (geometry_agrees(wo, s.wi, true)) out[count++] = s;
     }
     Vec3 i;
-    if (glass_delta_ && glass_weight_ > 0.0f && f_glass < 1.0f &&
+    if (m_.glass_delta && m_.glass_weight > 0.0f && f_glass < 1.0f &&
         refract(o, Vec3(0, 0, 1), eta, &i)) {
         BsdfSample s;
         s.wi = to_world(i);
-        s.weight = glass_weight_ * (1.0f - f_glass) * base_color_;
+        s.weight = m_.glass_weight * (1.0f - f_glass) * base_color_;
         if (mode == TransportMode::Radiance) s.weight /= eta * eta;
         s.pdf = 1.0f;
         s.kind = LobeKind::Delta;

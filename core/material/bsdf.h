@@ -51,14 +51,46 @@ struct BsdfSample {
     float eta = 1.0f;
 };
 
+/// The part of a material's BSDF that depends on the material alone (its parameters clamped to
+/// glTF's ranges, the layer's Fresnel terms and albedo-table cell, the lobes' kinds). Derived once
+/// per material (RenderScene::bsdf_materials), so that a Bsdf at a hit only adds the base colour
+/// and the frames: deriving it at every hit was a tenth of a photon bounce.
+struct BsdfMaterial {
+    explicit BsdfMaterial(const Material& material);
+
+    Color specular_f0;       // dielectric layer F0 (from ior and KHR_materials_specular)
+    float specular_f90;      // dielectric layer F90 (the specular factor)
+    float metallic;
+    float transmission;
+    float layer_weight;      // (1 - metallic)(1 - transmission): opaque dielectric part
+    float glass_weight;      // (1 - metallic) transmission: solid dielectric part
+    float roughness;         // perceptual roughness
+    float alpha;             // GGX alpha = roughness^2
+    float ior;
+    bool smooth;             // roughness < kDeltaRoughness: reflection/transmission are delta
+    bool glass_delta;        // smooth, or ior ~ 1 (no refraction): the dielectric is delta
+    LobeKind specular_kind;  // kind of the metal/layer reflection lobe
+    LobeKind glass_kind;     // kind of the dielectric reflection/transmission lobe
+    LobeMask other_lobes = 0;  // the lobes other than the Lambertian one
+    /// No specular layer, metal or glass: only a Lambertian lobe (if the base colour is not black).
+    bool lambertian_only = false;
+    Color diffuse_remaining;  // 1 - E_s_avg per channel: the Lambertian lobe's share of base colour
+    Color diffuse_norm;       // 1 / (1 - E_s_avg) per channel; 0 where the layer reflects all
+    int albedo_cell = -1;            // roughness cell of the layer albedo table; -1: mirror
+    float albedo_cell_weight = 0.0f;  // interpolation weight within that cell
+};
+
 class Bsdf {
 public:
     /// `shading` is the interpolated-normal frame and `geometric_normal` the triangle's normal, both
     /// on the same side. For opaque materials the caller orients both towards wo (two-sided
     /// shading); for transmissive materials the caller keeps the mesh's front-face orientation, so
     /// that the outside (ior 1) is the side the normals point to.
-    Bsdf(const Material& material, const Color& base_color, const Frame& shading,
+    Bsdf(const BsdfMaterial& material, const Color& base_color, const Frame& shading,
          const Vec3& geometric_normal);
+    Bsdf(const Material& material, const Color& base_color, const Frame& shading,
+         const Vec3& geometric_normal)
+        : Bsdf(BsdfMaterial(material), base_color, shading, geometric_normal) {}
 
     /// Sum of the non-delta lobes in `mask` (no cosine). Zero for delta-only materials.
     /// Reflection vs transmission is decided by the geometric normal (reflection iff wo and wi
@@ -122,34 +154,19 @@ private:
     Color layer_albedo(float cos_theta) const;
     Color lambert_albedo(float cos_theta) const;
     Color specular_albedo(float cos_theta) const;
-    float relative_ior(bool outside) const { return outside ? ior_ : 1.0f / ior_; }
+    float relative_ior(bool outside) const { return outside ? m_.ior : 1.0f / m_.ior; }
     bool geometry_agrees(const Vec3& wo, const Vec3& wi, bool local_reflection) const;
 
+    BsdfMaterial m_;
     Frame frame_;
     Vec3 geometric_normal_;
     Color base_color_;
     Color diffuse_;           // cosine-weighted average reflectance of the Lambertian lobe
     Color diffuse_weight_;    // (1 - metallic)(1 - transmission) base colour
-    Color diffuse_norm_;      // 1 / (1 - E_s_avg) per channel; 0 where the layer reflects all
-    Color specular_f0_;       // dielectric layer F0 (from ior and KHR_materials_specular)
-    float specular_f90_;      // dielectric layer F90 (the specular factor)
-    float metallic_;
-    float transmission_;
-    float layer_weight_;      // (1 - metallic)(1 - transmission): opaque dielectric part
-    float glass_weight_;      // (1 - metallic) transmission: solid dielectric part
-    float roughness_;         // perceptual roughness
-    float alpha_;             // GGX alpha = roughness^2
-    float ior_;
-    bool smooth_;             // roughness < kDeltaRoughness: reflection/transmission are delta
-    bool glass_delta_;        // smooth_, or ior ~ 1 (no refraction): the dielectric is delta
-    LobeKind specular_kind_;  // kind of the metal/layer reflection lobe
-    LobeKind glass_kind_;     // kind of the dielectric reflection/transmission lobe
     LobeMask lobes_ = 0;
     /// Only the Lambertian lobe, with no specular layer above it (KHR_materials_specular factor 0,
     /// not metallic, not transmissive): eval, pdf and sample take their closed forms.
     bool pure_lambertian_ = false;
-    int albedo_cell_ = -1;            // roughness cell of the layer albedo table; -1: mirror
-    float albedo_cell_weight_ = 0.0f;  // interpolation weight within that cell
 };
 
 }  // namespace photond

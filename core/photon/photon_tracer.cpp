@@ -98,7 +98,7 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
         if (!hit) return;
         const SurfaceInteraction si = make_interaction(*rs.scene, *hit, ray.direction);
         const Vec3 wo = -ray.direction;  // towards where the photon came from
-        const Bsdf bsdf = make_bsdf(*rs.scene, si, wo);
+        const Bsdf bsdf = make_bsdf(rs, si, wo);
         if (bsdf.has_non_delta()) {
             const bool caustic_path = specular_bounces > 0 && !diffuse_seen;
             const uint8_t flags = static_cast<uint8_t>((bounce == 0 ? photon_flags::kDirect : 0) |

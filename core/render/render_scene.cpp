@@ -10,6 +10,8 @@ Expected<std::shared_ptr<const RenderScene>> RenderScene::create(std::shared_ptr
     if (!tracer) return tracer.error();
     render_scene->tracer = std::move(tracer).value();
     render_scene->lights = std::make_unique<LightSet>(*scene);
+    render_scene->bsdf_materials.reserve(scene->materials.size());
+    for (const Material& material : scene->materials) render_scene->bsdf_materials.emplace_back(material);
     return std::shared_ptr<const RenderScene>(std::move(render_scene));
 }
 

@@ -1,12 +1,14 @@
-// Everything a render reads about a scene: the scene itself, its Embree ray tracer and its
-// lights. Built once, then immutable and shared read-only by every thread (and, later, by every
+// Everything a render reads about a scene: the scene itself, its Embree ray tracer, its lights
+// and its materials' BSDF constants. Built once, then immutable and shared read-only by every thread (and, later, by every
 // job that renders the same scene).
 #pragma once
 
 #include <memory>
+#include <vector>
 
 #include "core/accel/ray_tracer.h"
 #include "core/light/light_set.h"
+#include "core/material/bsdf.h"
 #include "core/scene/scene.h"
 
 namespace photond {
@@ -15,6 +17,7 @@ struct RenderScene {
     std::shared_ptr<const Scene> scene;
     std::unique_ptr<RayTracer> tracer;
     std::unique_ptr<LightSet> lights;
+    std::vector<BsdfMaterial> bsdf_materials;  // one per Scene::materials entry
 
     static Expected<std::shared_ptr<const RenderScene>> create(std::shared_ptr<EmbreeDevice> device,
                                                                std::shared_ptr<const Scene> scene);

@@ -259,7 +259,7 @@ inline std::vector<uint8_t> legitimately_bright_pixels(const RenderScene& rs,
         const SurfaceInteraction si = make_interaction(*rs.scene, *found, ray.direction);
         const Vec3 wo = -ray.direction;
         if (!is_black(rs.lights->emitted_radiance(si, wo))) return true;
-        const Bsdf bsdf = make_bsdf(*rs.scene, si, wo);
+        const Bsdf bsdf = make_bsdf(rs, si, wo);
         if (!bsdf.has_delta() || depth >= 6) return false;
         std::array<BsdfSample, 2> lobes;
         const int count = bsdf.delta_lobes(wo, lobes);
