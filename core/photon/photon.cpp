@@ -1,6 +1,7 @@
 #include "core/photon/photon.h"
 
 #include <algorithm>
+#include <bit>
 #include <cfloat>
 #include <cmath>
 
@@ -48,6 +49,16 @@ float sanitize_channel(float c) {
     return std::min(c, FLT_MAX);
 }
 
+/// x * 2^k for k in [-126, 127]: exact (as ldexp) unless the product is subnormal, when it may
+/// flush to zero, which the callers round to zero anyway.
+float times_power_of_two(float x, int k) { return x * std::bit_cast<float>(uint32_t(k + 127) << 23); }
+
+/// lround for 0 <= v < 2^32, without a libm call: v - trunc(v) is exact.
+uint32_t round_half_away(float v) {
+    const uint32_t r = static_cast<uint32_t>(v);
+    return r + (v - static_cast<float>(r) >= 0.5f ? 1u : 0u);
+}
+
 // Octahedral normal codes (Meyer et al. 2010): the unit octahedron |x| + |y| + |z| = 1 folded
 // onto the square [-1, 1]^2, 16 bits per coordinate.
 constexpr float kNormalScale = 65535.0f;
@@ -55,7 +66,7 @@ constexpr float kNormalScale = 65535.0f;
 float sign_not_zero(float v) { return v >= 0.0f ? 1.0f : -1.0f; }
 
 uint16_t normal_code(float c) {
-    return uint16_t(std::lround(std::clamp(c * 0.5f + 0.5f, 0.0f, 1.0f) * kNormalScale));
+    return uint16_t(round_half_away(std::clamp(c * 0.5f + 0.5f, 0.0f, 1.0f) * kNormalScale));
 }
 
 }  // namespace
@@ -80,19 +91,19 @@ Photon make_photon(Vec3 position, Vec3 direction, Color flux, uint8_t user_flags
     p.flags_ = uint8_t((user_flags << 2) | 3u);
 
     // Flux: shared exponent from the largest channel, mantissas rounded to nearest (the encoded
-    // value is the representable one nearest to each channel for that exponent).
-    const double rgb[3] = {sanitize_channel(flux.x), sanitize_channel(flux.y),
-                           sanitize_channel(flux.z)};
-    const double largest = std::max(rgb[0], std::max(rgb[1], rgb[2]));
-    int exponent = 0;
-    std::frexp(largest, &exponent);  // largest = f * 2^exponent, f in [0.5, 1)
-    if (largest > 0.0 && exponent >= Photon::kMinFluxExponent) {
-        if (std::lround(std::ldexp(largest, 10 - exponent)) >= 1024) ++exponent;  // rounds up
+    // value is the representable one nearest to each channel for that exponent). Float bit
+    // arithmetic, exact like frexp, ldexp and lround, which were a tenth of packing a photon.
+    const float rgb[3] = {sanitize_channel(flux.x), sanitize_channel(flux.y), sanitize_channel(flux.z)};
+    const float largest = std::max(rgb[0], std::max(rgb[1], rgb[2]));
+    // largest = f * 2^exponent with f in [0.5, 1) (frexp's convention); subnormals fall below the range.
+    int exponent = static_cast<int>(std::bit_cast<uint32_t>(largest) >> 23) - 126;
+    if (largest > 0.0f && exponent >= Photon::kMinFluxExponent) {
+        if (round_half_away(times_power_of_two(largest, 10 - exponent)) >= 1024) ++exponent;  // rounds up
         exponent = std::min(exponent, Photon::kMaxFluxExponent);
         uint32_t mantissas = 0;
         for (int c = 0; c < 3; ++c) {
-            const long m = std::min(1023l, std::lround(std::ldexp(rgb[c], 10 - exponent)));
-            mantissas |= uint32_t(m) << (10 * c);
+            const uint32_t m = std::min(1023u, round_half_away(times_power_of_two(rgb[c], 10 - exponent)));
+            mantissas |= m << (10 * c);
         }
         p.flux_mantissas_ = mantissas;
         p.flux_exponent_ = uint8_t(exponent - Photon::kMinFluxExponent + 1);

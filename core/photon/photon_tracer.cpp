@@ -146,15 +146,18 @@ std::shared_ptr<const PhotonMap> precompute_irradiance(const PhotonMap& global, 
 }
 
 std::shared_ptr<const PhotonMap> finish_map(MapBuilder& builder) {
-    std::vector<Photon> packed;
-    packed.reserve(builder.count);
+    // Packing is a few hundred ns a photon (the direction's acos and atan2): in parallel, each
+    // part into its own range.
+    std::vector<size_t> offsets(builder.parts.size() + 1, 0);
+    for (size_t i = 0; i < builder.parts.size(); ++i) offsets[i + 1] = offsets[i] + builder.parts[i].size();
+    std::vector<Photon> packed(builder.count);
     const double scale = builder.emitted > 0 ? 1.0 / static_cast<double>(builder.emitted) : 0.0;
-    for (const std::vector<TracedPhoton>& part : builder.parts) {
-        for (const TracedPhoton& p : part) {
-            packed.push_back(make_photon(p.position, p.direction, Color(DVec3(p.flux) * scale),
-                                         p.flags, p.normal));
+    tbb::parallel_for(size_t(0), builder.parts.size(), [&](size_t i) {
+        Photon* out = packed.data() + offsets[i];
+        for (const TracedPhoton& p : builder.parts[i]) {
+            *out++ = make_photon(p.position, p.direction, Color(DVec3(p.flux) * scale), p.flags, p.normal);
         }
-    }
+    });
     return std::make_shared<const PhotonMap>(std::move(packed), builder.emitted);
 }
 
