@@ -200,7 +200,10 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
         // Buffers taken by a map are gone; size the new ones from the store rate so far (growing
         // them photon by photon is copying and page faults).
         const auto expected = [&](const MapBuilder& m) {
-            if (!m.active || emitted == 0) return size_t(0);
+            if (!m.active) return size_t(0);
+            // First guess: a global photon per emission; caustic photons are rarer, and kept
+            // buffers keep their capacity.
+            if (emitted == 0) return &m == &global ? size_t(kChunkSize) : size_t(0);
             return static_cast<size_t>(1.2 * kChunkSize * static_cast<double>(m.count) / static_cast<double>(emitted)) + 16;
         };
         const size_t expected_global = expected(global), expected_caustic = expected(caustic);

@@ -17,9 +17,11 @@ SurfaceInteraction make_interaction(const Scene& scene, const Hit& hit, const Ve
     const float len = glm::length(n);
     si.shading_normal = oriented_shading_normal(len > 1e-12f && std::isfinite(len) ? n / len : Vec3(0.0f),
                                                 si.geometric_normal);
-    si.uv = w * scene.uvs[tri.x] + hit.u * scene.uvs[tri.y] + hit.v * scene.uvs[tri.z];
     si.triangle = hit.triangle;
     si.material = scene.triangle_materials[hit.triangle];
+    // Texture coordinates serve texture lookups only: untextured materials skip their three loads.
+    if (scene.materials[si.material].base_color_texture >= 0)
+        si.uv = w * scene.uvs[tri.x] + hit.u * scene.uvs[tri.y] + hit.v * scene.uvs[tri.z];
     si.front_face = glm::dot(ray_direction, si.geometric_normal) < 0.0f;
     si.distance = hit.t;
     return si;

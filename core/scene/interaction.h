@@ -11,7 +11,7 @@ struct SurfaceInteraction {
     Vec3 p{0.0f};
     Vec3 geometric_normal{0.0f, 0.0f, 1.0f};  // the triangle's front-face normal (winding)
     Vec3 shading_normal{0.0f, 0.0f, 1.0f};    // interpolated, on the geometric normal's side
-    Vec2 uv{0.0f};
+    Vec2 uv{0.0f};  // interpolated texture coordinates; zero when the material has no texture
     uint32_t triangle = 0;
     uint32_t material = 0;
     /// True when the incoming ray arrived from the front side (the side the normal points to).
