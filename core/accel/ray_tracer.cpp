@@ -43,7 +43,7 @@ void enable_flush_denormals() {
 }
 
 Expected<std::unique_ptr<RayTracer>> RayTracer::build(std::shared_ptr<EmbreeDevice> device,
-                                                      const Scene& scene) {
+                                                      const Scene& scene, const std::vector<uint32_t>* only) {
     std::unique_ptr<RayTracer> tracer(new RayTracer());
     tracer->device_ = device;
     tracer->scene_ = &scene;
@@ -55,7 +55,8 @@ Expected<std::unique_ptr<RayTracer>> RayTracer::build(std::shared_ptr<EmbreeDevi
     rtcSetSceneFlags(rtc_scene, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(rtc_scene, RTC_BUILD_QUALITY_HIGH);
 
-    if (!scene.triangles.empty()) {
+    const size_t triangle_count = only ? only->size() : scene.triangles.size();
+    if (triangle_count > 0) {
         RTCGeometry geometry = rtcNewGeometry(device->handle(), RTC_GEOMETRY_TYPE_TRIANGLE);
         // Embree may read 16 bytes past the last vertex's 12: pad the buffer by one float4.
         auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
@@ -63,16 +64,21 @@ Expected<std::unique_ptr<RayTracer>> RayTracer::build(std::shared_ptr<EmbreeDevi
             scene.positions.size() + 1));
         auto* indices = static_cast<uint32_t*>(
             rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                    3 * sizeof(uint32_t), scene.triangles.size()));
+                                    3 * sizeof(uint32_t), triangle_count));
         if (!vertices || !indices) {
             rtcReleaseGeometry(geometry);
             return Error{"Embree: could not allocate geometry buffers for " +
-                         std::to_string(scene.triangles.size()) +
+                         std::to_string(triangle_count) +
                          " triangles: " + device->last_error()};
         }
         std::memcpy(vertices, scene.positions.data(), scene.positions.size() * sizeof(Vec3));
         std::memset(vertices + 3 * scene.positions.size(), 0, 3 * sizeof(float));
-        std::memcpy(indices, scene.triangles.data(), scene.triangles.size() * sizeof(glm::uvec3));
+        if (only) {
+            for (size_t i = 0; i < only->size(); ++i)
+                std::memcpy(indices + 3 * i, &scene.triangles[(*only)[i]], sizeof(glm::uvec3));
+        } else {
+            std::memcpy(indices, scene.triangles.data(), scene.triangles.size() * sizeof(glm::uvec3));
+        }
         rtcCommitGeometry(geometry);
         rtcAttachGeometryByID(rtc_scene, geometry, 0);
         rtcReleaseGeometry(geometry);

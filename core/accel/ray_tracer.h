@@ -10,6 +10,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/math/vec.h"
 #include "core/scene/scene.h"
@@ -87,8 +88,11 @@ inline RTCRayHit to_rtc_rayhit(const Ray& ray) {
 
 class RayTracer {
 public:
+    /// A tracer for all of the scene's triangles, or only for those listed in `only` (their
+    /// hits then report indices into `only`).
     static Expected<std::unique_ptr<RayTracer>> build(std::shared_ptr<EmbreeDevice> device,
-                                                      const Scene& scene);
+                                                      const Scene& scene,
+                                                      const std::vector<uint32_t>* only = nullptr);
     ~RayTracer();
     RayTracer(const RayTracer&) = delete;
     RayTracer& operator=(const RayTracer&) = delete;

@@ -91,6 +91,8 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
         ray.origin = rs.tracer->offset_origin(emission->origin, emission->normal, emission->direction);
     int specular_bounces = 0;
     bool diffuse_seen = false;
+    // For the caustic map alone, a photon that no specular surface lies ahead of stores nothing.
+    if (!want_global && rs.caustic_casters && !rs.caustic_casters->occluded(ray)) return;
 
     for (int bounce = 0; bounce < settings.max_bounces; ++bounce) {
         ++out.rays;
@@ -108,6 +110,8 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
             if (want_global) out.global.push_back(photon);
             if (want_caustic && caustic_path) out.caustic.push_back(photon);
         }
+        // Only caustic paths wanted, and every way on from here is diffuse: no need to sample it.
+        if (!want_global && bsdf.lobes() == mask_of(LobeKind::Diffuse)) return;
         const float u_lobe = rng.next_float();
         const Vec2 u = rng.next_vec2();
         const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Importance);
@@ -183,16 +187,19 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
     std::vector<ChunkOutput> chunks;
     while ((global.active || caustic.active) && !cancelled) {
         // Size the next batch from the store rate so far (deterministic: it depends only on the
-        // maps' contents), within [16K, 1M] photons.
+        // maps' contents), within [16K, 1M] photons: enough for the map that fills first, so
+        // that photons past its fill point are not traced for it (the caustic map usually needs
+        // ten times the emissions; after the global map fills, its photons trace cheaply).
         uint64_t batch = 16384;
-        for (const MapBuilder* m : {&global, &caustic}) {
-            if (!m->active || emitted == 0) continue;
-            const double rate = static_cast<double>(m->count) / static_cast<double>(emitted);
-            const double remaining = static_cast<double>(m->target - m->count);
-            const double needed = rate > 0.0 ? 1.1 * remaining / rate : 1e18;
-            batch = std::max<uint64_t>(batch, static_cast<uint64_t>(std::min(needed, 1048576.0)));
+        if (emitted > 0) {
+            double needed_first = 1048576.0;
+            for (const MapBuilder* m : {&global, &caustic}) {
+                if (!m->active || m->count == 0) continue;
+                const double rate = static_cast<double>(m->count) / static_cast<double>(emitted);
+                needed_first = std::min(needed_first, 1.1 * static_cast<double>(m->target - m->count) / rate);
+            }
+            batch = std::max<uint64_t>(batch, static_cast<uint64_t>(needed_first));
         }
-        batch = std::min<uint64_t>(batch, 1048576);
         const bool want_global = global.active, want_caustic = caustic.active;
         const size_t chunk_count = (batch + kChunkSize - 1) / kChunkSize;
         // Chunk buffers are kept from batch to batch: their capacity is reused, not reallocated.

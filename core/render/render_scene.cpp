@@ -6,12 +6,22 @@ Expected<std::shared_ptr<const RenderScene>> RenderScene::create(std::shared_ptr
                                                                  std::shared_ptr<const Scene> scene) {
     auto render_scene = std::make_shared<RenderScene>();
     render_scene->scene = scene;
-    auto tracer = RayTracer::build(std::move(device), *scene);
+    auto tracer = RayTracer::build(device, *scene);
     if (!tracer) return tracer.error();
     render_scene->tracer = std::move(tracer).value();
     render_scene->lights = std::make_unique<LightSet>(*scene);
     render_scene->bsdf_materials.reserve(scene->materials.size());
     for (const Material& material : scene->materials) render_scene->bsdf_materials.emplace_back(material);
+    std::vector<uint32_t> specular;
+    constexpr LobeMask kCausticLobes = mask_of(LobeKind::Delta) | mask_of(LobeKind::Glossy);
+    for (uint32_t t = 0; t < scene->triangles.size(); ++t) {
+        if (render_scene->bsdf_materials[scene->triangle_materials[t]].other_lobes & kCausticLobes) specular.push_back(t);
+    }
+    if (!specular.empty()) {
+        auto casters = RayTracer::build(device, *scene, &specular);
+        if (!casters) return casters.error();
+        render_scene->caustic_casters = std::move(casters).value();
+    }
     return std::shared_ptr<const RenderScene>(std::move(render_scene));
 }
 

@@ -18,6 +18,10 @@ struct RenderScene {
     std::unique_ptr<RayTracer> tracer;
     std::unique_ptr<LightSet> lights;
     std::vector<BsdfMaterial> bsdf_materials;  // one per Scene::materials entry
+    /// The triangles a caustic path (LS+D) can start on: those whose material has a delta or
+    /// glossy lobe; null when there are none. Photons emitted for the caustic map alone that miss
+    /// all of them are dropped after this one cheap ray instead of a trace through the scene.
+    std::unique_ptr<RayTracer> caustic_casters;
 
     static Expected<std::shared_ptr<const RenderScene>> create(std::shared_ptr<EmbreeDevice> device,
                                                                std::shared_ptr<const Scene> scene);
