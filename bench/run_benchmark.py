@@ -52,6 +52,11 @@ class SceneSpec:
     region: tuple = None  # (x0, y0, x1, y1): rendered and compared only there
     block: int = 1  # compare block x block means (the reference is not converged per pixel)
     note: str = ""
+    builtin: str = None  # the built-in scene rendered (default: name)
+
+    @property
+    def scene(self):
+        return self.builtin or self.name
 
 
 SCENES = [
@@ -69,6 +74,12 @@ SCENES = [
     SceneSpec("spheres-room", "bench/references/spheres-room-256", 256, 256,
               [4, 16, 64, 256], [4, 16, 64],
               note="115 332 triangles (built-in, generated): the cost of scene size"),
+    SceneSpec("cornell-box-512", "bench/references/cornell-box-512", 512, 512,
+              [4, 16, 64], [4, 16], builtin="cornell-box",
+              note="cornell-box at 512 x 512: the presets' goals at four times the pixels"),
+    SceneSpec("cornell-box-diffuse-512", "bench/references/cornell-box-diffuse-512", 512, 512,
+              [4, 16, 64], [4, 16], builtin="cornell-box-diffuse",
+              note="cornell-box-diffuse at 512 x 512"),
 ]
 
 
@@ -156,7 +167,7 @@ def render(photond, scene, point, seed, threads, workdir):
     """One render; returns its time, ray count and error figures (without the comparison)."""
     out = Path(workdir) / f"{scene.name}_{point.method}_{point.name}_{seed}.exr"
     stats_file = out.with_suffix(".json")
-    command = [photond, "render", f"builtin:{scene.name}", "--integrator", point.method,
+    command = [photond, "render", f"builtin:{scene.scene}", "--integrator", point.method,
                "--preset", point.preset, "--width", str(scene.width), "--height",
                str(scene.height), "--seed", str(seed), "--threads", str(threads), "--quiet",
                "--set", f"photons.seed={seed}", "--set", "output.pixel_type=float",
