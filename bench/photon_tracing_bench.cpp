@@ -72,10 +72,8 @@ std::vector<Ray> photon_rays(const RenderScene& rs, size_t count) {
     return rays;
 }
 
-void BM_BarePhotonRays(benchmark::State& state) {
-    const RenderScene& rs = *scene_named(kScenes[state.range(0)]);
-    enable_flush_denormals();
-    const std::vector<Ray> rays = photon_rays(rs, 1 << 18);
+/// The benchmark loop of bare Embree over `rays`, reporting rays_per_s.
+void cast_bare(benchmark::State& state, const RenderScene& rs, const std::vector<Ray>& rays) {
     RTCScene scene = rs.tracer->handle();
     uint64_t hits = 0;
     for (auto _ : state) {
@@ -84,6 +82,13 @@ void BM_BarePhotonRays(benchmark::State& state) {
     benchmark::DoNotOptimize(hits);
     state.counters["rays_per_s"] = benchmark::Counter(static_cast<double>(state.iterations() * rays.size()),
                                                       benchmark::Counter::kIsRate);
+}
+
+void BM_BarePhotonRays(benchmark::State& state) {
+    const RenderScene& rs = *scene_named(kScenes[state.range(0)]);
+    enable_flush_denormals();
+    const std::vector<Ray> rays = photon_rays(rs, 1 << 18);
+    cast_bare(state, rs, rays);
 }
 
 void BM_BareEmbreeIncoherent(benchmark::State& state) {
@@ -96,14 +101,7 @@ void BM_BareEmbreeIncoherent(benchmark::State& state) {
         const Vec3 u(rng.next_float(), rng.next_float(), rng.next_float());
         rays.push_back(Ray{b.lower + (0.01f + 0.98f * u) * b.extent(), sample_uniform_sphere(rng.next_vec2())});
     }
-    RTCScene scene = rs.tracer->handle();
-    uint64_t hits = 0;
-    for (auto _ : state) {
-        hits += intersect_bare(scene, rays);
-    }
-    benchmark::DoNotOptimize(hits);
-    state.counters["rays_per_s"] = benchmark::Counter(static_cast<double>(state.iterations() * rays.size()),
-                                                      benchmark::Counter::kIsRate);
+    cast_bare(state, rs, rays);
 }
 
 BENCHMARK(BM_PhotonTracing)->Arg(0)->Arg(1)->Arg(2)->UseManualTime()->Unit(benchmark::kMillisecond)
