@@ -7,6 +7,10 @@
 // Deterministic in parallel: photon i draws from the random stream (seed, i), photons are traced
 // in batches, and each batch's stored photons are appended in photon order, so the maps do not
 // depend on the thread count.
+//
+// Work skipped: batches are sized for the map that fills first, and once only the caustic map
+// is collecting, a photon first casts one ray against the scene's specular triangles
+// (RenderScene::caustic_casters) and ends if it misses them all: it could store nothing.
 #pragma once
 
 #include <atomic>
