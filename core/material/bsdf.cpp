@@ -299,7 +299,7 @@ BsdfMaterial::BsdfMaterial(const Material& material) {
     }
     if (reflects) other_lobes |= mask_of(specular_kind);
     if (glass_weight > 0.0f) other_lobes |= mask_of(glass_kind);
-    lambertian_only = other_lobes == 0 && metallic <= 0.0f && glass_weight <= 0.0f && specular_f90 <= 0.0f;
+    lambertian_only = metallic <= 0.0f && glass_weight <= 0.0f && specular_f90 <= 0.0f;
 }
 
 Bsdf::Bsdf(const BsdfMaterial& material, const Color& base_color, const Frame& shading,

@@ -153,13 +153,21 @@ Quad scaled(const Quad& quad) {
             quad[3] * kCornellScale};
 }
 
-MeshData cornell_block(const std::array<Vec2, 4>& xz, float height) {
+/// A box standing on the floor (y = 0) over the footprint xz (corners in the order
+/// (-u,-w), (+u,-w), (-u,+w), (+u,+w) of its two edge directions), `height` tall.
+MeshData box_on_floor(const std::array<Vec2, 4>& xz, float height) {
     std::array<Vec3, 8> corners;
     for (int i = 0; i < 8; ++i) {
         const Vec2& c = xz[(i & 1) | ((i & 4) >> 1)];
-        corners[i] = kCornellScale * Vec3(c.x, (i & 2) ? height : 0.0f, c.y);
+        corners[i] = Vec3(c.x, (i & 2) ? height : 0.0f, c.y);
     }
     return make_box(corners);
+}
+
+MeshData cornell_block(const std::array<Vec2, 4>& xz, float height) {
+    std::array<Vec2, 4> scaled;
+    for (int i = 0; i < 4; ++i) scaled[i] = kCornellScale * xz[i];
+    return box_on_floor(scaled, kCornellScale * height);
 }
 
 Expected<Scene> make_cornell_box_diffuse() {
@@ -297,13 +305,13 @@ MeshData placed_sphere(const MeshData& unit, float floor_y, float x, float z, fl
 /// (radians) about the vertical.
 MeshData standing_box(float x, float z, float side, float height, float angle) {
     const float c = std::cos(angle), s = std::sin(angle);
-    std::array<Vec3, 8> corners;
-    for (int i = 0; i < 8; ++i) {
+    std::array<Vec2, 4> xz;
+    for (int i = 0; i < 4; ++i) {
         const float u = (i & 1) ? 0.5f * side : -0.5f * side;
-        const float w = (i & 4) ? 0.5f * side : -0.5f * side;
-        corners[i] = Vec3(x + c * u - s * w, (i & 2) ? height : 0.0f, z + s * u + c * w);
+        const float w = (i & 2) ? 0.5f * side : -0.5f * side;
+        xz[i] = Vec2(x + c * u - s * w, z + s * u + c * w);
     }
-    return make_box(corners);
+    return box_on_floor(xz, height);
 }
 
 /// "spheres-room": the large scene of the benchmark; see the header for the layout.
