@@ -94,12 +94,12 @@ RayTracer::~RayTracer() {
     if (rtc_scene_) rtcReleaseScene(rtc_scene_);
 }
 
-std::optional<Hit> RayTracer::intersect(const Ray& ray) const {
+std::optional<Hit> RayTracer::intersect_from_viewpoint(const Ray& ray) const {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     RTCRayHit rayhit = to_rtc_rayhit(ray);
     rtcIntersect1(rtc_scene_, &context, &rayhit);
-    if (ray.from_viewpoint) {
+    {
         // Camera rays start exactly at the camera, with no offset, so that a camera a hair above a
         // floor sees the floor (an offset along the ray skipped every surface closer than it: a
         // camera 1e-6 above a floor saw through it). Within offset_distance of a surface the side

@@ -102,7 +102,15 @@ public:
     /// side its normal points to): the ray sees the surface at the viewpoint's foot when it heads
     /// into the surface, and passes it when it heads away (back-face hits that close to the
     /// viewpoint are skipped). Farther surfaces are hit as they are, whichever face.
-    std::optional<Hit> intersect(const Ray& ray) const;
+    std::optional<Hit> intersect(const Ray& ray) const {
+        if (ray.from_viewpoint) return intersect_from_viewpoint(ray);
+        RTCIntersectContext context;
+        rtcInitIntersectContext(&context);
+        RTCRayHit rayhit = to_rtc_rayhit(ray);
+        rtcIntersect1(rtc_scene_, &context, &rayhit);
+        if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
+        return Hit{rayhit.ray.tfar, rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v};
+    }
     /// Whether anything lies in [tmin, tmax] (from_viewpoint is not looked at).
     bool occluded(const Ray& ray) const;
 
@@ -140,6 +148,7 @@ public:
 
 private:
     RayTracer() = default;
+    std::optional<Hit> intersect_from_viewpoint(const Ray& ray) const;
 
     std::shared_ptr<EmbreeDevice> device_;
     const Scene* scene_ = nullptr;

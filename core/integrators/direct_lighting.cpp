@@ -2,16 +2,6 @@
 
 namespace photond {
 
-Bsdf make_bsdf(const RenderScene& rs, const SurfaceInteraction& si, const Vec3& wo) {
-    const Material& material = rs.scene->materials[si.material];
-    Vec3 ng = si.geometric_normal, ns = si.shading_normal;
-    if (material.transmission <= 0.0f && glm::dot(wo, ng) < 0.0f) {
-        ng = -ng;
-        ns = -ns;
-    }
-    return Bsdf(rs.bsdf_materials[si.material], rs.scene->base_color(si.material, si.uv), Frame(ns), ng);
-}
-
 Color sample_direct_light(const RenderScene& rs, const SurfaceInteraction& si, const Bsdf& bsdf,
                           const Vec3& wo, SampleContext& context, bool use_mis, LobeMask mask) {
     const float u_select = context.next_1d();

@@ -89,7 +89,15 @@ inline Ray spawn_ray(const RenderScene& rs, const SurfaceInteraction& si, const 
 
 /// The BSDF at a hit seen from direction wo. Opaque materials are shaded two-sided (normals turned
 /// towards wo); transmissive ones keep the mesh's orientation, so the outside is the front side.
-Bsdf make_bsdf(const RenderScene& rs, const SurfaceInteraction& si, const Vec3& wo);
+inline Bsdf make_bsdf(const RenderScene& rs, const SurfaceInteraction& si, const Vec3& wo) {
+    const Material& material = rs.scene->materials[si.material];
+    Vec3 ng = si.geometric_normal, ns = si.shading_normal;
+    if (material.transmission <= 0.0f && glm::dot(wo, ng) < 0.0f) {
+        ng = -ng;
+        ns = -ns;
+    }
+    return Bsdf(rs.bsdf_materials[si.material], rs.scene->base_color(si.material, si.uv), Frame(ns), ng);
+}
 
 /// Next-event estimation: one light sample with a shadow ray, lobes in `mask` only. With
 /// `use_mis`, area-light samples are weighted by the power heuristic against BSDF sampling.

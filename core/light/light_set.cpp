@@ -65,6 +65,30 @@ LightSet::LightSet(const Scene& scene) : scene_(&scene) {
         total_power_ += e.power;
     }
     selection_ = DiscreteDistribution(weights);
+    // The flux weights that do not depend on the sample, divided by the choice probability here
+    // once rather than at every photon (the same expressions, so the same floats).
+    for (uint32_t i = 0; i < lights_.size(); ++i) {
+        Entry& e = lights_[i];
+        const float choice_pdf = selection_.probability(i);
+        if (!(choice_pdf > 0.0f)) continue;
+        switch (e.kind) {
+            case LightKind::Point:
+                e.emission_weight = scene.lights[e.index].intensity * (4.0f * kPi) / choice_pdf;
+                break;
+            case LightKind::Spot:  // the falloff varies with the direction: see sample_emission
+                break;
+            case LightKind::Directional:
+                e.emission_weight = scene.lights[e.index].intensity * (kPi * scene_radius_ * scene_radius_) / choice_pdf;
+                break;
+            case LightKind::Triangle: {
+                // Le * cos / (pdf_area * pdf_dir) = Le * pi * A, times the number of faces.
+                const Material& m = scene.materials[scene.triangle_materials[e.index]];
+                const float sides = m.double_sided ? 2.0f : 1.0f;
+                e.emission_weight = m.emission * (sides * kPi * e.area) / choice_pdf;
+                break;
+            }
+        }
+    }
 }
 
 std::optional<LightSample> LightSet::sample_incident(const Vec3& p, float u_select,
@@ -160,7 +184,7 @@ std::optional<EmissionSample> LightSet::sample_emission(float u_select, const Ve
             const PunctualLight& l = scene_->lights[e.index];
             s.origin = l.position;
             s.direction = sample_uniform_sphere(u_direction);
-            s.flux_weight = l.intensity * (4.0f * kPi) / choice_pdf;
+            s.flux_weight = e.emission_weight;
             break;
         }
         case LightKind::Spot: {
@@ -183,7 +207,7 @@ std::optional<EmissionSample> LightSet::sample_emission(float u_select, const Ve
             s.origin = scene_center_ - l.direction * (2.0f * scene_radius_) + frame.s * d.x + frame.t * d.y;
             s.direction = l.direction;
             s.normal = l.direction;
-            s.flux_weight = l.intensity * (kPi * scene_radius_ * scene_radius_) / choice_pdf;
+            s.flux_weight = e.emission_weight;
             break;
         }
         case LightKind::Triangle: {
@@ -194,9 +218,7 @@ std::optional<EmissionSample> LightSet::sample_emission(float u_select, const Ve
             Vec3 n = scene_->triangle_normal(e.index);
             const Material& m = scene_->materials[scene_->triangle_materials[e.index]];
             Vec2 ud = u_direction;
-            float sides = 1.0f;
             if (m.double_sided) {  // pick a face, reusing the random number
-                sides = 2.0f;
                 if (ud.x < 0.5f) {
                     ud.x *= 2.0f;
                 } else {
@@ -206,8 +228,7 @@ std::optional<EmissionSample> LightSet::sample_emission(float u_select, const Ve
             }
             s.normal = n;
             s.direction = Frame(n).to_world(sample_cosine_hemisphere(ud));
-            // Le * cos / (pdf_area * pdf_dir) = Le * pi * A, times the number of faces.
-            s.flux_weight = m.emission * (sides * kPi * e.area) / choice_pdf;
+            s.flux_weight = e.emission_weight;
             break;
         }
     }

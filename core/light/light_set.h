@@ -74,6 +74,9 @@ private:
         uint32_t index;  // into Scene::lights or Scene::triangles
         Color power;
         float area;      // triangles
+        /// sample_emission's flux weight, which does not depend on the sample (it already
+        /// includes the choice probability); unused for spot lights, whose falloff varies.
+        Color emission_weight{0.0f};
     };
     const Scene* scene_;
     std::vector<Entry> lights_;

@@ -302,17 +302,6 @@ BsdfMaterial::BsdfMaterial(const Material& material) {
     lambertian_only = metallic <= 0.0f && glass_weight <= 0.0f && specular_f90 <= 0.0f;
 }
 
-Bsdf::Bsdf(const BsdfMaterial& material, const Color& base_color, const Frame& shading,
-           const Vec3& geometric_normal)
-    : m_(material), frame_(shading), geometric_normal_(geometric_normal) {
-    base_color_ = glm::clamp(base_color, Color(0.0f), Color(1.0f));
-    diffuse_weight_ = m_.layer_weight * base_color_;
-    diffuse_ = diffuse_weight_ * m_.diffuse_remaining;
-    lobes_ = m_.other_lobes;
-    if (max_component(diffuse_) > 0.0f) lobes_ |= mask_of(LobeKind::Diffuse);
-    pure_lambertian_ = lobes_ == mask_of(LobeKind::Diffuse) && m_.lambertian_only;
-}
-
 Color Bsdf::layer_albedo(float cos_theta) const {
     const SpecularAlbedo e = specular_albedo_terms(m_.albedo_cell, m_.albedo_cell_weight, cos_theta);
     return m_.specular_f0 * e.total + (Color(m_.specular_f90) - m_.specular_f0) * e.schlick;
@@ -337,13 +326,6 @@ Color Bsdf::lambert_albedo(float cos_theta) const {
 
 Color Bsdf::diffuse_reflectance(const Vec3& wo) const {
     return lambert_albedo(std::min(std::abs(glm::dot(wo, frame_.n)), 1.0f));
-}
-
-bool Bsdf::geometry_agrees(const Vec3& wo, const Vec3& wi, bool local_reflection) const {
-    // pbrt-v3 style: the geometric normal decides reflection vs transmission.
-    const bool geometric_reflection =
-        glm::dot(wo, geometric_normal_) * glm::dot(wi, geometric_normal_) > 0.0f;
-    return geometric_reflection == local_reflection;
 }
 
 bool Bsdf::has_non_lambertian_non_delta() const {
@@ -487,27 +469,12 @@ float Bsdf::pdf(const Vec3& wo, const Vec3& wi, LobeMask mask) const {
     return pdf_local(o, i, outside, slot_probabilities(o, outside, mask));
 }
 
-std::optional<BsdfSample> Bsdf::sample(const Vec3& wo, float u_lobe, const Vec2& u,
-                                       TransportMode mode, LobeMask mask) const {
+std::optional<BsdfSample> Bsdf::sample_lobes(const Vec3& wo, float u_lobe, const Vec2& u,
+                                             TransportMode mode, LobeMask mask) const {
     Vec3 o = frame_.to_local(wo);
     if (!(o.z != 0.0f) || !is_finite(o)) return std::nullopt;
     const bool outside = o.z > 0.0f;
     if (!outside) o.z = -o.z;
-    if (pure_lambertian_) {
-        // Cosine-weighted sampling of f = rho / pi: weight = rho, pdf = cos / pi.
-        if (!in_mask(mask, LobeKind::Diffuse) || (mask & kExcludeLambertian)) return std::nullopt;
-        Vec3 i = sample_cosine_hemisphere(u);
-        if (!(i.z > 0.0f)) return std::nullopt;
-        const float pdf = i.z * kInvPi;
-        if (!outside) i.z = -i.z;
-        BsdfSample s;
-        s.wi = frame_.to_world(i);
-        if (!geometry_agrees(wo, s.wi, true)) return std::nullopt;
-        s.weight = diffuse_;
-        s.pdf = pdf;
-        s.kind = LobeKind::Diffuse;
-        return s;
-    }
     const SlotProbabilities slots = slot_probabilities(o, outside, mask);
 
     // Choose a slot with u_lobe; reuse the remainder of u_lobe for the reflect/refract choice.

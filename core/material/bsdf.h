@@ -13,6 +13,7 @@
 #include <optional>
 
 #include "core/math/frame.h"
+#include "core/math/sampling.h"
 #include "core/math/vec.h"
 #include "core/scene/scene.h"
 
@@ -87,7 +88,15 @@ public:
     /// shading); for transmissive materials the caller keeps the mesh's front-face orientation, so
     /// that the outside (ior 1) is the side the normals point to.
     Bsdf(const BsdfMaterial& material, const Color& base_color, const Frame& shading,
-         const Vec3& geometric_normal);
+         const Vec3& geometric_normal)
+        : m_(material), frame_(shading), geometric_normal_(geometric_normal) {
+        base_color_ = glm::clamp(base_color, Color(0.0f), Color(1.0f));
+        diffuse_weight_ = m_.layer_weight * base_color_;
+        diffuse_ = diffuse_weight_ * m_.diffuse_remaining;
+        lobes_ = m_.other_lobes;
+        if (max_component(diffuse_) > 0.0f) lobes_ |= mask_of(LobeKind::Diffuse);
+        pure_lambertian_ = lobes_ == mask_of(LobeKind::Diffuse) && m_.lambertian_only;
+    }
     Bsdf(const Material& material, const Color& base_color, const Frame& shading,
          const Vec3& geometric_normal)
         : Bsdf(BsdfMaterial(material), base_color, shading, geometric_normal) {}
@@ -115,7 +124,11 @@ public:
     /// Importance mode omits the 1/eta^2 radiance factor at refraction (Veach 1997, Sec. 5.2).
     std::optional<BsdfSample> sample(const Vec3& wo, float u_lobe, const Vec2& u,
                                      TransportMode mode = TransportMode::Radiance,
-                                     LobeMask mask = kAllLobes) const;
+                                     LobeMask mask = kAllLobes) const {
+        // Inline for the commonest case, the pure Lambertian surface (most photon bounces).
+        if (pure_lambertian_) return sample_lambertian(wo, u, mask);
+        return sample_lobes(wo, u_lobe, u, mode, mask);
+    }
     /// Every delta lobe at once (ideal mirror and ideal refraction), for deterministic recursion:
     /// weight = reflectance or transmittance (pdf = 1). Returns how many were written.
     /// The mirror entry sums every smooth reflection (metal, layer, dielectric); the refraction
@@ -155,7 +168,33 @@ private:
     Color lambert_albedo(float cos_theta) const;
     Color specular_albedo(float cos_theta) const;
     float relative_ior(bool outside) const { return outside ? m_.ior : 1.0f / m_.ior; }
-    bool geometry_agrees(const Vec3& wo, const Vec3& wi, bool local_reflection) const;
+    bool geometry_agrees(const Vec3& wo, const Vec3& wi, bool local_reflection) const {
+        // pbrt-v3 style: the geometric normal decides reflection vs transmission.
+        const bool geometric_reflection =
+            glm::dot(wo, geometric_normal_) * glm::dot(wi, geometric_normal_) > 0.0f;
+        return geometric_reflection == local_reflection;
+    }
+    std::optional<BsdfSample> sample_lobes(const Vec3& wo, float u_lobe, const Vec2& u, TransportMode mode,
+                                           LobeMask mask) const;
+    /// sample() of a pure Lambertian BSDF: cosine-weighted sampling of f = rho / pi, so weight =
+    /// rho and pdf = cos / pi.
+    std::optional<BsdfSample> sample_lambertian(const Vec3& wo, const Vec2& u, LobeMask mask) const {
+        // wo's local z alone: it is finite exactly when wo is (the frame is finite and unit).
+        const float o_z = glm::dot(wo, frame_.n);
+        if (!(o_z != 0.0f) || !std::isfinite(o_z)) return std::nullopt;
+        if (!(mask & mask_of(LobeKind::Diffuse)) || (mask & kExcludeLambertian)) return std::nullopt;
+        Vec3 i = sample_cosine_hemisphere(u);
+        if (!(i.z > 0.0f)) return std::nullopt;
+        const float pdf = i.z * kInvPi;
+        if (o_z < 0.0f) i.z = -i.z;  // on wo's side
+        BsdfSample s;
+        s.wi = frame_.to_world(i);
+        if (!geometry_agrees(wo, s.wi, true)) return std::nullopt;
+        s.weight = diffuse_;
+        s.pdf = pdf;
+        s.kind = LobeKind::Diffuse;
+        return s;
+    }
 
     BsdfMaterial m_;
     Frame frame_;

@@ -5,6 +5,7 @@
 
 #include <limits>
 
+#include "core/math/trig.h"
 #include "core/math/vec.h"
 
 namespace photond {
@@ -52,9 +53,9 @@ public:
         const Vec3 t2 = glm::cross(vh, t1);
         // Uniform point on the disc, warped to the projected visible hemisphere.
         const float r = std::sqrt(u.x);
-        const float phi = 2.0f * kPi * u.y;
-        const float p1 = r * std::cos(phi);
-        float p2 = r * std::sin(phi);
+        const Vec2 cs = cos_sin_turn(u.y);  // phi = 2 pi u.y
+        const float p1 = r * cs.x;
+        float p2 = r * cs.y;
         const float s = 0.5f * (1.0f + vh.z);
         p2 = (1.0f - s) * safe_sqrt(1.0f - p1 * p1) + s * p2;
         const Vec3 nh = p1 * t1 + p2 * t2 + safe_sqrt(1.0f - p1 * p1 - p2 * p2) * vh;

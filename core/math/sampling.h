@@ -4,6 +4,7 @@
 #include <span>
 #include <vector>
 
+#include "core/math/trig.h"
 #include "core/math/vec.h"
 
 namespace photond {
@@ -12,15 +13,11 @@ namespace photond {
 inline Vec2 sample_concentric_disk(const Vec2& u) {
     const Vec2 o = 2.0f * u - Vec2(1.0f);
     if (o.x == 0.0f && o.y == 0.0f) return {0.0f, 0.0f};
-    float r, theta;
-    if (std::abs(o.x) > std::abs(o.y)) {
-        r = o.x;
-        theta = (kPi / 4.0f) * (o.y / o.x);
-    } else {
-        r = o.y;
-        theta = (kPi / 2.0f) - (kPi / 4.0f) * (o.x / o.y);
-    }
-    return r * Vec2(std::cos(theta), std::sin(theta));
+    // theta = pi/4 (y/x) or pi/2 - pi/4 (x/y): within a quarter turn of 0 or of pi/2, whose
+    // cosine and sine are those of the small angle, swapped.
+    if (std::abs(o.x) > std::abs(o.y)) return o.x * cos_sin_quarter((kPi / 4.0f) * (o.y / o.x));
+    const Vec2 cs = cos_sin_quarter((kPi / 4.0f) * (o.x / o.y));
+    return o.y * Vec2(cs.y, cs.x);
 }
 
 /// Cosine-weighted direction on the +z hemisphere; pdf = cos(theta) / pi.
@@ -35,8 +32,8 @@ inline float cosine_hemisphere_pdf(float cos_theta) { return std::max(cos_theta,
 inline Vec3 sample_uniform_sphere(const Vec2& u) {
     const float z = 1.0f - 2.0f * u.x;
     const float r = safe_sqrt(1.0f - z * z);
-    const float phi = 2.0f * kPi * u.y;
-    return {r * std::cos(phi), r * std::sin(phi), z};
+    const Vec2 cs = cos_sin_turn(u.y);  // phi = 2 pi u.y
+    return {r * cs.x, r * cs.y, z};
 }
 
 /// Uniform direction in the cone around +z with cos(half angle) = cos_max;
@@ -46,8 +43,8 @@ inline Vec3 sample_uniform_cone(const Vec2& u, float cos_max) {
     const float one_minus_cos = u.x * (1.0f - cos_max);
     const float cos_theta = 1.0f - one_minus_cos;
     const float sin_theta = safe_sqrt(one_minus_cos * (2.0f - one_minus_cos));
-    const float phi = 2.0f * kPi * u.y;
-    return {sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta};
+    const Vec2 cs = cos_sin_turn(u.y);  // phi = 2 pi u.y
+    return {sin_theta * cs.x, sin_theta * cs.y, cos_theta};
 }
 inline float uniform_cone_pdf(float cos_max) { return 1.0f / (2.0f * kPi * (1.0f - cos_max)); }
 

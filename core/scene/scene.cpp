@@ -21,9 +21,7 @@ Color Texture::sample(const Vec2& uv) const {
            ty * ((1.0f - tx) * at(x0, y1) + tx * at(x1, y1));
 }
 
-Color Scene::base_color(uint32_t material, const Vec2& uv) const {
-    const Material& m = materials[material];
-    if (m.base_color_texture < 0) return m.base_color;
+Color Scene::textured_base_color(const Material& m, const Vec2& uv) const {
     return m.base_color * textures[static_cast<size_t>(m.base_color_texture)].sample(uv);
 }
 

@@ -100,13 +100,19 @@ struct Scene {
     /// Checks the invariants every consumer relies on (sizes, index ranges, finite data).
     Status validate() const;
     /// Base colour of a material at a texture coordinate (texture times factor).
-    Color base_color(uint32_t material, const Vec2& uv) const;
+    Color base_color(uint32_t material, const Vec2& uv) const {
+        const Material& m = materials[material];
+        return m.base_color_texture < 0 ? m.base_color : textured_base_color(m, uv);
+    }
     float triangle_area(uint32_t triangle) const;
     Vec3 triangle_normal(uint32_t triangle) const {  // geometric, unit (zero for degenerate)
         return triangle_normals[triangle];
     }
     /// Recomputes triangle_normals from the positions (after editing them).
     void compute_triangle_normals();
+
+private:
+    Color textured_base_color(const Material& m, const Vec2& uv) const;
 };
 
 /// Assembles a Scene: transforms meshes into world space, generates flat normals where a mesh
