@@ -6,6 +6,8 @@
 
 #include <cstdio>
 #include <map>
+#include <string>
+#include <vector>
 
 #include "bench/bare_embree.h"
 #include "core/math/rng.h"
@@ -104,12 +106,15 @@ void BM_BareEmbreeIncoherent(benchmark::State& state) {
     cast_bare(state, rs, rays);
 }
 
+// Nine repetitions each, run in random interleaved order (main() turns it on): on a shared
+// machine the load drifts, and the ratios compare tracing with bare Embree over the same minutes.
+constexpr int kRepetitions = 9;
 BENCHMARK(BM_PhotonTracing)->Arg(0)->Arg(1)->Arg(2)->UseManualTime()->Unit(benchmark::kMillisecond)
-    ->Repetitions(5)->ReportAggregatesOnly(true);
-BENCHMARK(BM_BarePhotonRays)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->Repetitions(5)
+    ->Repetitions(kRepetitions)->ReportAggregatesOnly(true);
+BENCHMARK(BM_BarePhotonRays)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->Repetitions(kRepetitions)
     ->ReportAggregatesOnly(true);
-BENCHMARK(BM_BareEmbreeIncoherent)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->Repetitions(5)
-    ->ReportAggregatesOnly(true);
+BENCHMARK(BM_BareEmbreeIncoherent)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)
+    ->Repetitions(kRepetitions)->ReportAggregatesOnly(true);
 
 class MedianReporter : public benchmark::ConsoleReporter {
 public:
@@ -128,7 +133,14 @@ public:
 }  // namespace photond
 
 int main(int argc, char** argv) {
-    benchmark::Initialize(&argc, argv);
+    // Random interleaving of the repetitions unless the command line says otherwise.
+    std::vector<char*> args(argv, argv + argc);
+    std::string interleave = "--benchmark_enable_random_interleaving=true";
+    bool given = false;
+    for (int i = 1; i < argc; ++i) given |= std::string(argv[i]).starts_with("--benchmark_enable_random_interleaving");
+    if (!given) args.insert(args.begin() + 1, interleave.data());
+    int count = static_cast<int>(args.size());
+    benchmark::Initialize(&count, args.data());
     photond::MedianReporter reporter;
     benchmark::RunSpecifiedBenchmarks(&reporter);
     for (int s = 0; s < 3; ++s) {

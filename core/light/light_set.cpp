@@ -85,6 +85,9 @@ LightSet::LightSet(const Scene& scene) : scene_(&scene) {
                 const Material& m = scene.materials[scene.triangle_materials[e.index]];
                 const float sides = m.double_sided ? 2.0f : 1.0f;
                 e.emission_weight = m.emission * (sides * kPi * e.area) / choice_pdf;
+                e.double_sided = m.double_sided;
+                e.front_frame = Frame(scene.triangle_normal(e.index));
+                e.back_frame = Frame(-scene.triangle_normal(e.index));
                 break;
             }
         }
@@ -215,19 +218,18 @@ std::optional<EmissionSample> LightSet::sample_emission(float u_select, const Ve
             const Vec2 b = sample_uniform_triangle(u_position);
             const Vec3& a0 = scene_->positions[t.x];
             s.origin = a0 + b.x * (scene_->positions[t.y] - a0) + b.y * (scene_->positions[t.z] - a0);
-            Vec3 n = scene_->triangle_normal(e.index);
-            const Material& m = scene_->materials[scene_->triangle_materials[e.index]];
+            const Frame* face = &e.front_frame;
             Vec2 ud = u_direction;
-            if (m.double_sided) {  // pick a face, reusing the random number
+            if (e.double_sided) {  // pick a face, reusing the random number
                 if (ud.x < 0.5f) {
                     ud.x *= 2.0f;
                 } else {
                     ud.x = std::min((ud.x - 0.5f) * 2.0f, 0x1.fffffep-1f);
-                    n = -n;
+                    face = &e.back_frame;
                 }
             }
-            s.normal = n;
-            s.direction = Frame(n).to_world(sample_cosine_hemisphere(ud));
+            s.normal = face->n;
+            s.direction = face->to_world(sample_cosine_hemisphere(ud));
             s.flux_weight = e.emission_weight;
             break;
         }

@@ -5,6 +5,7 @@
 #include <optional>
 #include <vector>
 
+#include "core/math/frame.h"
 #include "core/math/sampling.h"
 #include "core/scene/interaction.h"
 #include "core/scene/scene.h"
@@ -77,6 +78,10 @@ private:
         /// sample_emission's flux weight, which does not depend on the sample (it already
         /// includes the choice probability); unused for spot lights, whose falloff varies.
         Color emission_weight{0.0f};
+        /// Triangles: the shading frames of the emitting faces (the back one is used only when
+        /// double-sided), built once rather than at every photon.
+        Frame front_frame, back_frame;
+        bool double_sided = false;
     };
     const Scene* scene_;
     std::vector<Entry> lights_;

@@ -303,15 +303,15 @@ BsdfMaterial::BsdfMaterial(const Material& material) {
 }
 
 Color Bsdf::layer_albedo(float cos_theta) const {
-    const SpecularAlbedo e = specular_albedo_terms(m_.albedo_cell, m_.albedo_cell_weight, cos_theta);
-    return m_.specular_f0 * e.total + (Color(m_.specular_f90) - m_.specular_f0) * e.schlick;
+    const SpecularAlbedo e = specular_albedo_terms(m_->albedo_cell, m_->albedo_cell_weight, cos_theta);
+    return m_->specular_f0 * e.total + (Color(m_->specular_f90) - m_->specular_f0) * e.schlick;
 }
 
 Color Bsdf::specular_albedo(float cos_theta) const {
     // Metal (F0 = c, F90 = 1) plus the dielectric layer; exact when smooth.
-    const SpecularAlbedo e = specular_albedo_terms(m_.albedo_cell, m_.albedo_cell_weight, cos_theta);
+    const SpecularAlbedo e = specular_albedo_terms(m_->albedo_cell, m_->albedo_cell_weight, cos_theta);
     const Color metal = base_color_ * e.total + (Color(1.0f) - base_color_) * e.schlick;
-    return m_.metallic * metal + m_.layer_weight * layer_albedo(cos_theta);
+    return m_->metallic * metal + m_->layer_weight * layer_albedo(cos_theta);
 }
 
 Color Bsdf::lambert_albedo(float cos_theta) const {
@@ -319,7 +319,7 @@ Color Bsdf::lambert_albedo(float cos_theta) const {
     const Color remaining = Color(1.0f) - layer_albedo(cos_theta);
     Color rho(0.0f);
     for (int ch = 0; ch < 3; ++ch) {
-        if (m_.diffuse_norm[ch] > 0.0f) rho[ch] = diffuse_weight_[ch] * remaining[ch];
+        if (m_->diffuse_norm[ch] > 0.0f) rho[ch] = diffuse_weight_[ch] * remaining[ch];
     }
     return rho;
 }
@@ -329,8 +329,8 @@ Color Bsdf::diffuse_reflectance(const Vec3& wo) const {
 }
 
 bool Bsdf::has_non_lambertian_non_delta() const {
-    const bool rough_reflection = !m_.smooth && (m_.metallic > 0.0f || (m_.layer_weight > 0.0f && m_.specular_f90 > 0.0f));
-    const bool rough_glass = m_.glass_weight > 0.0f && !m_.glass_delta;
+    const bool rough_reflection = !m_->smooth && (m_->metallic > 0.0f || (m_->layer_weight > 0.0f && m_->specular_f90 > 0.0f));
+    const bool rough_glass = m_->glass_weight > 0.0f && !m_->glass_delta;
     return rough_reflection || rough_glass;
 }
 
@@ -344,12 +344,12 @@ Bsdf::SlotProbabilities Bsdf::slot_probabilities(const Vec3& wo, bool outside,
         max_component(diffuse_) > 0.0f) {
         p[kSlotDiffuse] = average(lambert_albedo(mu));
     }
-    if (in_mask(mask, m_.specular_kind) && (m_.metallic > 0.0f || m_.layer_weight > 0.0f)) {
+    if (in_mask(mask, m_->specular_kind) && (m_->metallic > 0.0f || m_->layer_weight > 0.0f)) {
         p[kSlotSpecular] = average(specular_albedo(mu));
     }
-    if (in_mask(mask, m_.glass_kind) && m_.glass_weight > 0.0f) {
+    if (in_mask(mask, m_->glass_kind) && m_->glass_weight > 0.0f) {
         const float f = fresnel_dielectric(mu, relative_ior(outside));
-        p[kSlotGlass] = m_.glass_weight * (f + (1.0f - f) * average(base_color_));
+        p[kSlotGlass] = m_->glass_weight * (f + (1.0f - f) * average(base_color_));
     }
     const float sum = p[0] + p[1] + p[2];
     if (!(sum > 0.0f)) return {0.0f, 0.0f, 0.0f};
@@ -360,14 +360,14 @@ Bsdf::SlotProbabilities Bsdf::slot_probabilities(const Vec3& wo, bool outside,
 Color Bsdf::eval_local(const Vec3& wo, const Vec3& wi, bool outside, TransportMode mode,
                        LobeMask mask) const {
     Color f(0.0f);
-    const GgxDistribution ggx(m_.alpha);
+    const GgxDistribution ggx(m_->alpha);
     if (wi.z > 0.0f) {
         if (in_mask(mask, LobeKind::Diffuse) && !(mask & kExcludeLambertian)) {
             f += diffuse_weight_ * kInvPi * (Color(1.0f) - layer_albedo(wo.z)) *
-                 (Color(1.0f) - layer_albedo(wi.z)) * m_.diffuse_norm;
+                 (Color(1.0f) - layer_albedo(wi.z)) * m_->diffuse_norm;
         }
-        const bool specular = !m_.smooth && in_mask(mask, m_.specular_kind);
-        const bool glass = !m_.glass_delta && m_.glass_weight > 0.0f && in_mask(mask, m_.glass_kind);
+        const bool specular = !m_->smooth && in_mask(mask, m_->specular_kind);
+        const bool glass = !m_->glass_delta && m_->glass_weight > 0.0f && in_mask(mask, m_->glass_kind);
         if (specular || glass) {
             // Torrance-Sparrow: F D G2 / (4 mu_o mu_i) (Walter et al. 2007, eq. 20).
             const Vec3 h = glm::normalize(wo + wi);
@@ -375,15 +375,15 @@ Color Bsdf::eval_local(const Vec3& wo, const Vec3& wi, bool outside, TransportMo
             const float common = ggx.d(h) * ggx.g2(wo, wi) / (4.0f * wo.z * wi.z);
             if (specular) {
                 const Color metal = fresnel_schlick(base_color_, Color(1.0f), cos_oh);
-                const Color layer = fresnel_schlick(m_.specular_f0, Color(m_.specular_f90), cos_oh);
-                f += (m_.metallic * metal + m_.layer_weight * layer) * common;
+                const Color layer = fresnel_schlick(m_->specular_f0, Color(m_->specular_f90), cos_oh);
+                f += (m_->metallic * metal + m_->layer_weight * layer) * common;
             }
             if (glass) {
-                f += Color(m_.glass_weight * fresnel_dielectric(cos_oh, relative_ior(outside)) *
+                f += Color(m_->glass_weight * fresnel_dielectric(cos_oh, relative_ior(outside)) *
                            common);
             }
         }
-    } else if (wi.z < 0.0f && !m_.glass_delta && m_.glass_weight > 0.0f && in_mask(mask, m_.glass_kind)) {
+    } else if (wi.z < 0.0f && !m_->glass_delta && m_->glass_weight > 0.0f && in_mask(mask, m_->glass_kind)) {
         // Rough dielectric transmission (Walter et al. 2007, eq. 21) with the generalized half
         // vector h ~ wo + eta wi, eta = n_i / n_o (wi's side over wo's side).
         const float eta = relative_ior(outside);
@@ -398,16 +398,16 @@ Color Bsdf::eval_local(const Vec3& wo, const Vec3& wi, bool outside, TransportMo
                       eta * -cos_ih * cos_oh / (wo.z * -wi.z * denom * denom);
         // Radiance is scaled by (n_o / n_i)^2 crossing the interface (Veach 1997, eq. 5.13).
         if (mode == TransportMode::Radiance) value /= eta * eta;
-        f += m_.glass_weight * value * base_color_;
+        f += m_->glass_weight * value * base_color_;
     }
     return f;
 }
 
 float Bsdf::pdf_local(const Vec3& wo, const Vec3& wi, bool outside,
                       const SlotProbabilities& slots) const {
-    const GgxDistribution ggx(m_.alpha);
-    const float p_specular = m_.smooth ? 0.0f : slots[kSlotSpecular];
-    const float p_glass = m_.glass_delta ? 0.0f : slots[kSlotGlass];
+    const GgxDistribution ggx(m_->alpha);
+    const float p_specular = m_->smooth ? 0.0f : slots[kSlotSpecular];
+    const float p_glass = m_->glass_delta ? 0.0f : slots[kSlotGlass];
     float pdf = 0.0f;
     if (wi.z > 0.0f) {
         pdf += slots[kSlotDiffuse] * cosine_hemisphere_pdf(wi.z);
@@ -493,7 +493,7 @@ std::optional<BsdfSample> Bsdf::sample_lobes(const Vec3& wo, float u_lobe, const
 
     BsdfSample s;
     Vec3 i;
-    const bool delta = (slot == kSlotSpecular && m_.smooth) || (slot == kSlotGlass && m_.glass_delta);
+    const bool delta = (slot == kSlotSpecular && m_->smooth) || (slot == kSlotGlass && m_->glass_delta);
     if (delta) {
         // All delta lobes share the mirror direction: its weight is their total reflectance over
         // the total probability of choosing it.
@@ -503,17 +503,17 @@ std::optional<BsdfSample> Bsdf::sample_lobes(const Vec3& wo, float u_lobe, const
         float probability = 0.0f;
         if (mirror) {
             i = Vec3(-o.x, -o.y, o.z);
-            if (m_.smooth && slots[kSlotSpecular] > 0.0f) {
+            if (m_->smooth && slots[kSlotSpecular] > 0.0f) {
                 reflectance += specular_albedo(o.z);
                 probability += slots[kSlotSpecular];
             }
-            if (m_.glass_delta && slots[kSlotGlass] > 0.0f) {
-                reflectance += Color(m_.glass_weight * f_glass);
+            if (m_->glass_delta && slots[kSlotGlass] > 0.0f) {
+                reflectance += Color(m_->glass_weight * f_glass);
                 probability += slots[kSlotGlass] * f_glass;
             }
         } else {
             if (!refract(o, Vec3(0, 0, 1), eta, &i)) return std::nullopt;
-            reflectance = m_.glass_weight * (1.0f - f_glass) * base_color_;
+            reflectance = m_->glass_weight * (1.0f - f_glass) * base_color_;
             if (mode == TransportMode::Radiance) reflectance /= eta * eta;
             probability = slots[kSlotGlass] * (1.0f - f_glass);
             s.is_transmission = true;
@@ -524,7 +524,7 @@ std::optional<BsdfSample> Bsdf::sample_lobes(const Vec3& wo, float u_lobe, const
         s.pdf = probability;
         s.kind = LobeKind::Delta;
     } else {
-        const GgxDistribution ggx(m_.alpha);
+        const GgxDistribution ggx(m_->alpha);
         bool reflection = true;
         if (slot == kSlotDiffuse) {
             i = sample_cosine_hemisphere(u);
@@ -546,7 +546,7 @@ std::optional<BsdfSample> Bsdf::sample_lobes(const Vec3& wo, float u_lobe, const
         s.weight = f * std::abs(i.z) / pdf;
         s.pdf = pdf;
         s.kind = slot == kSlotDiffuse ? LobeKind::Diffuse
-                                      : (slot == kSlotSpecular ? m_.specular_kind : m_.glass_kind);
+                                      : (slot == kSlotSpecular ? m_->specular_kind : m_->glass_kind);
         s.is_transmission = i.z < 0.0f;
         s.eta = s.is_transmission ? eta : 1.0f;
     }
@@ -564,15 +564,15 @@ int Bsdf::delta_lobes(const Vec3& wo, std::array<BsdfSample, 2>& out, TransportM
     if (!outside) o.z = -o.z;
     const float eta = relative_ior(outside);
     const float f_glass =
-        m_.glass_delta && m_.glass_weight > 0.0f ? fresnel_dielectric(o.z, eta) : 0.0f;
+        m_->glass_delta && m_->glass_weight > 0.0f ? fresnel_dielectric(o.z, eta) : 0.0f;
     auto to_world = [&](Vec3 i) {
         if (!outside) i.z = -i.z;
         return frame_.to_world(i);
     };
     int count = 0;
     Color mirror(0.0f);
-    if (m_.smooth) mirror += specular_albedo(o.z);
-    mirror += Color(m_.glass_weight * f_glass);
+    if (m_->smooth) mirror += specular_albedo(o.z);
+    mirror += Color(m_->glass_weight * f_glass);
     if (!is_black(mirror)) {
         BsdfSample s;
         s.wi = to_world(Vec3(-o.x, -o.y, o.z));
@@ -582,11 +582,11 @@ int Bsdf::delta_lobes(const Vec3& wo, std::array<BsdfSample, 2>& out, TransportM
         if (geometry_agrees(wo, s.wi, true)) out[count++] = s;
     }
     Vec3 i;
-    if (m_.glass_delta && m_.glass_weight > 0.0f && f_glass < 1.0f &&
+    if (m_->glass_delta && m_->glass_weight > 0.0f && f_glass < 1.0f &&
         refract(o, Vec3(0, 0, 1), eta, &i)) {
         BsdfSample s;
         s.wi = to_world(i);
-        s.weight = m_.glass_weight * (1.0f - f_glass) * base_color_;
+        s.weight = m_->glass_weight * (1.0f - f_glass) * base_color_;
         if (mode == TransportMode::Radiance) s.weight /= eta * eta;
         s.pdf = 1.0f;
         s.kind = LobeKind::Delta;

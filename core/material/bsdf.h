@@ -87,19 +87,18 @@ public:
     /// on the same side. For opaque materials the caller orients both towards wo (two-sided
     /// shading); for transmissive materials the caller keeps the mesh's front-face orientation, so
     /// that the outside (ior 1) is the side the normals point to.
+    /// `material` is referred to, not copied (copying it was a quarter of constructing a Bsdf at
+    /// a photon's hit): it must outlive the Bsdf, as RenderScene::bsdf_materials does.
     Bsdf(const BsdfMaterial& material, const Color& base_color, const Frame& shading,
          const Vec3& geometric_normal)
-        : m_(material), frame_(shading), geometric_normal_(geometric_normal) {
+        : m_(&material), frame_(shading), geometric_normal_(geometric_normal) {
         base_color_ = glm::clamp(base_color, Color(0.0f), Color(1.0f));
-        diffuse_weight_ = m_.layer_weight * base_color_;
-        diffuse_ = diffuse_weight_ * m_.diffuse_remaining;
-        lobes_ = m_.other_lobes;
+        diffuse_weight_ = m_->layer_weight * base_color_;
+        diffuse_ = diffuse_weight_ * m_->diffuse_remaining;
+        lobes_ = m_->other_lobes;
         if (max_component(diffuse_) > 0.0f) lobes_ |= mask_of(LobeKind::Diffuse);
-        pure_lambertian_ = lobes_ == mask_of(LobeKind::Diffuse) && m_.lambertian_only;
+        pure_lambertian_ = lobes_ == mask_of(LobeKind::Diffuse) && m_->lambertian_only;
     }
-    Bsdf(const Material& material, const Color& base_color, const Frame& shading,
-         const Vec3& geometric_normal)
-        : Bsdf(BsdfMaterial(material), base_color, shading, geometric_normal) {}
 
     /// Sum of the non-delta lobes in `mask` (no cosine). Zero for delta-only materials.
     /// Reflection vs transmission is decided by the geometric normal (reflection iff wo and wi
@@ -137,6 +136,9 @@ public:
                     TransportMode mode = TransportMode::Radiance) const;
 
     bool has_delta() const { return (lobes_ & mask_of(LobeKind::Delta)) != 0; }
+    /// Whether sample() reads u_lobe: not for a BSDF of a single Lambertian lobe, where a caller
+    /// drawing random numbers may skip it.
+    bool samples_lobe_choice() const { return !pure_lambertian_; }
     bool has_non_delta() const { return (lobes_ & kNonDeltaLobes) != 0; }
     /// Whether a non-delta lobe other than the Lambertian one exists (rough metal, rough
     /// dielectric layer, rough transmission): then L_o is not rho / pi * E.
@@ -167,7 +169,7 @@ private:
     Color layer_albedo(float cos_theta) const;
     Color lambert_albedo(float cos_theta) const;
     Color specular_albedo(float cos_theta) const;
-    float relative_ior(bool outside) const { return outside ? m_.ior : 1.0f / m_.ior; }
+    float relative_ior(bool outside) const { return outside ? m_->ior : 1.0f / m_->ior; }
     bool geometry_agrees(const Vec3& wo, const Vec3& wi, bool local_reflection) const {
         // pbrt-v3 style: the geometric normal decides reflection vs transmission.
         const bool geometric_reflection =
@@ -196,7 +198,7 @@ private:
         return s;
     }
 
-    BsdfMaterial m_;
+    const BsdfMaterial* m_;
     Frame frame_;
     Vec3 geometric_normal_;
     Color base_color_;

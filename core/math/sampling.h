@@ -1,6 +1,7 @@
 // Warping of uniform random numbers to the distributions the renderer samples, with their pdfs.
 #pragma once
 
+#include <algorithm>
 #include <span>
 #include <vector>
 
@@ -87,5 +88,21 @@ private:
     std::vector<double> cdf_;  // size n + 1, cdf_[0] = 0, cdf_[n] = 1
     double total_ = 0.0;
 };
+
+// Inline: every photon and every light sample picks a light with it.
+inline uint32_t DiscreteDistribution::sample(float u, float* probability, float* u_remapped) const {
+    // First bin whose upper cdf bound exceeds u; empty bins (zero width) are never chosen.
+    const auto it = std::upper_bound(cdf_.begin() + 1, cdf_.end(), static_cast<double>(u));
+    uint32_t index = static_cast<uint32_t>(std::min<ptrdiff_t>(it - cdf_.begin() - 1,
+                                                               static_cast<ptrdiff_t>(size()) - 1));
+    while (index > 0 && cdf_[index + 1] - cdf_[index] <= 0.0) --index;
+    const double width = cdf_[index + 1] - cdf_[index];
+    if (probability) *probability = static_cast<float>(width);
+    if (u_remapped) {
+        const double r = width > 0.0 ? (u - cdf_[index]) / width : 0.0;
+        *u_remapped = static_cast<float>(std::clamp(r, 0.0, 0x1.fffffep-1));
+    }
+    return index;
+}
 
 }  // namespace photond

@@ -119,7 +119,7 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
         }
         // Only caustic paths wanted, and every way on from here is diffuse: no need to sample it.
         if (!want_global && bsdf.lobes() == mask_of(LobeKind::Diffuse)) return;
-        const float u_lobe = rng.next_float();
+        const float u_lobe = bsdf.samples_lobe_choice() ? rng.next_float() : 0.0f;
         const Vec2 u = rng.next_vec2();
         const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Importance);
         if (!s || !(s->pdf > 0.0f)) return;
@@ -134,7 +134,7 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
         const Color next_flux = flux * s->weight;
         const float survive = std::min(1.0f, max_component(next_flux) / max_component(flux));
         if (!(survive > 0.0f) || rng.next_float() >= survive) return;
-        flux = next_flux / survive;
+        flux = next_flux * (1.0f / survive);
         if (!is_finite(flux)) return;
         ray = spawn_ray(rs, si, s->wi);
     }

@@ -23,7 +23,8 @@ SceneLightPaths analyse_light_paths(const Scene& scene, const LightSet& lights) 
         const Material& m = scene.materials[i];
         // Lobes from a representative BSDF of the material (its texture can only scale colours).
         const Color colour = m.base_color_texture >= 0 ? Color(1.0f) : m.base_color;
-        const Bsdf bsdf(m, colour, Frame(Vec3(0, 0, 1)), Vec3(0, 0, 1));
+        const BsdfMaterial constants(m);
+        const Bsdf bsdf(constants, colour, Frame(Vec3(0, 0, 1)), Vec3(0, 0, 1));
         const LobeMask lobes = bsdf.lobes();
         if (lobes & (mask_of(LobeKind::Delta) | mask_of(LobeKind::Glossy))) paths.has_specular = true;
         if (lobes & kNonDeltaLobes) paths.has_receiver = true;

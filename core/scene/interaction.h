@@ -41,7 +41,7 @@ inline SurfaceInteraction make_interaction(const Scene& scene, const Hit& hit, c
     }
     const Vec3 n = w * scene.normals[tri.x] + hit.u * scene.normals[tri.y] + hit.v * scene.normals[tri.z];
     const float len = glm::length(n);
-    si.shading_normal = oriented_shading_normal(len > 1e-12f && std::isfinite(len) ? n / len : Vec3(0.0f),
+    si.shading_normal = oriented_shading_normal(len > 1e-12f && std::isfinite(len) ? n * (1.0f / len) : Vec3(0.0f),
                                                 si.geometric_normal);
     si.triangle = hit.triangle;
     si.material = scene.triangle_materials[hit.triangle];

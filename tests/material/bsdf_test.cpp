@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <deque>
 #include <numeric>
 #include <ostream>
 #include <string>
@@ -34,8 +35,10 @@ Material make_material(float metallic, float roughness, float transmission = 0.0
     return m;
 }
 
+/// A Bsdf of m; its BsdfMaterial is kept for the rest of the test program (a Bsdf refers to it).
 Bsdf make_bsdf(const Material& m, const Color& c, const Vec3& n = Vec3(0, 0, 1)) {
-    return Bsdf(m, c, Frame(n), n);
+    static std::deque<BsdfMaterial> kept;
+    return Bsdf(kept.emplace_back(m), c, Frame(n), n);
 }
 
 /// Unit vector at polar angle theta from +z (degrees for readability) and azimuth phi.
@@ -411,7 +414,8 @@ TEST(BsdfReciprocity, ReflectionIsSymmetricAndTransmissionAdjoint) {
         const Vec3 ng(0, 0, 1);
         const Vec3 ns = glm::normalize(
             ng + 0.3f * Vec3(rng.next_float() - 0.5f, rng.next_float() - 0.5f, 0.0f));
-        const Bsdf bsdf(m, c, Frame(ns), ng);
+        const BsdfMaterial constants(m);
+        const Bsdf bsdf(constants, c, Frame(ns), ng);
         auto random_direction = [&] {
             const float z = 1.0f - 2.0f * rng.next_float();
             const float r = safe_sqrt(1.0f - z * z), phi = 2.0f * kPi * rng.next_float();
@@ -575,7 +579,8 @@ TEST(BsdfGeometry, ShadingNormalsDoNotLeakLight) {
     Rng rng = Rng::for_stream(11, 0);
     // Opaque: never anything below the geometric surface, even where the shading frame says
     // wi is above.
-    const Bsdf opaque(make_material(0.0f, 0.5f), Color(0.8f), Frame(ns), ng);
+    const BsdfMaterial plastic(make_material(0.0f, 0.5f));
+    const Bsdf opaque(plastic, Color(0.8f), Frame(ns), ng);
     const Vec3 below = glm::normalize(Vec3(0.9f, 0.0f, -0.1f));
     ASSERT_GT(glm::dot(below, ns), 0.0f);
     EXPECT_TRUE(is_black(opaque.eval(wo, below)));
@@ -588,7 +593,8 @@ TEST(BsdfGeometry, ShadingNormalsDoNotLeakLight) {
         }
     }
     // Transmissive: transmission only to the other side of the geometric surface.
-    const Bsdf glass(make_material(0.0f, 0.3f, 1.0f), Color(1.0f), Frame(ns), ng);
+    const BsdfMaterial rough_glass(make_material(0.0f, 0.3f, 1.0f));
+    const Bsdf glass(rough_glass, Color(1.0f), Frame(ns), ng);
     int transmitted = 0;
     for (int n = 0; n < 20000; ++n) {
         const float u_lobe = rng.next_float();

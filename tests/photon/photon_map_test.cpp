@@ -24,7 +24,8 @@ Material white_material() {
 
 Color radiance_at(const PhotonMap& map, const Vec3& p, const Vec3& n, float max_radius) {
     const Material white = white_material();
-    const Bsdf bsdf(white, white.base_color, Frame(n), n);
+    const BsdfMaterial constants(white);
+    const Bsdf bsdf(constants, white.base_color, Frame(n), n);
     RadianceEstimateOptions options;
     options.k = 50;
     options.max_radius = max_radius;

@@ -103,7 +103,8 @@ TEST(CoincidentPhotons, EstimatesStayFiniteAtZeroRadius) {
     const Vec3 p(0.5f, 0.0f, 0.5f), up(0.0f, 1.0f, 0.0f);
     const PhotonMap map = coincident_photons(p, 1000);
     const Material white = stress::lambertian_material("white", Color(0.8f));
-    const Bsdf bsdf(white, white.base_color, Frame(up), up);
+    const BsdfMaterial constants(white);
+    const Bsdf bsdf(constants, white.base_color, Frame(up), up);
     const auto finite_non_negative = [](const Color& c) {
         return is_finite(c) && min_component(c) >= 0.0f;
     };
