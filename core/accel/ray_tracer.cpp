@@ -99,26 +99,24 @@ std::optional<Hit> RayTracer::intersect_from_viewpoint(const Ray& ray) const {
     rtcInitIntersectContext(&context);
     RTCRayHit rayhit = to_rtc_rayhit(ray);
     rtcIntersect1(rtc_scene_, &context, &rayhit);
-    {
-        // Camera rays start exactly at the camera, with no offset, so that a camera a hair above a
-        // floor sees the floor (an offset along the ray skipped every surface closer than it: a
-        // camera 1e-6 above a floor saw through it). Within offset_distance of a surface the side
-        // the camera is on is not resolved by the arithmetic (Embree reports hits at t = 0, on
-        // either face), so such a camera is put on the front side: close back-face hits (plane
-        // distance t (d . n) <= offset_distance) are skipped. Embree accepts t >= tnear, hence
-        // the next float above t (and at least FLT_MIN: denormals are flushed to zero).
-        const float band = offset_distance(ray.origin);
-        for (int skip = 0; skip < kMaxViewpointSkips; ++skip) {
-            if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
-            const float t = rayhit.ray.tfar;
-            const Vec3 normal = scene_->triangle_normal(rayhit.hit.primID);
-            const float leaving = glm::dot(ray.direction, normal);
-            if (!(leaving > 0.0f) || t * leaving > band) break;  // a front face, or clear of it
-            rayhit = to_rtc_rayhit(ray);
-            rayhit.ray.tnear = std::max({ray.tmin, std::nextafter(t, FLT_MAX), FLT_MIN});
-            rtcInitIntersectContext(&context);
-            rtcIntersect1(rtc_scene_, &context, &rayhit);
-        }
+    // Camera rays start exactly at the camera, with no offset, so that a camera a hair above a
+    // floor sees the floor (an offset along the ray skipped every surface closer than it: a
+    // camera 1e-6 above a floor saw through it). Within offset_distance of a surface the side
+    // the camera is on is not resolved by the arithmetic (Embree reports hits at t = 0, on
+    // either face), so such a camera is put on the front side: close back-face hits (plane
+    // distance t (d . n) <= offset_distance) are skipped. Embree accepts t >= tnear, hence
+    // the next float above t (and at least FLT_MIN: denormals are flushed to zero).
+    const float band = offset_distance(ray.origin);
+    for (int skip = 0; skip < kMaxViewpointSkips; ++skip) {
+        if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
+        const float t = rayhit.ray.tfar;
+        const Vec3 normal = scene_->triangle_normal(rayhit.hit.primID);
+        const float leaving = glm::dot(ray.direction, normal);
+        if (!(leaving > 0.0f) || t * leaving > band) break;  // a front face, or clear of it
+        rayhit = to_rtc_rayhit(ray);
+        rayhit.ray.tnear = std::max({ray.tmin, std::nextafter(t, FLT_MAX), FLT_MIN});
+        rtcInitIntersectContext(&context);
+        rtcIntersect1(rtc_scene_, &context, &rayhit);
     }
     if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
     return Hit{rayhit.ray.tfar, rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v};

@@ -99,6 +99,8 @@ public:
         if (max_component(diffuse_) > 0.0f) lobes_ |= mask_of(LobeKind::Diffuse);
         pure_lambertian_ = lobes_ == mask_of(LobeKind::Diffuse) && m_->lambertian_only;
     }
+    /// Not from a temporary: the Bsdf would point to it after it is gone.
+    Bsdf(BsdfMaterial&&, const Color&, const Frame&, const Vec3&) = delete;
 
     /// Sum of the non-delta lobes in `mask` (no cosine). Zero for delta-only materials.
     /// Reflection vs transmission is decided by the geometric normal (reflection iff wo and wi

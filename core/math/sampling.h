@@ -14,10 +14,10 @@ namespace photond {
 inline Vec2 sample_concentric_disk(const Vec2& u) {
     const Vec2 o = 2.0f * u - Vec2(1.0f);
     if (o.x == 0.0f && o.y == 0.0f) return {0.0f, 0.0f};
-    // theta = pi/4 (y/x) or pi/2 - pi/4 (x/y): within a quarter turn of 0 or of pi/2, whose
+    // theta = pi/4 (y/x) or pi/2 - pi/4 (x/y): within an eighth of a turn of 0, or of pi/2, where
     // cosine and sine are those of the small angle, swapped.
-    if (std::abs(o.x) > std::abs(o.y)) return o.x * cos_sin_quarter((kPi / 4.0f) * (o.y / o.x));
-    const Vec2 cs = cos_sin_quarter((kPi / 4.0f) * (o.x / o.y));
+    if (std::abs(o.x) > std::abs(o.y)) return o.x * cos_sin_eighth((kPi / 4.0f) * (o.y / o.x));
+    const Vec2 cs = cos_sin_eighth((kPi / 4.0f) * (o.x / o.y));
     return o.y * Vec2(cs.y, cs.x);
 }
 

@@ -36,6 +36,7 @@ Material make_material(float metallic, float roughness, float transmission = 0.0
 }
 
 /// A Bsdf of m; its BsdfMaterial is kept for the rest of the test program (a Bsdf refers to it).
+/// For the single-threaded test bodies only.
 Bsdf make_bsdf(const Material& m, const Color& c, const Vec3& n = Vec3(0, 0, 1)) {
     static std::deque<BsdfMaterial> kept;
     return Bsdf(kept.emplace_back(m), c, Frame(n), n);

@@ -15,12 +15,12 @@ TEST(Trig, QuarterTurnMatchesLibm) {
     double worst = 0.0;
     for (int i = -1000000; i <= 1000000; ++i) {
         const float a = static_cast<float>(i * 1e-6 * kPiDouble / 4.0);
-        const Vec2 cs = cos_sin_quarter(a);
+        const Vec2 cs = cos_sin_eighth(a);
         worst = std::max({worst, std::abs(cs.x - std::cos(double(a))), std::abs(cs.y - std::sin(double(a)))});
     }
     EXPECT_LT(worst, kMaxError);
     // The ends of the range and zero exactly where it matters: cos 0 = 1, sin 0 = 0.
-    EXPECT_EQ(cos_sin_quarter(0.0f), Vec2(1.0f, 0.0f));
+    EXPECT_EQ(cos_sin_eighth(0.0f), Vec2(1.0f, 0.0f));
 }
 
 TEST(Trig, FullTurnMatchesLibm) {
