@@ -133,12 +133,11 @@ public:
 }  // namespace photond
 
 int main(int argc, char** argv) {
-    // Random interleaving of the repetitions unless the command line says otherwise.
-    std::vector<char*> args(argv, argv + argc);
+    // Random interleaving of the repetitions, first on the command line so that a later
+    // --benchmark_enable_random_interleaving=false of the user's overrides it (the last one wins).
     std::string interleave = "--benchmark_enable_random_interleaving=true";
-    bool given = false;
-    for (int i = 1; i < argc; ++i) given |= std::string(argv[i]).starts_with("--benchmark_enable_random_interleaving");
-    if (!given) args.insert(args.begin() + 1, interleave.data());
+    std::vector<char*> args(argv, argv + argc);
+    args.insert(args.begin() + 1, interleave.data());
     int count = static_cast<int>(args.size());
     benchmark::Initialize(&count, args.data());
     photond::MedianReporter reporter;

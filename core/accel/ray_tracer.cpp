@@ -94,11 +94,7 @@ RayTracer::~RayTracer() {
     if (rtc_scene_) rtcReleaseScene(rtc_scene_);
 }
 
-std::optional<Hit> RayTracer::intersect_from_viewpoint(const Ray& ray) const {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    RTCRayHit rayhit = to_rtc_rayhit(ray);
-    rtcIntersect1(rtc_scene_, &context, &rayhit);
+void RayTracer::skip_back_faces_at_viewpoint(const Ray& ray, RTCRayHit& rayhit) const {
     // Camera rays start exactly at the camera, with no offset, so that a camera a hair above a
     // floor sees the floor (an offset along the ray skipped every surface closer than it: a
     // camera 1e-6 above a floor saw through it). Within offset_distance of a surface the side
@@ -115,11 +111,8 @@ std::optional<Hit> RayTracer::intersect_from_viewpoint(const Ray& ray) const {
         if (!(leaving > 0.0f) || t * leaving > band) break;  // a front face, or clear of it
         rayhit = to_rtc_rayhit(ray);
         rayhit.ray.tnear = std::max({ray.tmin, std::nextafter(t, FLT_MAX), FLT_MIN});
-        rtcInitIntersectContext(&context);
-        rtcIntersect1(rtc_scene_, &context, &rayhit);
+        cast(rayhit);
     }
-    if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
-    return Hit{rayhit.ray.tfar, rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v};
 }
 
 bool RayTracer::occluded(const Ray& ray) const {

@@ -103,11 +103,9 @@ public:
     /// into the surface, and passes it when it heads away (back-face hits that close to the
     /// viewpoint are skipped). Farther surfaces are hit as they are, whichever face.
     std::optional<Hit> intersect(const Ray& ray) const {
-        if (ray.from_viewpoint) return intersect_from_viewpoint(ray);
-        RTCIntersectContext context;
-        rtcInitIntersectContext(&context);
         RTCRayHit rayhit = to_rtc_rayhit(ray);
-        rtcIntersect1(rtc_scene_, &context, &rayhit);
+        cast(rayhit);
+        if (ray.from_viewpoint) skip_back_faces_at_viewpoint(ray, rayhit);
         if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
         return Hit{rayhit.ray.tfar, rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v};
     }
@@ -148,7 +146,14 @@ public:
 
 private:
     RayTracer() = default;
-    std::optional<Hit> intersect_from_viewpoint(const Ray& ray) const;
+    /// rtcIntersect1 on rayhit (inline: every ray of every pass comes through here).
+    void cast(RTCRayHit& rayhit) const {
+        RTCIntersectContext context;
+        rtcInitIntersectContext(&context);
+        rtcIntersect1(rtc_scene_, &context, &rayhit);
+    }
+    /// The viewpoint rule of intersect(): casts again past close back faces.
+    void skip_back_faces_at_viewpoint(const Ray& ray, RTCRayHit& rayhit) const;
 
     std::shared_ptr<EmbreeDevice> device_;
     const Scene* scene_ = nullptr;

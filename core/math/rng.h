@@ -67,8 +67,8 @@ private:
 class RngStreamFamily {
 public:
     RngStreamFamily(uint64_t seed, uint64_t a) : prefix_(mix64(mix64(seed) ^ a)) {}
-    /// Equal to Rng::for_stream(seed, a, i).
-    Rng stream(uint64_t i) const { return Rng::for_key(mix64(mix64(prefix_ ^ i) ^ 0)); }
+    /// Equal to Rng::for_stream(seed, a, i): hash_indices(seed, a, i, 0) after its first two mixes.
+    Rng stream(uint64_t i) const { return Rng::for_key(mix64(mix64(prefix_ ^ i))); }
 
 private:
     uint64_t prefix_;
