@@ -88,6 +88,10 @@ LightSet::LightSet(const Scene& scene) : scene_(&scene) {
                 e.double_sided = m.double_sided;
                 e.front_frame = Frame(scene.triangle_normal(e.index));
                 e.back_frame = Frame(-scene.triangle_normal(e.index));
+                const glm::uvec3& t = scene.triangles[e.index];
+                e.corner = scene.positions[t.x];
+                e.edge1 = scene.positions[t.y] - e.corner;
+                e.edge2 = scene.positions[t.z] - e.corner;
                 break;
             }
         }
@@ -173,8 +177,7 @@ Color LightSet::emitted_radiance(const SurfaceInteraction& si, const Vec3& wo) c
     return m.emission;
 }
 
-std::optional<EmissionSample> LightSet::sample_emission(float u_select, const Vec2& u_position,
-                                                        const Vec2& u_direction) const {
+std::optional<EmissionSample> LightSet::sample_emission(float u_select, Vec2 u_position, Vec2 u_direction) const {
     if (empty()) return std::nullopt;
     float choice_pdf = 0.0f;
     const uint32_t index = selection_.sample(u_select, &choice_pdf);
@@ -214,10 +217,8 @@ std::optional<EmissionSample> LightSet::sample_emission(float u_select, const Ve
             break;
         }
         case LightKind::Triangle: {
-            const glm::uvec3& t = scene_->triangles[e.index];
             const Vec2 b = sample_uniform_triangle(u_position);
-            const Vec3& a0 = scene_->positions[t.x];
-            s.origin = a0 + b.x * (scene_->positions[t.y] - a0) + b.y * (scene_->positions[t.z] - a0);
+            s.origin = e.corner + b.x * e.edge1 + b.y * e.edge2;
             const Frame* face = &e.front_frame;
             Vec2 ud = u_direction;
             if (e.double_sided) {  // pick a face, reusing the random number

@@ -61,8 +61,8 @@ public:
     /// Samples a photon's origin and direction from the emission distribution of a light chosen
     /// by power: point (uniform sphere), spot (uniform cone), directional (a disc covering the
     /// scene's bounds), emissive triangles (uniform by area, cosine-weighted direction).
-    std::optional<EmissionSample> sample_emission(float u_select, const Vec2& u_position,
-                                                  const Vec2& u_direction) const;
+    /// The random numbers by value: references would keep a caller's in memory.
+    std::optional<EmissionSample> sample_emission(float u_select, Vec2 u_position, Vec2 u_direction) const;
 
     /// Spot light angular falloff of KHR_lights_punctual (quadratic in the cosine).
     static float spot_falloff(const PunctualLight& light, float cos_angle);
@@ -81,6 +81,9 @@ private:
         /// Triangles: the shading frames of the emitting faces (the back one is used only when
         /// double-sided), built once rather than at every photon.
         Frame front_frame, back_frame;
+        /// Triangles: the first vertex and the edges from it to the other two, so that a photon's
+        /// origin needs no vertex lookups (the same floats as from the vertices).
+        Vec3 corner{0.0f}, edge1{0.0f}, edge2{0.0f};
         bool double_sided = false;
     };
     const Scene* scene_;

@@ -39,10 +39,14 @@ inline SurfaceInteraction make_interaction(const Scene& scene, const Hit& hit, c
         // A degenerate (zero-area) triangle that Embree still reported: face the ray.
         si.geometric_normal = -glm::normalize(ray_direction);
     }
-    const Vec3 n = w * scene.normals[tri.x] + hit.u * scene.normals[tri.y] + hit.v * scene.normals[tri.z];
-    const float len = glm::length(n);
-    si.shading_normal = oriented_shading_normal(len > 1e-12f && std::isfinite(len) ? n * (1.0f / len) : Vec3(0.0f),
-                                                si.geometric_normal);
+    // A flat-shaded triangle's vertices share one normal, unit or zero (SceneBuilder).
+    Vec3 shading = scene.normals[tri.x];
+    if (!scene.flat_shaded[hit.triangle]) {
+        const Vec3 n = w * shading + hit.u * scene.normals[tri.y] + hit.v * scene.normals[tri.z];
+        const float len = glm::length(n);
+        shading = len > 1e-12f && std::isfinite(len) ? n * (1.0f / len) : Vec3(0.0f);
+    }
+    si.shading_normal = oriented_shading_normal(shading, si.geometric_normal);
     si.triangle = hit.triangle;
     si.material = scene.triangle_materials[hit.triangle];
     // Texture coordinates serve texture lookups only: untextured materials skip their three loads.

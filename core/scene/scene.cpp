@@ -21,7 +21,7 @@ Color Texture::sample(const Vec2& uv) const {
            ty * ((1.0f - tx) * at(x0, y1) + tx * at(x1, y1));
 }
 
-Color Scene::textured_base_color(const Material& m, const Vec2& uv) const {
+Color Scene::textured_base_color(const Material& m, Vec2 uv) const {
     return m.base_color * textures[static_cast<size_t>(m.base_color_texture)].sample(uv);
 }
 
@@ -31,20 +31,23 @@ float Scene::triangle_area(uint32_t triangle) const {
                                          positions[t.z] - positions[t.x]));
 }
 
-void Scene::compute_triangle_normals() {
+void Scene::derive_triangle_data() {
     triangle_normals.resize(triangles.size());
+    flat_shaded.resize(triangles.size());
     for (size_t i = 0; i < triangles.size(); ++i) {
         const glm::uvec3& t = triangles[i];
         const Vec3 c = glm::cross(positions[t.y] - positions[t.x], positions[t.z] - positions[t.x]);
         const float len = glm::length(c);
         triangle_normals[i] = len > 0.0f && std::isfinite(len) ? c / len : Vec3(0.0f);
+        flat_shaded[i] = normals[t.x] == normals[t.y] && normals[t.x] == normals[t.z];
     }
 }
 
 Status Scene::validate() const {
     if (normals.size() != positions.size() || uvs.size() != positions.size())
         return Error{"scene '" + name + "': per-vertex arrays differ in size"};
-    if (triangle_materials.size() != triangles.size() || triangle_normals.size() != triangles.size())
+    if (triangle_materials.size() != triangles.size() || triangle_normals.size() != triangles.size() ||
+        flat_shaded.size() != triangles.size())
         return Error{"scene '" + name + "': per-triangle arrays differ in size"};
     for (size_t i = 0; i < positions.size(); ++i) {
         if (!is_finite(positions[i]))
@@ -162,11 +165,13 @@ Expected<Scene> SceneBuilder::build() {
         if (l.type != PunctualLightType::Directional) scene_.bounds.extend(l.position);
     }
     scene_.triangle_normals.clear();
+    scene_.flat_shaded.clear();
     if (!scene_.triangles.empty()) {
-        // Validate indices before computing normals from them.
+        // Validate indices before deriving data from them.
         scene_.triangle_normals.assign(scene_.triangles.size(), Vec3(0.0f));
+        scene_.flat_shaded.assign(scene_.triangles.size(), 0);
         if (Status st = scene_.validate(); !st) return st.error();
-        scene_.compute_triangle_normals();
+        scene_.derive_triangle_data();
     }
     if (Status st = scene_.validate(); !st) return st.error();
     Scene out = std::move(scene_);

@@ -91,6 +91,10 @@ struct Scene {
     /// Per triangle, unit, zero for degenerate triangles; derived from the positions by
     /// SceneBuilder::build (every ray hit needs it).
     std::vector<Vec3> triangle_normals;
+    /// Per triangle, 1 where its three vertex normals are one vector (a flat-shaded face, such
+    /// as every mesh without normals): its shading normal is that vector, not an interpolation.
+    /// Derived from the normals with triangle_normals.
+    std::vector<uint8_t> flat_shaded;
     std::vector<Material> materials;
     std::vector<Texture> textures;
     std::vector<PunctualLight> lights;
@@ -108,11 +112,13 @@ struct Scene {
     Vec3 triangle_normal(uint32_t triangle) const {  // geometric, unit (zero for degenerate)
         return triangle_normals[triangle];
     }
-    /// Recomputes triangle_normals from the positions (after editing them).
-    void compute_triangle_normals();
+    /// Recomputes triangle_normals and flat_shaded from the positions and normals (after
+    /// editing them).
+    void derive_triangle_data();
 
 private:
-    Color textured_base_color(const Material& m, const Vec2& uv) const;
+    /// uv by value: a reference would keep a caller's whole interaction in memory.
+    Color textured_base_color(const Material& m, Vec2 uv) const;
 };
 
 /// Assembles a Scene: transforms meshes into world space, generates flat normals where a mesh

@@ -39,7 +39,7 @@ Expected<Scene> transform_scene(const Scene& scene, const SimilarityTransform& t
             return Error{context + "camera '" + camera.name + "' leaves the float range"};
     }
     // Recomputed rather than kept: the rounded positions define the triangles now.
-    out.compute_triangle_normals();
+    out.derive_triangle_data();
     if (Status status = out.validate(); !status) return status.error();
     return out;
 }
