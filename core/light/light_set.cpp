@@ -56,7 +56,15 @@ LightSet::LightSet(const Scene& scene) : scene_(&scene) {
         if (!(area > 0.0f) || !std::isfinite(area)) continue;  // zero-area emitters emit nothing
         const float sides = m.double_sided ? 2.0f : 1.0f;
         light_of_triangle_[t] = static_cast<int32_t>(lights_.size());
-        lights_.push_back(Entry{LightKind::Triangle, t, sides * kPi * area * m.emission, area});
+        Entry e{LightKind::Triangle, t, sides * kPi * area * m.emission, area};
+        e.double_sided = m.double_sided;
+        e.front_frame = Frame(scene.triangle_normal(t));
+        e.back_frame = Frame(-scene.triangle_normal(t));
+        const glm::uvec3& v = scene.triangles[t];
+        e.corner = scene.positions[v.x];
+        e.edge1 = scene.positions[v.y] - e.corner;
+        e.edge2 = scene.positions[v.z] - e.corner;
+        lights_.push_back(e);
     }
     std::vector<float> weights;
     weights.reserve(lights_.size());
@@ -85,13 +93,6 @@ LightSet::LightSet(const Scene& scene) : scene_(&scene) {
                 const Material& m = scene.materials[scene.triangle_materials[e.index]];
                 const float sides = m.double_sided ? 2.0f : 1.0f;
                 e.emission_weight = m.emission * (sides * kPi * e.area) / choice_pdf;
-                e.double_sided = m.double_sided;
-                e.front_frame = Frame(scene.triangle_normal(e.index));
-                e.back_frame = Frame(-scene.triangle_normal(e.index));
-                const glm::uvec3& t = scene.triangles[e.index];
-                e.corner = scene.positions[t.x];
-                e.edge1 = scene.positions[t.y] - e.corner;
-                e.edge2 = scene.positions[t.z] - e.corner;
                 break;
             }
         }
@@ -132,10 +133,7 @@ std::optional<LightSample> LightSet::sample_incident(const Vec3& p, float u_sele
             break;
         }
         case LightKind::Triangle: {
-            const glm::uvec3& t = scene_->triangles[e.index];
-            const Vec2 b = sample_uniform_triangle(u);
-            const Vec3& a0 = scene_->positions[t.x];
-            const Vec3 q = a0 + b.x * (scene_->positions[t.y] - a0) + b.y * (scene_->positions[t.z] - a0);
+            const Vec3 q = e.point_at(sample_uniform_triangle(u));
             const Vec3 n = scene_->triangle_normal(e.index);
             const Vec3 d = q - p;
             const float dist2 = glm::dot(d, d);
@@ -217,8 +215,7 @@ std::optional<EmissionSample> LightSet::sample_emission(float u_select, Vec2 u_p
             break;
         }
         case LightKind::Triangle: {
-            const Vec2 b = sample_uniform_triangle(u_position);
-            s.origin = e.corner + b.x * e.edge1 + b.y * e.edge2;
+            s.origin = e.point_at(sample_uniform_triangle(u_position));
             const Frame* face = &e.front_frame;
             Vec2 ud = u_direction;
             if (e.double_sided) {  // pick a face, reusing the random number

@@ -81,9 +81,11 @@ private:
         /// Triangles: the shading frames of the emitting faces (the back one is used only when
         /// double-sided), built once rather than at every photon.
         Frame front_frame, back_frame;
-        /// Triangles: the first vertex and the edges from it to the other two, so that a photon's
-        /// origin needs no vertex lookups (the same floats as from the vertices).
+        /// Triangles: the first vertex and the edges from it to the other two, so that a sampled
+        /// point needs no vertex lookups (the same floats as from the vertices).
         Vec3 corner{0.0f}, edge1{0.0f}, edge2{0.0f};
+        /// Triangles: the point at barycentric coordinates b of the second and third vertices.
+        Vec3 point_at(Vec2 b) const { return corner + b.x * edge1 + b.y * edge2; }
         bool double_sided = false;
     };
     const Scene* scene_;
