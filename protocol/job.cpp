@@ -171,9 +171,9 @@ private:
     std::string path_;
 };
 
-constexpr std::array<std::string_view, 11> kJobFields{
-    "scene",  "camera",           "image",  "preset",   "integrator", "photons",
-    "gather", "irradiance_cache", "output", "priority", "seed"};
+constexpr std::array<std::string_view, 13> kJobFields{
+    "scene",  "camera",           "image",  "preset",      "integrator", "photons", "gather",
+    "irradiance_cache", "output", "environment", "lights", "priority",   "seed"};
 constexpr std::array<std::string_view, 3> kSceneFields{"builtin", "path", "id"};
 constexpr std::array<std::string_view, 5> kCameraFields{"gltf_camera", "look_from", "look_at", "up",
                                                         "vfov_deg"};
@@ -185,6 +185,18 @@ constexpr std::array<std::string_view, 1> kGatherFields{"rays"};
 constexpr std::array<std::string_view, 5> kIrradianceCacheFields{
     "enabled", "a", "gradients", "min_spacing_px", "max_spacing_px"};
 constexpr std::array<std::string_view, 2> kOutputFields{"pixel_type", "aovs"};
+constexpr std::array<std::string_view, 4> kEnvironmentFields{"color", "image", "intensity",
+                                                             "rotation_deg"};
+constexpr std::array<std::string_view, 4> kPointLightFields{"type", "position", "intensity",
+                                                            "color"};
+constexpr std::array<std::string_view, 7> kSpotLightFields{
+    "type", "position", "direction", "intensity", "color", "inner_cone_deg", "outer_cone_deg"};
+constexpr std::array<std::string_view, 5> kDirectionalLightFields{
+    "type", "direction", "irradiance", "color", "angular_diameter_deg"};
+constexpr std::array<std::string_view, 7> kQuadLightFields{
+    "type", "position", "edge_u", "edge_v", "radiance", "color", "two_sided"};
+// Colours of lights and the environment: non-negative factors.
+constexpr NumberRange kColorComponent{0.0, 1e6};
 
 // ----------------------------------------------------------------------------------- scene
 
@@ -410,6 +422,135 @@ void check_irradiance_cache(const IrradianceCacheSpec& cache) {
     }
 }
 
+// ------------------------------------------------------------------ environment, lights
+
+std::array<double, 3> read_color(const json& value, const std::string& path) {
+    if (!value.is_array() || value.size() != 3) {
+        fail(path, "must be an array of 3 numbers [r, g, b]" + got(value));
+    }
+    std::array<double, 3> c{};
+    for (size_t i = 0; i < 3; ++i) c[i] = read_number(value[i], element_path(path, i), kColorComponent);
+    return c;
+}
+
+std::array<double, 3> cross(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+    return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+
+bool has_extension(std::string_view path, std::string_view extension) {
+    if (path.size() < extension.size()) return false;
+    std::string_view tail = path.substr(path.size() - extension.size());
+    return std::equal(tail.begin(), tail.end(), extension.begin(), [](char a, char b) {
+        return std::tolower(static_cast<unsigned char>(a)) == b;
+    });
+}
+
+EnvironmentSpec parse_environment(const json& value) {
+    EnvironmentSpec environment;
+    if (value.is_null()) {
+        environment.kind = EnvironmentSpec::Kind::None;
+        return environment;
+    }
+    ObjectFields fields(value, "environment", kEnvironmentFields);
+    if (fields.has("color") && fields.has("image"))
+        fail("environment", "must have either \"color\" (uniform) or \"image\", not both");
+    if (const json* v = fields.find("image")) {
+        environment.kind = EnvironmentSpec::Kind::Image;
+        environment.image = read_string(*v, "environment.image");
+        if (!is_contained_relative_path(environment.image)) {
+            fail("environment.image",
+                 "must be relative to the scene root (or the uploaded bundle), without '..'" +
+                     got(*v));
+        }
+        if (std::none_of(kEnvironmentImageExtensions.begin(), kEnvironmentImageExtensions.end(),
+                         [&](std::string_view e) { return has_extension(environment.image, e); }))
+            fail("environment.image", "must be an OpenEXR (.exr) or Radiance (.hdr) file" + got(*v));
+        fields.overlay_number("rotation_deg", limits::kRotationDeg, environment.rotation_deg);
+    } else {
+        environment.kind = EnvironmentSpec::Kind::Uniform;
+        if (const json* v = fields.find("color")) environment.color = read_color(*v, "environment.color");
+        if (fields.has("rotation_deg"))
+            fail("environment.rotation_deg", "turns an image environment; this one is uniform");
+    }
+    fields.overlay_number("intensity", limits::kEnvironmentIntensity, environment.intensity);
+    return environment;
+}
+
+std::span<const std::string_view> light_fields(std::string_view type) {
+    if (type == "point") return kPointLightFields;
+    if (type == "spot") return kSpotLightFields;
+    if (type == "directional") return kDirectionalLightFields;
+    return kQuadLightFields;
+}
+
+/// A unit-able direction: finite and not the zero vector.
+std::array<double, 3> read_direction(const ObjectFields& fields, std::string_view key) {
+    const std::string path = fields.path_of(key);
+    const json* v = fields.find(key);
+    if (!v) fail(path, "required: a direction [x, y, z]");
+    std::array<double, 3> d = read_vector3(*v, path);
+    if (length(d) == 0.0) fail(path, "must not be the zero vector");
+    return d;
+}
+
+LightSpec parse_light(const json& value, const std::string& path) {
+    if (!value.is_object()) fail(path, "must be an object with a \"type\"" + got(value));
+    const auto type_it = value.find("type");
+    if (type_it == value.end())
+        fail(child_path(path, "type"), "required: one of " + quoted_list(kLightTypeNames));
+    LightSpec light;
+    light.type = read_choice(*type_it, child_path(path, "type"), kLightTypeNames);
+    ObjectFields fields(value, path, light_fields(light.type));
+    const std::string_view strength = light_strength_field(light.type);
+    if (!fields.has(strength)) {
+        const char* unit = light.type == "directional" ? "W/m^2 on a surface facing the light"
+                           : light.type == "quad"      ? "W m^-2 sr^-1"
+                                                       : "W/sr";
+        fail(fields.path_of(strength), std::string("required: the light's ") + std::string(strength) +
+                                           " in " + unit);
+    }
+    fields.overlay_number(strength, limits::kLightStrength, light.strength);
+    if (const json* v = fields.find("color")) light.color = read_color(*v, fields.path_of("color"));
+    if (light.type != "directional") {
+        const json* v = fields.find("position");
+        if (!v) fail(fields.path_of("position"), "required: a point [x, y, z]");
+        light.position = read_vector3(*v, fields.path_of("position"));
+    }
+    if (light.type == "spot" || light.type == "directional") light.direction = read_direction(fields, "direction");
+    if (light.type == "spot") {
+        fields.overlay_number("inner_cone_deg", limits::kSpotConeDeg, light.inner_cone_deg);
+        fields.overlay_number("outer_cone_deg", limits::kSpotConeDeg, light.outer_cone_deg);
+        if (!(light.outer_cone_deg > 0.0))
+            fail(fields.path_of("outer_cone_deg"), "must be above 0 degrees" + got(light.outer_cone_deg));
+        if (light.inner_cone_deg > light.outer_cone_deg)
+            fail(fields.path_of("inner_cone_deg"),
+                 "must be at most outer_cone_deg (" + format_number(light.outer_cone_deg) + ")" +
+                     got(light.inner_cone_deg));
+    }
+    if (light.type == "directional")
+        fields.overlay_number("angular_diameter_deg", limits::kAngularDiameterDeg, light.angular_diameter_deg);
+    if (light.type == "quad") {
+        light.edge_u = read_direction(fields, "edge_u");
+        light.edge_v = read_direction(fields, "edge_v");
+        // The same float-safety margin as the camera's up vector: clearly not parallel.
+        constexpr double kMinSinAngle = 1e-4;
+        if (length(cross(light.edge_u, light.edge_v)) < kMinSinAngle * length(light.edge_u) * length(light.edge_v))
+            fail(fields.path_of("edge_v"), "must not be parallel to edge_u (the quad has no area)");
+        fields.overlay_bool("two_sided", light.two_sided);
+    }
+    return light;
+}
+
+std::vector<LightSpec> parse_lights(const json& value) {
+    if (!value.is_array()) fail("lights", "must be an array of lights" + got(value));
+    if (!integer_in_range(json(value.size()), limits::kJobLights))
+        fail("lights", "must hold at most " + std::to_string(limits::kJobLights.max) + " lights (got " +
+                           std::to_string(value.size()) + ")");
+    std::vector<LightSpec> lights;
+    for (size_t i = 0; i < value.size(); ++i) lights.push_back(parse_light(value[i], element_path("lights", i)));
+    return lights;
+}
+
 // ------------------------------------------------------------------------------------- job
 
 Job read_job(const json& document) {
@@ -433,6 +574,8 @@ Job read_job(const json& document) {
         overlay_irradiance_cache(*v, job.irradiance_cache);
     }
     if (const json* v = fields.find("output")) overlay_output(*v, job.output);
+    if (const json* v = fields.find("environment")) job.environment = parse_environment(*v);
+    if (const json* v = fields.find("lights")) job.lights = parse_lights(*v);
     fields.overlay_integer("priority", limits::kPriority, job.priority);
     fields.overlay_integer("seed", limits::kSeed, job.seed);
 
@@ -649,6 +792,87 @@ json output_schema() {
         "the OpenEXR output");
 }
 
+json color_schema(std::string description) {
+    return {{"type", "array"},
+            {"items", number_schema(kColorComponent, "linear RGB component")},
+            {"minItems", 3},
+            {"maxItems", 3},
+            {"description", std::move(description)}};
+}
+
+json environment_schema() {
+    json intensity = number_schema(limits::kEnvironmentIntensity, "scales the radiance (default 1)");
+    json image_path = {{"type", "string"},
+                       {"pattern", R"(^(?![/\\])(?![A-Za-z]:)(?!(.*[/\\])?\.\.([/\\]|$))[^\x00-\x1f]+\.([eE][xX][rR]|[hH][dD][rR])$)"},
+                       {"description",
+                        "an equirectangular image of linear radiance (.exr or .hdr) relative to the "
+                        "scene root or the uploaded scene's bundle; +Y is up, u = 0.5 looks along +X"}};
+    json environment = object_schema(
+        {{"color", color_schema("uniform radiance, W m^-2 sr^-1 per channel (default [1, 1, 1]); not with image")},
+         {"image", image_path},
+         {"intensity", intensity},
+         {"rotation_deg",
+          number_schema(limits::kRotationDeg, "turns the image about +Y, degrees; only with image")}},
+        {}, "a uniform environment (color) or an environment image (image)");
+    environment["not"] = {{"required", {"color", "image"}}};
+    environment["dependentRequired"] = {{"rotation_deg", {"image"}}};
+    return {{"description",
+             "light from infinitely far away; absent: a uniform white environment of radiance 1 when "
+             "neither the scene nor the job has a light; null: none (a scene without light is refused)"},
+            {"oneOf", {{{"type", "null"}, {"description", "no environment"}}, environment}}};
+}
+
+json lights_schema() {
+    auto light = [](std::string_view type, json properties, std::vector<std::string> required,
+                    std::string description) {
+        properties["type"] = {{"const", std::string(type)}, {"description", "the kind of light"}};
+        required.insert(required.begin(), "type");
+        return object_schema(std::move(properties), std::move(required), std::move(description));
+    };
+    json strength = number_schema(limits::kLightStrength, "");
+    auto with = [](json schema, std::string description) {
+        schema["description"] = std::move(description);
+        return schema;
+    };
+    json colour = color_schema("colour factor (default [1, 1, 1])");
+    json cone = number_schema(limits::kSpotConeDeg, "");
+    json items = json::array(
+        {light("point",
+               {{"position", vector3_schema("world position")},
+                {"intensity", with(strength, "radiant intensity, W/sr")},
+                {"color", colour}},
+               {"position", "intensity"}, "a point light"),
+         light("spot",
+               {{"position", vector3_schema("world position")},
+                {"direction", vector3_schema("the cone's axis, where the light travels")},
+                {"intensity", with(strength, "radiant intensity on the axis, W/sr")},
+                {"color", colour},
+                {"inner_cone_deg", with(cone, "full intensity inside this angle to the axis (default 0)")},
+                {"outer_cone_deg", with(cone, "no light beyond this angle (default 45)")}},
+               {"position", "direction", "intensity"}, "a spot light (KHR_lights_punctual falloff)"),
+         light("directional",
+               {{"direction", vector3_schema("where the light travels, e.g. [0, -1, 0] from straight above")},
+                {"irradiance", with(strength, "irradiance on a surface facing the light, W/m^2")},
+                {"color", colour},
+                {"angular_diameter_deg",
+                 number_schema(limits::kAngularDiameterDeg,
+                               "0: a delta light with sharp shadows; > 0: a soft sun of that angular "
+                               "diameter (the Sun: 0.53)")}},
+               {"direction", "irradiance"}, "a distant light (a sun)"),
+         light("quad",
+               {{"position", vector3_schema("a corner")},
+                {"edge_u", vector3_schema("the first edge from the corner")},
+                {"edge_v", vector3_schema("the second edge from the corner; emits towards edge_u x edge_v")},
+                {"radiance", with(strength, "emitted radiance, W m^-2 sr^-1")},
+                {"color", colour},
+                {"two_sided", bool_schema("emit from both faces (default false)")}},
+               {"position", "edge_u", "edge_v", "radiance"}, "a visible rectangular area light")});
+    return {{"type", "array"},
+            {"maxItems", limits::kJobLights.max},
+            {"items", {{"oneOf", items}}},
+            {"description", "lights added to the scene's own (radiometric units)"}};
+}
+
 /// Writes each preset's value of every field as "x-preset-defaults" (and the default preset's as
 /// "default") onto the schema nodes that exist; a field missing from the schema stays missing.
 void annotate_preset_defaults(json& schema) {
@@ -677,6 +901,12 @@ void annotate_preset_defaults(json& schema) {
 }
 
 }  // namespace
+
+std::string_view light_strength_field(std::string_view type) {
+    if (type == "directional") return "irradiance";
+    if (type == "quad") return "radiance";
+    return "intensity";
+}
 
 std::string describe(const FieldError& error) {
     return error.path.empty() ? error.message : error.path + ": " + error.message;
@@ -757,6 +987,44 @@ nlohmann::json to_json(const Job& job) {
                                     {"min_spacing_px", cache.min_spacing_px},
                                     {"max_spacing_px", cache.max_spacing_px}};
     document["output"] = {{"pixel_type", job.output.pixel_type}, {"aovs", job.output.aovs}};
+    const EnvironmentSpec& environment = job.environment;
+    switch (environment.kind) {
+        case EnvironmentSpec::Kind::Default:
+            break;
+        case EnvironmentSpec::Kind::None:
+            document["environment"] = nullptr;
+            break;
+        case EnvironmentSpec::Kind::Uniform:
+            document["environment"] = {{"color", environment.color}, {"intensity", environment.intensity}};
+            break;
+        case EnvironmentSpec::Kind::Image:
+            document["environment"] = {{"image", environment.image},
+                                       {"intensity", environment.intensity},
+                                       {"rotation_deg", environment.rotation_deg}};
+            break;
+    }
+    if (!job.lights.empty()) {
+        json lights = json::array();
+        for (const LightSpec& light : job.lights) {
+            json l = {{"type", light.type},
+                      {std::string(light_strength_field(light.type)), light.strength},
+                      {"color", light.color}};
+            if (light.type != "directional") l["position"] = light.position;
+            if (light.type == "spot" || light.type == "directional") l["direction"] = light.direction;
+            if (light.type == "spot") {
+                l["inner_cone_deg"] = light.inner_cone_deg;
+                l["outer_cone_deg"] = light.outer_cone_deg;
+            }
+            if (light.type == "directional") l["angular_diameter_deg"] = light.angular_diameter_deg;
+            if (light.type == "quad") {
+                l["edge_u"] = light.edge_u;
+                l["edge_v"] = light.edge_v;
+                l["two_sided"] = light.two_sided;
+            }
+            lights.push_back(std::move(l));
+        }
+        document["lights"] = std::move(lights);
+    }
     document["priority"] = job.priority;
     document["seed"] = job.seed;
     return document;
@@ -814,6 +1082,8 @@ nlohmann::json job_json_schema() {
                                  {}, "final gathering")},
         {"irradiance_cache", irradiance_cache_schema()},
         {"output", output_schema()},
+        {"environment", environment_schema()},
+        {"lights", lights_schema()},
         {"priority", integer_schema(limits::kPriority, "queue priority; higher runs first")},
         {"seed", integer_schema(limits::kSeed, "seed of the render's random streams")}};
     json schema = object_schema(std::move(properties), {"scene"},

@@ -56,6 +56,14 @@ inline constexpr NumberRange kVerticalFovDeg{0.0, 180.0, true, true};
 // Camera coordinates must survive the conversion to the renderer's 32-bit floats.
 inline constexpr NumberRange kCoordinate{-std::numeric_limits<float>::max(),
                                          std::numeric_limits<float>::max()};
+// Job lights and the environment: radiometric units (W/sr, W/m^2, W m^-2 sr^-1).
+inline constexpr NumberRange kLightStrength{0.0, 1e9};
+inline constexpr NumberRange kEnvironmentIntensity{0.0, 1e6};
+inline constexpr NumberRange kRotationDeg{-360.0, 360.0};
+inline constexpr NumberRange kSpotConeDeg{0.0, 90.0};
+// A soft sun's angular diameter: the Sun is about 0.53 degrees; 0 is a delta light.
+inline constexpr NumberRange kAngularDiameterDeg{0.0, 90.0, false, true};
+inline constexpr IntegerRange kJobLights{0, 1024};
 inline constexpr std::string_view kSceneIdPrefix = "sha256:";
 inline constexpr size_t kSceneIdHexDigits = 64;
 }  // namespace limits
@@ -64,6 +72,9 @@ inline constexpr std::array<std::string_view, 3> kPresetNames{"preview", "final"
 inline constexpr std::string_view kDefaultPreset = "final";
 inline constexpr std::array<std::string_view, 3> kIntegratorNames{"photon-map", "path", "direct"};
 inline constexpr std::array<std::string_view, 2> kPixelTypeNames{"half", "float"};
+inline constexpr std::array<std::string_view, 4> kLightTypeNames{"point", "spot", "directional",
+                                                                 "quad"};
+inline constexpr std::array<std::string_view, 2> kEnvironmentImageExtensions{".exr", ".hdr"};
 inline constexpr std::array<std::string_view, 6> kAovNames{"direct", "indirect", "caustic",
                                                            "albedo", "normal",   "depth"};
 
@@ -140,6 +151,50 @@ struct OutputSpec {
     bool operator==(const OutputSpec&) const = default;
 };
 
+/// "environment": light arriving from infinitely far away, as glTF viewers show models.
+/// Absent (Default): a uniform white environment of radiance 1 when the scene and the job have no
+/// light of their own, else none. null (None): none, and a scene without light is refused.
+/// {"color": [r, g, b], "intensity": k}: uniform radiance k * colour. {"image": "sky.exr",
+/// "intensity": k, "rotation_deg": r}: an equirectangular image of linear radiance (OpenEXR or
+/// Radiance .hdr) from the scene root or the uploaded scene's bundle, turned r degrees about +Y.
+struct EnvironmentSpec {
+    enum class Kind { Default, None, Uniform, Image };
+    Kind kind = Kind::Default;
+    std::array<double, 3> color{1.0, 1.0, 1.0};  // Uniform
+    std::string image;                           // Image: a relative path, .exr or .hdr
+    double intensity = 1.0;
+    double rotation_deg = 0.0;  // Image
+
+    bool operator==(const EnvironmentSpec&) const = default;
+};
+
+/// One of "lights": added to the scene's own lights (radiometric units).
+///   point:       position, intensity (W/sr), color
+///   spot:        position, direction, intensity (W/sr), color, inner_cone_deg, outer_cone_deg
+///   directional: direction (where the light travels), irradiance (W/m^2 on a surface facing
+///                it), color, angular_diameter_deg (0: a delta light; > 0: a soft sun)
+///   quad:        position (a corner), edge_u, edge_v, radiance (W m^-2 sr^-1), color,
+///                two_sided; it emits towards cross(edge_u, edge_v) and is visible
+struct LightSpec {
+    std::string type;  // one of kLightTypeNames
+    std::array<double, 3> position{0.0, 0.0, 0.0};
+    std::array<double, 3> direction{0.0, -1.0, 0.0};
+    std::array<double, 3> color{1.0, 1.0, 1.0};
+    /// intensity (point, spot), irradiance (directional) or radiance (quad).
+    double strength = 1.0;
+    double inner_cone_deg = 0.0;
+    double outer_cone_deg = 45.0;
+    double angular_diameter_deg = 0.0;
+    std::array<double, 3> edge_u{1.0, 0.0, 0.0};
+    std::array<double, 3> edge_v{0.0, 0.0, 1.0};
+    bool two_sided = false;
+
+    bool operator==(const LightSpec&) const = default;
+};
+
+/// The JSON name of a light type's strength: "intensity", "irradiance" or "radiance".
+std::string_view light_strength_field(std::string_view type);
+
 /// A whole job with every default filled. A default-constructed Job is NOT valid (zero sizes):
 /// start from preset_defaults() (presets.h) or parse_job().
 struct Job {
@@ -153,6 +208,8 @@ struct Job {
     GatherSpec gather;
     IrradianceCacheSpec irradiance_cache;
     OutputSpec output;
+    EnvironmentSpec environment;
+    std::vector<LightSpec> lights;
     int priority = 0;
     uint64_t seed = 0;  // the render's random streams (photons.seed drives photon tracing)
 

@@ -19,6 +19,9 @@ nlohmann::json to_json(const RenderStatistics& s) {
         {"total_seconds", s.total_seconds},
         {"cancelled", s.cancelled},
     };
+    result["lighting"] = {{"lights", s.lighting.lights},
+                          {"job_lights", s.lighting.job_lights},
+                          {"environment", s.lighting.environment}};
     if (!s.plan.empty()) {
         nlohmann::json plan = nlohmann::json::array();
         for (const PassDecision& d : s.plan)

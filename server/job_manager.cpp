@@ -242,6 +242,15 @@ void JobManager::shutdown() {
 // ---------------------------------------------------------------------------------------------
 // Submission and queries
 
+PipelineOptions JobManager::pipeline_options() const {
+    PipelineOptions options;
+    options.threads = options_.threads;
+    options.scene_root = options_.scene_root;
+    options.photon_maps = photon_maps_;
+    options.scene_lookup = [this](const std::string& id) { return scenes_->lookup(id); };
+    return options;
+}
+
 void JobManager::check_scene(const protocol::Job& job) const {
     const protocol::SceneRef& scene = job.scene;
     switch (scene.kind) {
@@ -254,7 +263,7 @@ void JobManager::check_scene(const protocol::Job& job) const {
                     built ? "unknown built-in scene '" + scene.value + "'" : built.error().message,
                     "scene.builtin");
             }
-            return;
+            break;
         }
         case protocol::SceneRef::Kind::Path: {
             std::error_code error;
@@ -273,7 +282,7 @@ void JobManager::check_scene(const protocol::Job& job) const {
                                    "no scene file '" + scene.value + "' below the scene root (" +
                                        options_.scene_root.string() + ")",
                                    "scene.path");
-            return;
+            break;
         }
         case protocol::SceneRef::Kind::Id:
             if (!scenes_->contains(scene.value))
@@ -281,8 +290,10 @@ void JobManager::check_scene(const protocol::Job& job) const {
                     ErrorKind::InvalidField,
                     "no uploaded scene " + scene.value + " (upload it with POST /v1/scenes)",
                     "scene.id");
-            return;
+            break;
     }
+    if (const auto error = check_job_lighting(job, pipeline_options()))
+        throw ServiceError(ErrorKind::InvalidField, protocol::describe(*error), error->path);
 }
 
 int JobManager::retry_after_seconds_locked() const {
@@ -624,11 +635,7 @@ void JobManager::worker_loop() {
 
 void JobManager::run(const std::shared_ptr<Entry>& entry) {
     Entry& e = *entry;
-    PipelineOptions options;
-    options.threads = options_.threads;
-    options.scene_root = options_.scene_root;
-    options.photon_maps = photon_maps_;
-    options.scene_lookup = [this](const std::string& id) { return scenes_->lookup(id); };
+    PipelineOptions options = pipeline_options();
     options.callbacks.cancel = &e.cancel;
     options.callbacks.on_tile = [&](const TileEvent& event, const Image& frame) {
         // Only this tile's pixels are read: other threads write other tiles of the frame.

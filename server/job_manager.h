@@ -145,7 +145,10 @@ private:
     using Clock = std::chrono::steady_clock;
 
     std::shared_ptr<Entry> find_locked(const std::string& id) const;  // throws NotFound
-    void check_scene(const protocol::Job& job) const;                 // throws InvalidField
+    /// Checks the job's scene and its lighting (throws InvalidField naming the field).
+    void check_scene(const protocol::Job& job) const;
+    /// The pipeline's options for this daemon's jobs (no callbacks).
+    PipelineOptions pipeline_options() const;
     int retry_after_seconds_locked() const;
     void push_event_locked(Entry& entry, protocol::JobEventType type, nlohmann::json data);
     void worker_loop();

@@ -11,6 +11,7 @@
 #include "core/render/render_plan.h"
 #include "core/render/render_scene.h"
 #include "core/scene/builtin_scenes.h"
+#include "core/image/environment_image.h"
 #include "core/scene/gltf_loader.h"
 #include "core/scene/scene_hash.h"
 
@@ -25,6 +26,74 @@ double seconds_since(Clock::time_point start) {
 
 Vec3 to_vec3(const std::array<double, 3>& a) {
     return Vec3(static_cast<float>(a[0]), static_cast<float>(a[1]), static_cast<float>(a[2]));
+}
+
+float radians(double degrees) { return static_cast<float>(degrees * 3.14159265358979323846 / 180.0); }
+
+/// `relative` below `root`, with symbolic links resolved: nullopt when it leaves the root.
+std::optional<std::filesystem::path> contained_path(const std::filesystem::path& root,
+                                                    const std::string& relative) {
+    std::error_code error;
+    const std::filesystem::path canonical_root = std::filesystem::weakly_canonical(root, error);
+    if (error) return std::nullopt;
+    const std::filesystem::path file = std::filesystem::weakly_canonical(canonical_root / relative, error);
+    if (error) return std::nullopt;
+    const auto [root_end, file_it] =
+        std::mismatch(canonical_root.begin(), canonical_root.end(), file.begin(), file.end());
+    if (root_end != canonical_root.end()) return std::nullopt;
+    return file;
+}
+
+/// The file of a job's environment image: below the scene root for built-in and path scenes, in
+/// the uploaded bundle for {"id": ...} scenes. The error is the message for environment.image.
+Expected<std::filesystem::path> environment_image_file(const protocol::Job& job, const PipelineOptions& options) {
+    const std::string& name = job.environment.image;
+    std::filesystem::path root;
+    if (job.scene.kind == protocol::SceneRef::Kind::Id) {
+        std::optional<std::filesystem::path> bundle;
+        if (options.bundle_lookup) bundle = options.bundle_lookup(job.scene.value);
+        if (!bundle)
+            return Error{"the uploaded scene " + job.scene.value +
+                         " has no bundle of files; upload the scene with its environment image as a zip "
+                         "or tar bundle"};
+        root = *bundle;
+    } else {
+        if (options.scene_root.empty()) return Error{"no scene root is configured to read '" + name + "' from"};
+        root = options.scene_root;
+    }
+    const std::optional<std::filesystem::path> file = contained_path(root, name);
+    if (!file) return Error{"'" + name + "' lies outside the scene root"};
+    std::error_code error;
+    if (!std::filesystem::is_regular_file(*file, error))
+        return Error{"no environment image '" + name + "' below the " +
+                     std::string(job.scene.kind == protocol::SceneRef::Kind::Id ? "uploaded bundle" : "scene root")};
+    return *file;
+}
+
+Expected<Environment> load_environment_image(const protocol::Job& job, const PipelineOptions& options) {
+    auto file = environment_image_file(job, options);
+    if (!file) return Error{"environment.image: " + file.error().message};
+    auto environment = read_environment_image(*file);
+    if (!environment) return Error{"environment.image: " + environment.error().message};
+    environment->name = job.environment.image;
+    return environment;
+}
+
+constexpr const char* kNoLightMessage =
+    "the scene has no light and the job turned the default environment off; add \"lights\" (point, "
+    "spot, directional or quad) or an \"environment\" ({\"color\": [1, 1, 1]} or {\"image\": "
+    "\"sky.exr\"})";
+
+std::string format_number(double value) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "%g", value);
+    return text;
+}
+
+std::string describe_colour(const std::array<double, 3>& c) {
+    char text[96];
+    std::snprintf(text, sizeof(text), "[%g, %g, %g]", c[0], c[1], c[2]);
+    return text;
 }
 
 /// Plans the photon pass of a photon-map job and gets its maps: from the store when one is
@@ -135,6 +204,101 @@ Expected<std::shared_ptr<const Scene>> load_job_scene(const protocol::SceneRef& 
     return Error{"scene: unknown kind"};
 }
 
+Expected<AddedLighting> job_lighting(const protocol::Job& job, const Scene& scene, const PipelineOptions& options,
+                                     PassDecision* decision) {
+    AddedLighting lighting;
+    for (size_t i = 0; i < job.lights.size(); ++i) {
+        const protocol::LightSpec& spec = job.lights[i];
+        const std::string name = "lights[" + std::to_string(i) + "]";
+        const Color colour = to_vec3(spec.color) * static_cast<float>(spec.strength);
+        if (spec.type == "quad") {
+            lighting.quads.push_back({name, to_vec3(spec.position), to_vec3(spec.edge_u), to_vec3(spec.edge_v),
+                                      colour, spec.two_sided});
+            continue;
+        }
+        PunctualLight light;
+        light.name = name;
+        light.intensity = colour;
+        light.position = to_vec3(spec.position);
+        light.direction = glm::normalize(to_vec3(spec.direction));
+        if (spec.type == "point") light.type = PunctualLightType::Point;
+        if (spec.type == "spot") {
+            light.type = PunctualLightType::Spot;
+            light.cos_inner = std::cos(radians(spec.inner_cone_deg));
+            light.cos_outer = std::cos(radians(spec.outer_cone_deg));
+        }
+        if (spec.type == "directional") {
+            light.type = PunctualLightType::Directional;
+            light.angular_radius = 0.5f * radians(spec.angular_diameter_deg);
+        }
+        lighting.lights.push_back(light);
+    }
+
+    using Kind = protocol::EnvironmentSpec::Kind;
+    const protocol::EnvironmentSpec& spec = job.environment;
+    *decision = {"environment", true, ""};
+    switch (spec.kind) {
+        case Kind::Default:
+            if (scene.environment) {
+                *decision = {"environment", true, "the scene's own: '" + scene.environment->name + "'"};
+                break;
+            }
+            if (!job.lights.empty() || scene_emits_light(scene)) {
+                *decision = {"environment", false,
+                             "the scene" + std::string(job.lights.empty() ? "" : " or the job") +
+                                 " has lights of its own (add \"environment\" to light it from a sky too)"};
+                break;
+            }
+            lighting.environment = Environment{};
+            lighting.environment->name = "default";
+            decision->reason =
+                "default: a uniform white environment of radiance 1, since neither the scene nor the job has "
+                "a light (set \"environment\": null to refuse such jobs instead)";
+            break;
+        case Kind::None:
+            *decision = {"environment", false, "the job turned it off (\"environment\": null)"};
+            if (job.lights.empty() && !scene_emits_light(scene))
+                return Error{std::string("environment: ") + kNoLightMessage};
+            break;
+        case Kind::Uniform:
+            lighting.environment = Environment{};
+            lighting.environment->name = "uniform";
+            lighting.environment->color = to_vec3(spec.color);
+            lighting.environment->intensity = static_cast<float>(spec.intensity);
+            decision->reason = "uniform radiance " + describe_colour(spec.color) + " x " + format_number(spec.intensity);
+            break;
+        case Kind::Image: {
+            auto environment = load_environment_image(job, options);
+            if (!environment) return environment.error();
+            environment->intensity = static_cast<float>(spec.intensity);
+            environment->rotation = radians(spec.rotation_deg);
+            decision->reason = "image '" + spec.image + "' (" + std::to_string(environment->width) + " x " +
+                               std::to_string(environment->height) + "), importance-sampled";
+            lighting.environment = std::move(environment).value();
+            break;
+        }
+    }
+    if (lighting.environment) {
+        // A black environment lights nothing: say so rather than render black in silence.
+        Scene probe;
+        probe.environment = lighting.environment;
+        if (!scene_emits_light(probe)) decision->reason += "; it is black and adds no light";
+    }
+    return lighting;
+}
+
+std::optional<protocol::FieldError> check_job_lighting(const protocol::Job& job, const PipelineOptions& options) {
+    if (job.environment.kind == protocol::EnvironmentSpec::Kind::Image) {
+        auto file = environment_image_file(job, options);
+        if (!file) return protocol::FieldError{"environment.image", file.error().message};
+    }
+    if (job.environment.kind == protocol::EnvironmentSpec::Kind::None && job.lights.empty()) {
+        auto scene = load_job_scene(job.scene, options);
+        if (scene && !scene_emits_light(**scene)) return protocol::FieldError{"environment", kNoLightMessage};
+    }
+    return std::nullopt;
+}
+
 Expected<CameraDesc> resolve_camera(const protocol::Job& job, const Scene& scene) {
     if (job.camera) {
         if (const auto* gltf = std::get_if<protocol::GltfCamera>(&*job.camera)) {
@@ -182,20 +346,34 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     if (options.on_pass) options.on_pass("scene");
     auto scene = load_job_scene(job.scene, options);
     if (!scene) return scene.error();
+    PassDecision environment_decision;
+    auto lighting = job_lighting(job, **scene, options, &environment_decision);
+    if (!lighting) return lighting.error();
+    std::shared_ptr<const Scene> lit_scene = *scene;
+    if (!lighting->empty()) {
+        auto lit = with_added_lighting(**scene, *lighting);
+        if (!lit) return lit.error();
+        lit_scene = std::make_shared<const Scene>(std::move(lit).value());
+    }
+    stats.lighting.job_lights = job.lights.size();
+    stats.lighting.environment = lit_scene->environment ? lit_scene->environment->name : "";
     stats.passes.push_back({"scene", seconds_since(pass_start)});
 
     pass_start = Clock::now();
     if (options.on_pass) options.on_pass("acceleration");
-    auto render_scene = RenderScene::create(device, *scene);
+    auto render_scene = RenderScene::create(device, lit_scene);
     if (!render_scene) return render_scene.error();
+    stats.lighting.lights = (*render_scene)->lights->size();
     stats.passes.push_back({"acceleration", seconds_since(pass_start)});
 
+    // The camera frames the scene as loaded: lights added by the job do not move it.
     auto camera_desc = resolve_camera(job, **scene);
     if (!camera_desc) return camera_desc.error();
     auto camera = Camera::create(*camera_desc, job.image.width, job.image.height);
     if (!camera) return camera.error();
     auto integrator = make_integrator(job, *render_scene, options, stats);
     if (!integrator) return integrator.error();
+    stats.plan.insert(stats.plan.begin(), environment_decision);
 
     if (auto* photon_map = dynamic_cast<PhotonMapIntegrator*>(integrator->get())) {
         if (options.on_pass) options.on_pass("irradiance_cache");

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 
 #include "core/accel/ray_tracer.h"
 #include "core/photon/photon_tracer.h"
@@ -15,6 +16,7 @@
 #include "core/render/statistics.h"
 #include "core/render/tile_renderer.h"
 #include "core/scene/scene.h"
+#include "core/scene/scene_lighting.h"
 #include "protocol/job.h"
 
 namespace photond::service {
@@ -32,6 +34,9 @@ public:
 /// Resolves {"id": "sha256:..."} scenes (uploaded to the daemon).
 using SceneLookup = std::function<Expected<std::shared_ptr<const Scene>>(const std::string& id)>;
 
+/// The directory holding an uploaded scene's bundle files (environment images), if it has one.
+using SceneBundleLookup = std::function<std::optional<std::filesystem::path>(const std::string& id)>;
+
 /// Called when a pass starts ("scene", "acceleration", "photon_tracing", "render"), for status.
 using PassCallback = std::function<void(const std::string& pass)>;
 
@@ -41,6 +46,7 @@ struct PipelineOptions {
     RenderCallbacks callbacks;          // per-tile progress and cancellation
     PhotonMapStore* photon_maps = nullptr;  // null: photon maps are built for this job only
     SceneLookup scene_lookup;               // null: {"id": ...} scenes are refused
+    SceneBundleLookup bundle_lookup;        // null: uploaded scenes have no files for the job
     PassCallback on_pass;
 };
 
@@ -56,6 +62,18 @@ Expected<std::shared_ptr<const Scene>> load_job_scene(const protocol::SceneRef& 
 /// The photon tracing settings of a photon-map job under its plan.
 PhotonTracingSettings photon_settings(const protocol::Job& job, const RenderPlan& plan,
                                       const PipelineOptions& options);
+
+/// The lights and environment a job adds to `scene` (reading an environment image under the
+/// scene root or the uploaded bundle), with the default environment for a scene without light;
+/// `decision` receives the plan's "environment" entry. An error for `"environment": null` on a
+/// scene without light, naming what to add.
+Expected<AddedLighting> job_lighting(const protocol::Job& job, const Scene& scene, const PipelineOptions& options,
+                                     PassDecision* decision);
+
+/// What job_lighting would refuse, checked before a job is queued (so that the daemon answers
+/// 422 at once): an environment image that is missing or outside the scene root or bundle, and
+/// `"environment": null` on a scene without light (this one loads the scene).
+std::optional<protocol::FieldError> check_job_lighting(const protocol::Job& job, const PipelineOptions& options);
 
 /// The camera a job asks for: its own, the scene's glTF camera, or a view of the whole scene.
 Expected<CameraDesc> resolve_camera(const protocol::Job& job, const Scene& scene);

@@ -12,7 +12,8 @@ Color DirectIntegrator::radiance(const CameraRay& ray, SampleContext& context) c
 Color DirectIntegrator::radiance_along(const Ray& ray, int depth, SampleContext& context) const {
     const RenderScene& rs = *scene_;
     const std::optional<Hit> hit = trace_ray(rs, ray, context.counters);
-    if (!hit) return Color(0.0f);
+    // A camera ray or a delta bounce that leaves the scene sees the sky whole.
+    if (!hit) return rs.lights->escaped_radiance(ray.direction, 0.0f);
     const SurfaceInteraction si = make_interaction(*rs.scene, *hit, ray.direction);
     const Vec3 wo = -ray.direction;
     Color radiance = rs.lights->emitted_radiance(si, wo);

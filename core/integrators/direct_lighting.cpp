@@ -2,14 +2,41 @@
 
 namespace photond {
 
-Color sample_direct_light(const RenderScene& rs, const SurfaceInteraction& si, const Bsdf& bsdf,
-                          const Vec3& wo, SampleContext& context, bool use_mis, LobeMask mask) {
+namespace {
+
+/// The BSDF-sampled half of multiple importance sampling for distant area lights (environment,
+/// soft suns): one BSDF direction; where it leaves the scene unblocked, the sky's radiance
+/// weighted by the power heuristic against the light samples of sample_direct_light. Delta
+/// directions are left to the caller's specular recursion.
+Color sample_distant_lights_by_bsdf(const RenderScene& rs, const LightSet& lights, const SurfaceInteraction& si,
+                                    const Bsdf& bsdf, const Vec3& wo, SampleContext& context, LobeMask mask) {
+    const float u_lobe = context.next_1d();
+    const Vec2 u = context.next_2d();
+    const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Radiance, mask);
+    if (!s || s->kind == LobeKind::Delta || !(s->pdf > 0.0f) || is_black(s->weight)) return Color(0.0f);
+    const Color sky = lights.escaped_radiance(s->wi, s->pdf);
+    if (is_black(sky)) return Color(0.0f);
+    ++context.counters.shadow_rays;
+    if (rs.tracer->occluded(spawn_ray(rs, si, s->wi))) return Color(0.0f);
+    return s->weight * sky;
+}
+
+}  // namespace
+
+Color sample_direct_light(const RenderScene& rs, const LightSet& lights, const SurfaceInteraction& si,
+                          const Bsdf& bsdf, const Vec3& wo, SampleContext& context, bool use_mis, LobeMask mask) {
+    // Without the caller's MIS, distant area lights still get both strategies here: light
+    // sampling alone is poor for glossy lobes under a sky, BSDF sampling alone for a small sun.
+    const bool distant_mis = !use_mis && lights.has_distant_area_lights();
+    Color radiance(0.0f);
+    if (distant_mis) radiance += sample_distant_lights_by_bsdf(rs, lights, si, bsdf, wo, context, mask);
+
     const float u_select = context.next_1d();
     const Vec2 u = context.next_2d();
-    const std::optional<LightSample> ls = rs.lights->sample_incident(si.p, u_select, u);
-    if (!ls || !(ls->pdf > 0.0f) || is_black(ls->radiance)) return Color(0.0f);
+    const std::optional<LightSample> ls = lights.sample_incident(si.p, u_select, u);
+    if (!ls || !(ls->pdf > 0.0f) || is_black(ls->radiance)) return radiance;
     const Color f = bsdf.eval(wo, ls->wi, TransportMode::Radiance, mask);
-    if (is_black(f)) return Color(0.0f);
+    if (is_black(f)) return radiance;
     const float cos_theta = std::abs(glm::dot(ls->wi, si.shading_normal));
 
     const Vec3 origin = rs.tracer->offset_origin(si.p, si.geometric_normal, ls->wi);
@@ -23,11 +50,13 @@ Color sample_direct_light(const RenderScene& rs, const SurfaceInteraction& si, c
         shadow.tmax = 1.0f;
     }
     ++context.counters.shadow_rays;
-    if (rs.tracer->occluded(shadow)) return Color(0.0f);
+    if (rs.tracer->occluded(shadow)) return radiance;
 
     float weight = 1.0f;
-    if (use_mis && !ls->is_delta) weight = power_heuristic(ls->pdf, bsdf.pdf(wo, ls->wi, mask));
-    return f * ls->radiance * (cos_theta * weight / ls->pdf);
+    const bool distant_area = !ls->is_delta && !std::isfinite(ls->distance);
+    if ((use_mis || (distant_mis && distant_area)) && !ls->is_delta)
+        weight = power_heuristic(ls->pdf, bsdf.pdf(wo, ls->wi, mask));
+    return radiance + f * ls->radiance * (cos_theta * weight / ls->pdf);
 }
 
 }  // namespace photond

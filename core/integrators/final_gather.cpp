@@ -54,7 +54,12 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
         Color along(const Ray& r, int depth, float* first_distance) const {
             const std::optional<Hit> hit = trace_ray(rs, r, counters);
             if (first_distance) *first_distance = hit ? hit->t : std::numeric_limits<float>::infinity();
-            if (!hit) return Color(0.0f);
+            if (!hit) {
+                // Only straight from the gathering point: the sky seen through specular
+                // surfaces is the caustic map's.
+                if (depth == 0 && g.settings_.gather_diffuse_sky && rs.diffuse_sky) return rs.diffuse_sky->radiance(r.direction);
+                return Color(0.0f);
+            }
             const SurfaceInteraction si = make_interaction(*rs.scene, *hit, r.direction);
             const Vec3 wo = -r.direction;
             const Bsdf bsdf = make_bsdf(rs, si, wo);

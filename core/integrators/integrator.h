@@ -101,8 +101,16 @@ inline Bsdf make_bsdf(const RenderScene& rs, const SurfaceInteraction& si, const
 
 /// Next-event estimation: one light sample with a shadow ray, lobes in `mask` only. With
 /// `use_mis`, area-light samples are weighted by the power heuristic against BSDF sampling.
-Color sample_direct_light(const RenderScene& rs, const SurfaceInteraction& si, const Bsdf& bsdf,
-                          const Vec3& wo, SampleContext& context, bool use_mis,
+/// Without `use_mis`, distant area lights (environment, soft suns) still get MIS against one
+/// BSDF sample taken here.
+Color sample_direct_light(const RenderScene& rs, const LightSet& lights, const SurfaceInteraction& si,
+                          const Bsdf& bsdf, const Vec3& wo, SampleContext& context, bool use_mis,
                           LobeMask mask = kAllLobes);
+/// The same with the scene's lights.
+inline Color sample_direct_light(const RenderScene& rs, const SurfaceInteraction& si, const Bsdf& bsdf,
+                                 const Vec3& wo, SampleContext& context, bool use_mis,
+                                 LobeMask mask = kAllLobes) {
+    return sample_direct_light(rs, *rs.lights, si, bsdf, wo, context, use_mis, mask);
+}
 
 }  // namespace photond

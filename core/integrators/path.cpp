@@ -17,7 +17,14 @@ Color PathIntegrator::radiance(const CameraRay& camera_ray, SampleContext& conte
 
     for (int depth = 0; depth < max_depth_; ++depth) {
         const std::optional<Hit> hit = trace_ray(rs, ray, context.counters);
-        if (!hit) break;
+        if (!hit) {
+            // Left the scene: the environment and soft suns, weighted against their light
+            // samples at the previous vertex (whole after the camera or a delta bounce).
+            if (rs.lights->has_distant_area_lights())
+                radiance += throughput * rs.lights->escaped_radiance(ray.direction,
+                                                                     previous_was_delta ? 0.0f : previous_bsdf_pdf);
+            break;
+        }
         const SurfaceInteraction si = make_interaction(*rs.scene, *hit, ray.direction);
         const Vec3 wo = -ray.direction;
 

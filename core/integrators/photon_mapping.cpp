@@ -30,8 +30,11 @@ PhotonMapIntegrator::PhotonMapIntegrator(std::shared_ptr<const RenderScene> scen
         GatherSettings gather = settings_.gather;
         gather.k_global = settings_.k_global;
         gather.max_radius = global_options_.max_radius;
+        gather.gather_diffuse_sky = scene_->lights_with_sky_peaks != nullptr;
         gatherer_ = std::make_unique<FinalGatherer>(scene_, maps_, gather);
     }
+    direct_lights_ = gatherer_ && scene_->lights_with_sky_peaks ? scene_->lights_with_sky_peaks.get()
+                                                                  : scene_->lights.get();
 }
 
 void PhotonMapIntegrator::prepare(const Camera& camera, CacheBuildStatistics* statistics) {
@@ -66,14 +69,15 @@ Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_
                                           SampleContext& context) const {
     const RenderScene& rs = *scene_;
     const std::optional<Hit> hit = trace_ray(rs, ray, context.counters);
-    if (!hit) return Color(0.0f);
+    // A camera ray or a delta bounce that leaves the scene sees the sky whole.
+    if (!hit) return rs.lights->escaped_radiance(ray.direction, 0.0f);
     const SurfaceInteraction si = make_interaction(*rs.scene, *hit, ray.direction);
     const Vec3 wo = -ray.direction;
     Color radiance = rs.lights->emitted_radiance(si, wo);
     const Bsdf bsdf = make_bsdf(rs, si, wo);
     const float length = path_length + hit->t;
     if (bsdf.has_non_delta()) {
-        radiance += sample_direct_light(rs, si, bsdf, wo, context, false);
+        radiance += sample_direct_light(rs, *direct_lights_, si, bsdf, wo, context, false);
         const Vec3 normal = glm::dot(si.shading_normal, wo) >= 0.0f ? si.shading_normal : -si.shading_normal;
         if (maps_->caustic)
             radiance += maps_->caustic->estimate_radiance(si.p, normal, bsdf, wo, caustic_options_);

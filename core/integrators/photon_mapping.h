@@ -62,6 +62,9 @@ private:
     RadianceEstimateOptions global_options_;
     std::unique_ptr<FinalGatherer> gatherer_;
     std::unique_ptr<IrradianceCache> cache_;
+    /// What next-event estimation samples: the scene's lights, or with final gathering under an
+    /// environment, the lights with only the sky's peaks (the gather collects the rest).
+    const LightSet* direct_lights_ = nullptr;
 };
 
 }  // namespace photond

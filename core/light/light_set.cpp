@@ -18,7 +18,16 @@ float LightSet::spot_falloff_from_axis(const PunctualLight& light, float one_min
     return t * t;
 }
 
-LightSet::LightSet(const Scene& scene) : scene_(&scene) {
+Color LightSet::sun_radiance(const PunctualLight& light) {
+    // E = integral over the cone of L cos = L pi sin^2(radius): the irradiance on a surface
+    // facing the sun is the light's intensity.
+    const float s = std::sin(light.angular_radius);
+    return light.intensity / (kPi * s * s);
+}
+
+LightSet::LightSet(const Scene& scene) : LightSet(scene, scene.environment ? &*scene.environment : nullptr) {}
+
+LightSet::LightSet(const Scene& scene, const Environment* environment) : scene_(&scene) {
     scene_center_ = scene.bounds.empty() ? Vec3(0.0f) : scene.bounds.center();
     scene_radius_ = std::max(scene.bounds.radius(), 1e-6f);
     for (uint32_t i = 0; i < scene.lights.size(); ++i) {
@@ -43,7 +52,12 @@ LightSet::LightSet(const Scene& scene) : scene_(&scene) {
             }
             case PunctualLightType::Directional:
                 e.kind = LightKind::Directional;
-                e.power = kPi * scene_radius_ * scene_radius_ * l.intensity;
+                // Through a disc of the bounding radius: E for a delta light, L times the cone's
+                // solid angle for a soft sun.
+                e.power = kPi * scene_radius_ * scene_radius_ *
+                          (l.angular_radius > 0.0f
+                               ? sun_radiance(l) * (2.0f * kPi * (1.0f - std::cos(l.angular_radius)))
+                               : l.intensity);
                 break;
         }
         lights_.push_back(e);
@@ -66,6 +80,12 @@ LightSet::LightSet(const Scene& scene) : scene_(&scene) {
         e.edge2 = scene.positions[v.z] - e.corner;
         lights_.push_back(e);
     }
+    if (environment) {
+        environment_.emplace(*environment);
+        Entry e{LightKind::Environment, 0, Color(0.0f), 0.0f};
+        e.power = kPi * scene_radius_ * scene_radius_ * environment_->radiance_integral();
+        lights_.push_back(e);
+    }
     std::vector<float> weights;
     weights.reserve(lights_.size());
     for (const Entry& e : lights_) {
@@ -85,8 +105,19 @@ LightSet::LightSet(const Scene& scene) : scene_(&scene) {
                 break;
             case LightKind::Spot:  // the falloff varies with the direction: see sample_emission
                 break;
-            case LightKind::Directional:
-                e.emission_weight = scene.lights[e.index].intensity * (kPi * scene_radius_ * scene_radius_) / choice_pdf;
+            case LightKind::Directional: {
+                const PunctualLight& l = scene.lights[e.index];
+                // A soft sun: L / pdf = L times the cone's solid angle, the same for every sample.
+                const Color through_disc =
+                    l.angular_radius > 0.0f ? sun_radiance(l) / uniform_cone_pdf(std::cos(l.angular_radius))
+                                            : l.intensity;
+                e.emission_weight = through_disc * (kPi * scene_radius_ * scene_radius_) / choice_pdf;
+                if (l.angular_radius > 0.0f) distant_area_lights_.push_back(i);
+                break;
+            }
+            case LightKind::Environment:  // L / pdf varies with the direction: see sample_emission
+                e.emission_weight = Color(kPi * scene_radius_ * scene_radius_ / choice_pdf);
+                distant_area_lights_.push_back(i);
                 break;
             case LightKind::Triangle: {
                 // Le * cos / (pdf_area * pdf_dir) = Le * pi * A, times the number of faces.
@@ -125,11 +156,27 @@ std::optional<LightSample> LightSet::sample_incident(const Vec3& p, float u_sele
         }
         case LightKind::Directional: {
             const PunctualLight& l = scene_->lights[e.index];
-            s.wi = -l.direction;
             s.distance = std::numeric_limits<float>::infinity();
+            if (l.angular_radius > 0.0f) {
+                const float cos_max = std::cos(l.angular_radius);
+                s.wi = Frame(-l.direction).to_world(sample_uniform_cone(u, cos_max));
+                s.radiance = sun_radiance(l);
+                s.pdf = choice_pdf * uniform_cone_pdf(cos_max);
+                break;
+            }
+            s.wi = -l.direction;
             s.radiance = l.intensity;
             s.pdf = choice_pdf;
             s.is_delta = true;
+            break;
+        }
+        case LightKind::Environment: {
+            float pdf = 0.0f;
+            s.wi = environment_->sample(u, &pdf);
+            if (!(pdf > 0.0f)) return std::nullopt;
+            s.distance = std::numeric_limits<float>::infinity();
+            s.radiance = environment_->radiance(s.wi);
+            s.pdf = choice_pdf * pdf;
             break;
         }
         case LightKind::Triangle: {
@@ -166,6 +213,40 @@ float LightSet::pdf_incident_triangle(uint32_t triangle, const Vec3& p, const Ve
     const float abs_cos = std::abs(glm::dot(d, scene_->triangle_normal(triangle))) / std::sqrt(dist2);
     if (!(abs_cos > 0.0f)) return 0.0f;
     return selection_.probability(static_cast<uint32_t>(light)) * dist2 / (abs_cos * e.area);
+}
+
+float LightSet::distant_pdf(uint32_t light, const Vec3& d, Color* radiance) const {
+    const Entry& e = lights_[light];
+    const float choice_pdf = selection_.probability(light);
+    if (e.kind == LightKind::Environment) {
+        *radiance = environment_->radiance(d);
+        return choice_pdf * environment_->pdf(d);
+    }
+    const PunctualLight& l = scene_->lights[e.index];  // a soft sun
+    const float cos_max = std::cos(l.angular_radius);
+    if (!(glm::dot(d, -l.direction) >= cos_max)) {
+        *radiance = Color(0.0f);
+        return 0.0f;
+    }
+    *radiance = sun_radiance(l);
+    return choice_pdf * uniform_cone_pdf(cos_max);
+}
+
+Color LightSet::escaped_radiance(const Vec3& d, float bsdf_pdf) const {
+    Color sum(0.0f);
+    for (const uint32_t light : distant_area_lights_) {
+        Color radiance(0.0f);
+        const float light_pdf = distant_pdf(light, d, &radiance);
+        if (is_black(radiance)) continue;
+        sum += bsdf_pdf > 0.0f ? radiance * power_heuristic(bsdf_pdf, light_pdf) : radiance;
+    }
+    return sum;
+}
+
+Vec3 LightSet::parallel_origin(const Vec3& direction, Vec2 u) const {
+    const Frame frame(direction);
+    const Vec2 d = sample_concentric_disk(u) * scene_radius_;
+    return scene_center_ - direction * (2.0f * scene_radius_) + frame.s * d.x + frame.t * d.y;
 }
 
 Color LightSet::emitted_radiance(const SurfaceInteraction& si, const Vec3& wo) const {
@@ -206,12 +287,22 @@ std::optional<EmissionSample> LightSet::sample_emission(float u_select, Vec2 u_p
         case LightKind::Directional: {
             const PunctualLight& l = scene_->lights[e.index];
             // A disc of the scene's bounding radius, perpendicular to the light, outside the scene.
-            const Frame frame(l.direction);
-            const Vec2 d = sample_concentric_disk(u_position) * scene_radius_;
-            s.origin = scene_center_ - l.direction * (2.0f * scene_radius_) + frame.s * d.x + frame.t * d.y;
-            s.direction = l.direction;
-            s.normal = l.direction;
+            s.direction = l.angular_radius > 0.0f
+                              ? Frame(l.direction).to_world(sample_uniform_cone(u_direction, std::cos(l.angular_radius)))
+                              : l.direction;
+            s.origin = parallel_origin(s.direction, u_position);
+            s.normal = s.direction;
             s.flux_weight = e.emission_weight;
+            break;
+        }
+        case LightKind::Environment: {
+            float pdf = 0.0f;
+            const Vec3 towards_sky = environment_->sample(u_direction, &pdf);
+            if (!(pdf > 0.0f)) return std::nullopt;
+            s.direction = -towards_sky;
+            s.origin = parallel_origin(s.direction, u_position);
+            s.normal = s.direction;
+            s.flux_weight = e.emission_weight * environment_->radiance(towards_sky) / pdf;
             break;
         }
         case LightKind::Triangle: {

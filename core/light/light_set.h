@@ -1,10 +1,12 @@
-// Every light of a scene in one set: punctual lights (point, spot, directional) and emissive
-// triangles, chosen by power. Immutable after construction; safe to share between threads.
+// Every light of a scene in one set: punctual lights (point, spot, directional, soft sun),
+// emissive triangles and the environment, chosen by power. Immutable after construction; safe
+// to share between threads.
 #pragma once
 
 #include <optional>
 #include <vector>
 
+#include "core/light/environment_light.h"
 #include "core/math/frame.h"
 #include "core/math/sampling.h"
 #include "core/scene/interaction.h"
@@ -12,12 +14,12 @@
 
 namespace photond {
 
-enum class LightKind : uint8_t { Point, Spot, Directional, Triangle };
+enum class LightKind : uint8_t { Point, Spot, Directional, Triangle, Environment };
 
 /// A light sample seen from a shading point (next-event estimation).
 struct LightSample {
     Vec3 wi{0.0f};            // unit, from the shading point towards the light
-    float distance = 0.0f;    // to the sampled light point; infinity for directional lights
+    float distance = 0.0f;    // to the sampled light point; infinity for distant lights
     Color radiance{0.0f};     // incident radiance along -wi (intensity / d^2 for point lights)
     float pdf = 0.0f;         // solid-angle pdf incl. light choice; delta lights: choice probability
     bool is_delta = false;
@@ -39,6 +41,9 @@ struct EmissionSample {
 class LightSet {
 public:
     explicit LightSet(const Scene& scene);
+    /// The scene's lights with `environment` in place of the scene's own (null: none); it must
+    /// outlive the set.
+    LightSet(const Scene& scene, const Environment* environment);
 
     bool empty() const { return lights_.empty() || selection_.empty(); }
     size_t size() const { return lights_.size(); }
@@ -58,9 +63,22 @@ public:
     /// Radiance an emissive surface sends towards wo (front face only unless double-sided).
     Color emitted_radiance(const SurfaceInteraction& si, const Vec3& wo) const;
 
+    /// Whether a ray that leaves the scene can meet light: an environment or a soft sun (the
+    /// distant lights that are not delta lights).
+    bool has_distant_area_lights() const { return !distant_area_lights_.empty(); }
+    /// Radiance arriving along a ray that left the scene in direction `d` (unit), from every
+    /// distant area light. With bsdf_pdf > 0 (the ray was BSDF-sampled with that solid-angle
+    /// pdf) each light's share is weighted by the power heuristic against sample_incident; with
+    /// bsdf_pdf = 0 (camera rays, delta bounces) it is taken whole.
+    Color escaped_radiance(const Vec3& d, float bsdf_pdf) const;
+    /// The environment, when the scene has one.
+    const EnvironmentLight* environment() const { return environment_ ? &*environment_ : nullptr; }
+
     /// Samples a photon's origin and direction from the emission distribution of a light chosen
-    /// by power: point (uniform sphere), spot (uniform cone), directional (a disc covering the
-    /// scene's bounds), emissive triangles (uniform by area, cosine-weighted direction).
+    /// by power: point (uniform sphere), spot (uniform cone), directional (parallel from a disc
+    /// covering the scene's bounds; a soft sun's directions uniform in its cone), emissive
+    /// triangles (uniform by area, cosine-weighted direction), the environment (directions by
+    /// its importance distribution, parallel from a disc of the scene's bounding sphere).
     /// The random numbers by value: references would keep a caller's in memory.
     std::optional<EmissionSample> sample_emission(float u_select, Vec2 u_position, Vec2 u_direction) const;
 
@@ -68,8 +86,17 @@ public:
     static float spot_falloff(const PunctualLight& light, float cos_angle);
     /// The same falloff from 1 - cos(angle to the axis), precise for narrow cones.
     static float spot_falloff_from_axis(const PunctualLight& light, float one_minus_cos);
+    /// The radiance of a soft sun: its irradiance over pi sin^2 of its angular radius.
+    static Color sun_radiance(const PunctualLight& light);
 
 private:
+    /// The solid-angle pdf with which sample_incident picks direction d from distant area
+    /// light `light` (choice included), and the radiance it sends along d.
+    float distant_pdf(uint32_t light, const Vec3& d, Color* radiance) const;
+    /// The origin of a parallel photon travelling in `direction`: a point of a disc of the
+    /// scene's bounding radius perpendicular to it, outside the scene.
+    Vec3 parallel_origin(const Vec3& direction, Vec2 u) const;
+
     struct Entry {
         LightKind kind;
         uint32_t index;  // into Scene::lights or Scene::triangles
@@ -91,6 +118,8 @@ private:
     const Scene* scene_;
     std::vector<Entry> lights_;
     std::vector<int32_t> light_of_triangle_;  // -1 when the triangle emits nothing
+    std::vector<uint32_t> distant_area_lights_;  // the environment and soft suns, with power
+    std::optional<EnvironmentLight> environment_;
     DiscreteDistribution selection_;
     Color total_power_{0.0f};
     Vec3 scene_center_{0.0f};

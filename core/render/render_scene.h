@@ -18,6 +18,13 @@ struct RenderScene {
     std::unique_ptr<RayTracer> tracer;
     std::unique_ptr<LightSet> lights;
     std::vector<BsdfMaterial> bsdf_materials;  // one per Scene::materials entry
+    /// The environment split for final gathering (split_environment_peaks): gather rays that
+    /// leave the scene see `diffuse_sky`, and next-event estimation samples `lights_with_sky_peaks`
+    /// (the scene's lights with only the environment's peaks). Null without an environment.
+    std::unique_ptr<const Environment> sky_peaks;
+    std::unique_ptr<const Environment> diffuse_sky_environment;
+    std::unique_ptr<EnvironmentLight> diffuse_sky;
+    std::unique_ptr<LightSet> lights_with_sky_peaks;
     /// The triangles a caustic path (LS+D) can start on: those whose material has a delta or
     /// glossy lobe; null when there are none. Photons emitted for the caustic map alone that miss
     /// all of them are dropped after this one cheap ray instead of a trace through the scene.

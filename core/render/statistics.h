@@ -28,7 +28,17 @@ struct RenderStatistics {
     double render_seconds = 0.0;  // the tile pass alone
     double total_seconds = 0.0;
     bool cancelled = false;
-    /// The passes decided for this render, each with its reason (photon-map integrator).
+    /// What lights the render: the lights of the light set (punctual lights, emissive
+    /// triangles, the environment), how many the job added, and the environment's name (empty:
+    /// none; "default": the white environment of a scene without light).
+    struct LightingFigures {
+        size_t lights = 0;
+        size_t job_lights = 0;
+        std::string environment;
+    };
+    LightingFigures lighting;
+    /// The passes decided for this render, each with its reason (the environment for every
+    /// integrator; the photon maps for photon-map).
     std::vector<PassDecision> plan;
     /// The photon pass, when one ran or its maps came from the cache.
     std::optional<PhotonTracingStatistics> photons;

@@ -388,11 +388,108 @@ Expected<Scene> make_spheres_room() {
     return finish(builder, st, "spheres-room");
 }
 
+/// The sky of "sunlit-room": an equirectangular image with a blue gradient above the horizon,
+/// a dim ground below it and the sun as one patch of texels (see the header).
+Environment make_sunlit_room_sky() {
+    Environment sky;
+    sky.name = "sunlit-room sky";
+    sky.width = kSunlitRoomSkyWidth;
+    sky.height = kSunlitRoomSkyWidth / 2;
+    sky.texels.resize(static_cast<size_t>(sky.width) * static_cast<size_t>(sky.height));
+    for (int y = 0; y < sky.height; ++y) {
+        // Elevation of the row's centre: +90 degrees at the top row, -90 at the bottom.
+        const float elevation = 0.5f * kPi - kPi * (static_cast<float>(y) + 0.5f) / static_cast<float>(sky.height);
+        const float up = std::sin(elevation);
+        const Color colour = elevation > 0.0f ? glm::mix(Color(1.1f, 1.2f, 1.35f), Color(0.35f, 0.55f, 1.0f), up)
+                                              : Color(0.12f, 0.1f, 0.08f);
+        for (int x = 0; x < sky.width; ++x) sky.texels[static_cast<size_t>(y * sky.width + x)] = colour;
+    }
+    // The sun: the texels whose centres lie within kSunlitRoomSunRadius of its direction, with
+    // the radiance that gives kSunlitRoomSunIrradiance on a surface facing it.
+    const Vec3 sun = -kSunlitRoomSunDirection;
+    double solid_angle = 0.0;
+    std::vector<size_t> sun_texels;
+    for (int y = 0; y < sky.height; ++y) {
+        const double theta0 = kPi * y / sky.height, theta1 = kPi * (y + 1) / sky.height;
+        const double texel_solid_angle = 2.0 * kPi * (std::cos(theta0) - std::cos(theta1)) / sky.width;
+        for (int x = 0; x < sky.width; ++x) {
+            const float theta = kPi * (static_cast<float>(y) + 0.5f) / static_cast<float>(sky.height);
+            const float phi = 2.0f * kPi * ((static_cast<float>(x) + 0.5f) / static_cast<float>(sky.width) - 0.5f);
+            const Vec3 d(std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi));
+            if (glm::dot(d, sun) < std::cos(kSunlitRoomSunRadius)) continue;
+            sun_texels.push_back(static_cast<size_t>(y * sky.width + x));
+            solid_angle += texel_solid_angle;
+        }
+    }
+    for (size_t i : sun_texels)
+        sky.texels[i] = Color(1.0f, 0.93f, 0.82f) * static_cast<float>(kSunlitRoomSunIrradiance / solid_angle);
+    return sky;
+}
+
+/// A two-tone checkerboard of `checks` x `checks` squares of 8 x 8 texels.
+Texture checker_texture(int checks, const Color& a, const Color& b) {
+    Texture t;
+    t.width = t.height = 8 * checks;
+    t.texels.resize(static_cast<size_t>(t.width * t.height));
+    for (int y = 0; y < t.height; ++y)
+        for (int x = 0; x < t.width; ++x) t.texels[static_cast<size_t>(y * t.width + x)] = ((x / 8 + y / 8) % 2) ? a : b;
+    return t;
+}
+
+/// "sunlit-room": an interior lit by a sky and sun through a window; see the header.
+Expected<Scene> make_sunlit_room() {
+    constexpr float kHalfX = kSunlitRoomHalfWidth, kHalfZ = kSunlitRoomHalfDepth, kHeight = kSunlitRoomHeight;
+    SceneBuilder builder("sunlit-room");
+    const uint32_t checker = builder.add_texture(checker_texture(8, Color(0.75f, 0.7f, 0.6f), Color(0.35f, 0.25f, 0.2f)));
+    Material floor = lambertian("floor", Color(1.0f));
+    floor.base_color_texture = static_cast<int>(checker);
+    const uint32_t floor_material = builder.add_material(floor);
+    const uint32_t white = builder.add_material(lambertian("white", Color(0.8f)));
+    const uint32_t blue = builder.add_material(lambertian("blue", Color(0.25f, 0.35f, 0.65f)));
+    const uint32_t terracotta = builder.add_material(lambertian("terracotta", Color(0.7f, 0.35f, 0.2f)));
+    const uint32_t ivory = builder.add_material(lambertian("ivory", Color(0.8f, 0.78f, 0.7f)));
+
+    const Vec3 interior(0.0f, 0.5f * kHeight, 0.0f);
+    const Vec3 lower(-kHalfX, 0.0f, -kHalfZ);
+    const Vec3 ex(2.0f * kHalfX, 0.0f, 0.0f), ey(0.0f, kHeight, 0.0f), ez(0.0f, 0.0f, 2.0f * kHalfZ);
+    Status st;
+    if (st) st = add_mesh(builder, make_quad(lower, ex, ez, interior - lower), floor_material);
+    if (st) st = add_mesh(builder, make_quad(lower + ey, ex, ez, interior - lower - ey), white);
+    if (st) st = add_mesh(builder, make_quad(lower, ex, ey, interior - lower), white);              // z = -half
+    if (st) st = add_mesh(builder, make_quad(lower + ez, ex, ey, interior - lower - ez), white);    // z = +half
+    if (st) st = add_mesh(builder, make_quad(lower, ey, ez, interior - lower), blue);               // x = -half
+    // The window wall (x = +half): four panels around the opening [z0, z1] x [y0, y1].
+    const float x = kHalfX, y0 = kSunlitRoomWindow[0], y1 = kSunlitRoomWindow[1];
+    const float z0 = kSunlitRoomWindow[2], z1 = kSunlitRoomWindow[3];
+    const Vec3 facing(-1.0f, 0.0f, 0.0f);
+    const auto panel = [&](float ya, float yb, float za, float zb) {
+        return add_mesh(builder, make_quad(Vec3(x, ya, za), Vec3(0.0f, yb - ya, 0.0f), Vec3(0.0f, 0.0f, zb - za), facing),
+                        white);
+    };
+    if (st) st = panel(0.0f, y0, -kHalfZ, kHalfZ);
+    if (st) st = panel(y1, kHeight, -kHalfZ, kHalfZ);
+    if (st) st = panel(y0, y1, -kHalfZ, z0);
+    if (st) st = panel(y0, y1, z1, kHalfZ);
+    // Furniture: a turned box and a sphere.
+    if (st) st = add_mesh(builder, standing_box(-0.6f, -1.4f, 0.8f, 0.9f, 0.4f), terracotta);
+    if (st) st = add_mesh(builder, sphere_resting_on(0.0f, 0.6f, 1.2f, 0.45f), ivory);
+
+    CameraDesc camera;
+    camera.name = "camera";
+    camera.position = Vec3(-1.7f, 1.5f, 2.6f);
+    camera.look_at = Vec3(0.9f, 0.7f, -0.6f);
+    camera.vfov_deg = 60.0f;
+    builder.add_camera(camera);
+    Expected<Scene> scene = finish(builder, st, "sunlit-room");
+    if (scene) scene->environment = make_sunlit_room_sky();
+    return scene;
+}
+
 }  // namespace
 
 std::vector<std::string> builtin_scene_names() {
     return {"cornell-box", "cornell-box-diffuse", "caustic", "caustic-area",
-            "furnace",     "spheres-room"};
+            "furnace",     "spheres-room",        "sunlit-room"};
 }
 
 Expected<Scene> make_builtin_scene(std::string_view name) {
@@ -402,6 +499,7 @@ Expected<Scene> make_builtin_scene(std::string_view name) {
     if (name == "caustic-area") return make_caustic(true);
     if (name == "furnace") return make_furnace();
     if (name == "spheres-room") return make_spheres_room();
+    if (name == "sunlit-room") return make_sunlit_room();
     std::string known;
     for (const std::string& n : builtin_scene_names()) known += (known.empty() ? "" : ", ") + n;
     return Error{"unknown built-in scene '" + std::string(name) + "'; known scenes: " + known};

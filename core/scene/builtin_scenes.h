@@ -48,8 +48,19 @@
 //                         kSpheresRoomRows grid of objects in five colours: tessellated spheres
 //                         (level kSpheresRoomSphereSubdivisions, 5120 triangles each) and, every
 //                         third cell, a turned box carrying a small sphere (1280 triangles).
+//  "sunlit-room"          An interior lit only from outside, where photon maps must earn their
+//                         place: a closed room x in [-2, 2], y in [0, 2.8], z in [-3, 3], its
+//                         walls facing in, a window opening in the +x wall (kSunlitRoomWindow),
+//                         under an equirectangular sky image (the scene's environment,
+//                         kSunlitRoomSkyWidth wide: a blue gradient above the horizon, a dim ground
+//                         below, and the sun as texels within kSunlitRoomSunRadius of
+//                         -kSunlitRoomSunDirection with irradiance kSunlitRoomSunIrradiance). The
+//                         sun falls through the window onto a checkerboard-textured floor;
+//                         everything else is lit indirectly. Lambertian: white walls and ceiling,
+//                         a blue -x wall, a terracotta box and an ivory sphere.
 #pragma once
 
+#include <array>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -88,6 +99,17 @@ inline constexpr int kSpheresRoomColumns = 6;
 inline constexpr int kSpheresRoomRows = 5;
 inline constexpr float kSpheresRoomSpacing = 1.25f;
 inline constexpr int kSpheresRoomSphereSubdivisions = 4;
+
+/// "sunlit-room": room, window [y0, y1, z0, z1] in the x = +half wall, sky and sun.
+inline constexpr float kSunlitRoomHalfWidth = 2.0f;
+inline constexpr float kSunlitRoomHalfDepth = 3.0f;
+inline constexpr float kSunlitRoomHeight = 2.8f;
+inline constexpr std::array<float, 4> kSunlitRoomWindow{0.9f, 2.1f, -1.2f, 0.6f};
+inline constexpr int kSunlitRoomSkyWidth = 256;
+/// Where sunlight travels: into the window, 30 degrees down.
+inline constexpr Vec3 kSunlitRoomSunDirection{-0.8660254f, -0.5f, 0.0f};
+inline constexpr float kSunlitRoomSunRadius = 0.03f;  // radians (the Sun: 0.0047)
+inline constexpr float kSunlitRoomSunIrradiance = 12.0f;
 
 /// The names make_builtin_scene accepts, in a fixed order.
 std::vector<std::string> builtin_scene_names();

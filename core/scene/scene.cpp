@@ -74,6 +74,25 @@ Status Scene::validate() const {
     for (const PunctualLight& l : lights) {
         if (!is_finite(l.position) || !is_finite(l.direction) || !is_finite(l.intensity))
             return Error{"scene '" + name + "': light '" + l.name + "' has a non-finite value"};
+        if (!(l.angular_radius >= 0.0f && l.angular_radius < 0.5f * kPi))
+            return Error{"scene '" + name + "': light '" + l.name +
+                         "' has an angular radius outside [0, pi/2)"};
+    }
+    if (environment) {
+        const Environment& e = *environment;
+        if (!is_finite(e.color) || !std::isfinite(e.intensity) || !std::isfinite(e.rotation) ||
+            min_component(e.color) < 0.0f || e.intensity < 0.0f)
+            return Error{"scene '" + name + "': environment '" + e.name +
+                         "' has a negative or non-finite colour, intensity or rotation"};
+        if (e.width < 0 || e.height < 0 ||
+            e.texels.size() != static_cast<size_t>(e.width) * static_cast<size_t>(e.height))
+            return Error{"scene '" + name + "': environment '" + e.name +
+                         "' has texels that do not match its size"};
+        for (const Color& c : e.texels) {
+            if (!is_finite(c) || min_component(c) < 0.0f)
+                return Error{"scene '" + name + "': environment image '" + e.name +
+                             "' has a negative or non-finite texel"};
+        }
     }
     return Status::ok();
 }

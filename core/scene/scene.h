@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -53,6 +54,27 @@ struct PunctualLight {
     Color intensity{1.0f};              // colour * intensity
     float cos_inner = 1.0f;             // spot: full intensity inside the inner cone
     float cos_outer = 0.0f;             // spot: zero outside the outer cone
+    /// Directional: half the angular diameter of the source (radians); 0 is a delta light, more
+    /// is a soft sun (a disc of uniform radiance whose irradiance on a surface facing it is
+    /// `intensity`).
+    float angular_radius = 0.0f;
+};
+
+/// Light arriving from infinitely far away in every direction: a uniform colour, or an
+/// equirectangular image of linear radiance (the job's `environment`). An image maps direction
+/// d (unit, towards the sky) to u = 0.5 + atan2(d.z, d.x) / (2 pi), v = acos(d.y) / pi (row 0 at
+/// v = 0, straight up: +Y), the convention of Blender and three.js, after turning d by
+/// -rotation about +Y.
+struct Environment {
+    std::string name;          // the image file, or "uniform"; for statistics and warnings
+    Color color{1.0f};         // uniform radiance when the image is empty
+    int width = 0;             // the image; 0 for a uniform environment
+    int height = 0;
+    std::vector<Color> texels;  // row-major, row 0 at the top (+Y)
+    float intensity = 1.0f;    // scales the colour or the image
+    float rotation = 0.0f;     // radians about +Y, counter-clockwise seen from above
+
+    bool has_image() const { return width > 0 && height > 0; }
 };
 
 /// A pinhole camera: position, orientation and vertical field of view.
@@ -99,6 +121,8 @@ struct Scene {
     std::vector<Texture> textures;
     std::vector<PunctualLight> lights;
     std::vector<CameraDesc> cameras;
+    /// Distant light around the scene; absent: none (only the scene's own lights shine).
+    std::optional<Environment> environment;
     Bounds3 bounds;  // of all triangles (and of punctual light positions)
 
     /// Checks the invariants every consumer relies on (sizes, index ranges, finite data).

@@ -17,7 +17,10 @@ static_assert(sizeof(Texture) == 8 + sizeof(std::vector<Color>),
               "Texture changed: hash the new field in scene_content_hash");
 // Scene::triangle_normals and flat_shaded are derived from the positions and normals and need no
 // hashing of their own.
-static_assert(sizeof(Scene) == sizeof(std::string) + 11 * sizeof(std::vector<int>) + sizeof(Bounds3),
+static_assert(sizeof(Environment) == sizeof(std::string) + sizeof(std::vector<Color>) + 32,
+              "Environment changed: hash the new field in scene_content_hash");
+static_assert(sizeof(Scene) == sizeof(std::string) + 11 * sizeof(std::vector<int>) +
+                                   sizeof(std::optional<Environment>) + sizeof(Bounds3),
               "Scene changed: hash the new field in scene_content_hash");
 static_assert(sizeof(void*) != 8 || sizeof(PhotonTracingSettings) == 48,
               "PhotonTracingSettings changed: add the new field to photon_map_key if the maps "
@@ -52,7 +55,7 @@ void hash_array(Sha256& hasher, const std::vector<T>& values, HashElement&& hash
 
 Sha256Digest scene_content_hash(const Scene& scene) {
     Sha256 hasher;
-    hasher.update_string("photond scene content 1");
+    hasher.update_string("photond scene content 2");
     hash_array(hasher, scene.positions, [&](const Vec3& p) { hash_vec3(hasher, p); });
     hash_array(hasher, scene.normals, [&](const Vec3& n) { hash_vec3(hasher, n); });
     hash_array(hasher, scene.uvs, [&](const Vec2& uv) { hash_vec2(hasher, uv); });
@@ -86,7 +89,18 @@ Sha256Digest scene_content_hash(const Scene& scene) {
         hash_vec3(hasher, l.intensity);
         hash_float(hasher, l.cos_inner);
         hash_float(hasher, l.cos_outer);
+        hash_float(hasher, l.angular_radius);
     });
+    // The environment lights the scene as its own lights do (the name is only a label).
+    hasher.update_value(uint8_t(scene.environment ? 1 : 0));
+    if (const std::optional<Environment>& e = scene.environment) {
+        hash_vec3(hasher, e->color);
+        hasher.update_value(int32_t(e->width));
+        hasher.update_value(int32_t(e->height));
+        hash_array(hasher, e->texels, [&](const Color& c) { hash_vec3(hasher, c); });
+        hash_float(hasher, e->intensity);
+        hash_float(hasher, e->rotation);
+    }
     return hasher.finish();
 }
 

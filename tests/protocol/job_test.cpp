@@ -162,6 +162,25 @@ Job full_job() {
     job.gather.rays = 333;
     job.irradiance_cache = IrradianceCacheSpec{false, 0.1234567890123, false, 0.1, 1024.0};
     job.output = OutputSpec{"float", {"depth", "direct", "normal"}};
+    job.environment = EnvironmentSpec{.kind = EnvironmentSpec::Kind::Image,
+                                      .image = "skies/noon.hdr",
+                                      .intensity = 2.5,
+                                      .rotation_deg = -90.0};
+    LightSpec point{.type = "point", .position = {1, 2, 3}, .color = {1, 0.5, 0.25}, .strength = 40};
+    LightSpec spot{.type = "spot",
+                   .position = {0, 5, 0},
+                   .direction = {0, -1, 0.5},
+                   .strength = 100,
+                   .inner_cone_deg = 10,
+                   .outer_cone_deg = 30};
+    LightSpec sun{.type = "directional", .direction = {-1, -2, 0}, .strength = 800, .angular_diameter_deg = 0.53};
+    LightSpec quad{.type = "quad",
+                   .position = {-1, 3, -1},
+                   .strength = 12,
+                   .edge_u = {2, 0, 0},
+                   .edge_v = {0, 0, 2},
+                   .two_sided = true};
+    job.lights = {point, spot, sun, quad};
     job.priority = 100;
     job.seed = std::numeric_limits<uint64_t>::max();
     return job;
@@ -710,6 +729,7 @@ std::set<std::string> every_document_field() {
     other.camera = GltfCamera{0};
     collect_fields(to_json(other), "", fields);
     for (std::string_view form : {"builtin", "id"}) fields.insert("scene." + std::string(form));
+    fields.insert("environment.color");  // the uniform form (full_job has an image)
     return fields;
 }
 
@@ -766,6 +786,7 @@ TEST(JobSchema, NumericBoundsAgreeWithTheValidator) {
         bool spacing = field.find("spacing") != std::string::npos;  // also min <= max
         auto document_with = [&](const json& value) {
             json document = base_job();
+            if (field == "environment.rotation_deg") document["environment"]["image"] = "sky.exr";
             document[json::json_pointer("/" + std::regex_replace(field, std::regex("\\."), "/"))] =
                 value;
             return document;
@@ -810,6 +831,107 @@ TEST(JobSchema, ScenePathPatternMatchesTheValidator) {
         bool valid = accepts({{"scene", {{"path", path}}}});
         EXPECT_EQ(std::regex_match(path, pattern), valid) << path;
     }
+}
+
+TEST(JobEnvironment, AbsentIsTheDefaultNullIsNoneAndEachFormParses) {
+    EXPECT_EQ(parsed(base_job()).environment.kind, EnvironmentSpec::Kind::Default);
+    EXPECT_FALSE(to_json(parsed(base_job())).contains("environment"));
+    json off = base_job();
+    off["environment"] = nullptr;
+    EXPECT_EQ(parsed(off).environment.kind, EnvironmentSpec::Kind::None);
+    EXPECT_TRUE(to_json(parsed(off)).at("environment").is_null());
+    EXPECT_EQ(parsed(to_json(parsed(off))), parsed(off));
+
+    json uniform = base_job();
+    uniform["environment"] = {{"color", {0.5, 0.6, 0.7}}, {"intensity", 2}};
+    const EnvironmentSpec u = parsed(uniform).environment;
+    EXPECT_EQ(u.kind, EnvironmentSpec::Kind::Uniform);
+    EXPECT_EQ(u.color, (std::array<double, 3>{0.5, 0.6, 0.7}));
+    EXPECT_EQ(u.intensity, 2.0);
+    EXPECT_EQ(parsed(to_json(parsed(uniform))), parsed(uniform));
+    json white = base_job();
+    white["environment"] = json::object();  // uniform white of radiance 1
+    EXPECT_EQ(parsed(white).environment.color, (std::array<double, 3>{1, 1, 1}));
+
+    json image = base_job();
+    image["environment"] = {{"image", "sky/Noon.EXR"}, {"rotation_deg", 45}};
+    const EnvironmentSpec i = parsed(image).environment;
+    EXPECT_EQ(i.kind, EnvironmentSpec::Kind::Image);
+    EXPECT_EQ(i.image, "sky/Noon.EXR");
+    EXPECT_EQ(i.rotation_deg, 45.0);
+}
+
+TEST(JobEnvironment, RefusesWhatCannotBeRightByName) {
+    auto with = [](json environment) {
+        json document = base_job();
+        document["environment"] = std::move(environment);
+        return document;
+    };
+    EXPECT_TRUE(rejects(with({{"color", {1, 1, 1}}, {"image", "a.exr"}}), "environment", "not both"));
+    EXPECT_TRUE(rejects(with({{"image", "../a.exr"}}), "environment.image", "without '..'"));
+    EXPECT_TRUE(rejects(with({{"image", "/etc/a.exr"}}), "environment.image"));
+    EXPECT_TRUE(rejects(with({{"image", "sky.png"}}), "environment.image", ".hdr"));
+    EXPECT_TRUE(rejects(with({{"image", 3}}), "environment.image", "string"));
+    EXPECT_TRUE(rejects(with({{"color", {1, 1}}}), "environment.color", "3 numbers"));
+    EXPECT_TRUE(rejects(with({{"color", {1, -1, 1}}}), "environment.color[1]"));
+    EXPECT_TRUE(rejects(with({{"rotation_deg", 10}}), "environment.rotation_deg", "uniform"));
+    EXPECT_TRUE(rejects(with({{"colour", {1, 1, 1}}}), "environment.colour", "unknown field"));
+    EXPECT_TRUE(rejects(with({{"intensity", -1}}), "environment.intensity"));
+    EXPECT_TRUE(rejects(with("sky.exr"), "environment", "object"));
+}
+
+TEST(JobLights, EveryTypeParsesAndSurvivesTheRoundTrip) {
+    json document = base_job();
+    document["lights"] = json::array(
+        {{{"type", "point"}, {"position", {0, 1, 0}}, {"intensity", 5}},
+         {{"type", "directional"}, {"direction", {0, -1, 0}}, {"irradiance", 3}, {"angular_diameter_deg", 0.53}},
+         {{"type", "quad"}, {"position", {0, 2, 0}}, {"edge_u", {1, 0, 0}}, {"edge_v", {0, 0, 1}}, {"radiance", 4}},
+         {{"type", "spot"}, {"position", {0, 2, 0}}, {"direction", {0, -1, 0}}, {"intensity", 9},
+          {"outer_cone_deg", 20}}});
+    const Job job = parsed(document);
+    ASSERT_EQ(job.lights.size(), 4u);
+    EXPECT_EQ(job.lights[0].strength, 5.0);
+    EXPECT_EQ(job.lights[1].angular_diameter_deg, 0.53);
+    EXPECT_EQ(job.lights[2].edge_v, (std::array<double, 3>{0, 0, 1}));
+    EXPECT_FALSE(job.lights[2].two_sided);
+    EXPECT_EQ(job.lights[3].outer_cone_deg, 20.0);
+    EXPECT_EQ(job.lights[3].inner_cone_deg, 0.0);
+    EXPECT_EQ(parsed(to_json(job)), job);
+    EXPECT_EQ(to_json(job)["lights"][1]["irradiance"], 3.0);
+}
+
+TEST(JobLights, RefusesWhatCannotBeRightByName) {
+    auto with = [](json light) {
+        json document = base_job();
+        document["lights"] = json::array({std::move(light)});
+        return document;
+    };
+    EXPECT_TRUE(rejects(with({{"position", {0, 1, 0}}}), "lights[0].type", "required"));
+    EXPECT_TRUE(rejects(with({{"type", "area"}}), "lights[0].type", "\"quad\""));
+    EXPECT_TRUE(rejects(with({{"type", "point"}, {"position", {0, 1, 0}}}), "lights[0].intensity", "W/sr"));
+    EXPECT_TRUE(rejects(with({{"type", "point"}, {"intensity", 1}}), "lights[0].position", "required"));
+    EXPECT_TRUE(rejects(with({{"type", "point"}, {"position", {0, 1, 0}}, {"irradiance", 1}}),
+                        "lights[0].irradiance", "unknown field"));
+    EXPECT_TRUE(rejects(with({{"type", "directional"}, {"direction", {0, 0, 0}}, {"irradiance", 1}}),
+                        "lights[0].direction", "zero"));
+    EXPECT_TRUE(rejects(with({{"type", "directional"}, {"direction", {0, -1, 0}}, {"irradiance", 1},
+                              {"angular_diameter_deg", 90}}),
+                        "lights[0].angular_diameter_deg"));
+    EXPECT_TRUE(rejects(with({{"type", "spot"}, {"position", {0, 1, 0}}, {"direction", {0, -1, 0}},
+                              {"intensity", 1}, {"inner_cone_deg", 30}, {"outer_cone_deg", 20}}),
+                        "lights[0].inner_cone_deg", "outer_cone_deg"));
+    EXPECT_TRUE(rejects(with({{"type", "quad"}, {"position", {0, 1, 0}}, {"edge_u", {1, 0, 0}},
+                              {"edge_v", {2, 0, 0}}, {"radiance", 1}}),
+                        "lights[0].edge_v", "parallel"));
+    EXPECT_TRUE(rejects(with({{"type", "point"}, {"position", {0, 1, 0}}, {"intensity", NAN}}),
+                        "lights[0].intensity"));
+    json many = base_job();
+    many["lights"] = json::array();
+    for (int i = 0; i < 1025; ++i) many["lights"].push_back({{"type", "point"}, {"position", {0, 1, 0}}, {"intensity", 1}});
+    EXPECT_TRUE(rejects(many, "lights", "at most 1024"));
+    json not_array = base_job();
+    not_array["lights"] = {{"type", "point"}};
+    EXPECT_TRUE(rejects(not_array, "lights", "array"));
 }
 
 TEST(JobErrors, DescribeJoinsPathAndMessage) {

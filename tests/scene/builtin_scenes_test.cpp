@@ -1,4 +1,5 @@
 #include "core/scene/builtin_scenes.h"
+#include "core/scene/scene_lighting.h"
 
 #include <gtest/gtest.h>
 
@@ -225,7 +226,7 @@ TEST(BuiltinScenes, NamesAreListedAndUnique) {
     const std::set<std::string> unique(names.begin(), names.end());
     EXPECT_EQ(unique.size(), names.size());
     for (const char* expected : {"cornell-box", "cornell-box-diffuse", "caustic", "caustic-area",
-                                 "furnace", "spheres-room"}) {
+                                 "furnace", "spheres-room", "sunlit-room"}) {
         EXPECT_TRUE(unique.contains(expected)) << expected;
     }
 }
@@ -245,9 +246,7 @@ TEST(BuiltinScenes, EveryBuiltinBuildsValidatesAndHasOneCameraAndLight) {
         ASSERT_EQ(scene->cameras.size(), 1u) << name;
         EXPECT_EQ(scene->cameras[0].aspect, 0.0f) << name;
         EXPECT_GT(glm::length(scene->cameras[0].look_at - scene->cameras[0].position), 0.0f);
-        bool emissive = !scene->lights.empty();
-        for (uint32_t m : scene->triangle_materials) emissive |= scene->materials[m].is_emissive();
-        EXPECT_TRUE(emissive) << name << " has no light";
+        EXPECT_TRUE(scene_emits_light(*scene)) << name << " has no light";
         for (size_t i = 0; i < scene->triangles.size(); ++i) {
             ASSERT_GT(scene->triangle_area(static_cast<uint32_t>(i)), 0.0f)
                 << name << ": degenerate triangle " << i;

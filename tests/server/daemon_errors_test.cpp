@@ -186,6 +186,36 @@ TEST_F(DaemonErrors, BadJobsAndUploadsGetProblemsAndTheDaemonKeepsServing) {
     EXPECT_EQ(daemon.stop(), 0) << daemon.log();
 }
 
+TEST_F(DaemonErrors, LightingThatCannotWorkIsRefusedAtSubmission) {
+    const fs::path root = dir_.path() / "scenes";
+    fs::create_directories(root);
+    fs::copy_file(fs::path(PHOTOND_TEST_DATA_DIR) / "gltf" / "texture.gltf", root / "dark.gltf");
+    write_file(dir_.path() / "outside.exr", "not read");
+    fs::create_symlink(dir_.path() / "outside.exr", root / "escape.exr");
+    Daemon daemon(dir_.path() / "cache", {"--scene-root", root.string()});
+    ASSERT_TRUE(daemon.started()) << daemon.log();
+    const HttpClient client = daemon.client();
+    const json dark = with(kSmallJob, "/scene", {{"path", "dark.gltf"}});
+    // No light in the scene, none from the job, and the default environment turned off.
+    expect_problem(client, client.post("/v1/jobs", with(dark, "/environment", nullptr).dump()), 422,
+                   "environment", "\"lights\"");
+    expect_problem(client,
+                   client.post("/v1/jobs", with(dark, "/environment", {{"image", "missing.exr"}}).dump()),
+                   422, "environment.image", "missing.exr");
+    expect_problem(client,
+                   client.post("/v1/jobs", with(dark, "/environment", {{"image", "escape.exr"}}).dump()),
+                   422, "environment.image", "outside the scene root");
+    // With a light from the job the same scene renders, and by default under the white sky.
+    json lit = with(dark, "/environment", nullptr);
+    lit["lights"] = json::array({{{"type", "point"}, {"position", {0, 0, 2}}, {"intensity", 5}}});
+    for (const json& job : {lit, dark}) {
+        const HttpResponse accepted = client.post("/v1/jobs", job.dump());
+        ASSERT_EQ(accepted.status, 202) << accepted.body;
+        const json done = wait_for_status(client, accepted.json_body().at("id"), is_terminal_state);
+        EXPECT_EQ(done.at("state"), "done") << done.dump();
+    }
+}
+
 TEST_F(DaemonErrors, FullQueueAnswers429WithRetryAfter) {
     Daemon daemon(dir_.path() / "cache", {"--max-queued", "1"});
     ASSERT_TRUE(daemon.started()) << daemon.log();

@@ -10,6 +10,10 @@
 
 #include "core/image/exr_io.h"
 
+#ifndef PHOTOND_TEST_DATA_DIR
+#error "PHOTOND_TEST_DATA_DIR must be defined"
+#endif
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -109,6 +113,99 @@ TEST_F(PhotondRender, BadInputGetsAClearErrorNamingTheField) {
     EXPECT_NE(r.exit_code, 0);
     EXPECT_NE(r.output.find("missing.gltf"), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(dir_ / "x.exr"));
+}
+
+/// The mean of an EXR's beauty pixels (every one finite).
+photond::Color mean_of(const fs::path& path) {
+    const auto image = photond::read_exr(path);
+    EXPECT_TRUE(image.has_value()) << (image ? "" : image.error().message);
+    if (!image) return photond::Color(0.0f);
+    photond::DVec3 sum(0.0);
+    for (const auto& c : image->beauty.pixels()) {
+        EXPECT_TRUE(photond::is_finite(c));
+        sum += photond::DVec3(c);
+    }
+    return photond::Color(sum / static_cast<double>(image->beauty.pixel_count()));
+}
+
+const fs::path kLightlessScene = fs::path(PHOTOND_TEST_DATA_DIR) / "gltf" / "texture.gltf";
+
+TEST_F(PhotondRender, SceneWithoutLightRendersUnderTheDefaultEnvironmentAndSaysSo) {
+    const std::string common = "render " + kLightlessScene.string() + " --width 32 --height 32 --spp 2 ";
+    const auto r = run(common + "-o " + (dir_ / "a.exr").string() + " --stats-json " + (dir_ / "s.json").string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("default: a uniform white environment"), std::string::npos) << r.output;
+    EXPECT_GT(photond::max_component(mean_of(dir_ / "a.exr")), 0.1f);
+    const auto stats = nlohmann::json::parse(read_file(dir_ / "s.json"));
+    EXPECT_EQ(stats.at("lighting").at("environment"), "default");
+    EXPECT_EQ(stats.at("plan").at(0).at("pass"), "environment");
+    EXPECT_EQ(stats.at("plan").at(0).at("enabled"), true);
+
+    // Turned off, the job fails and says what to add.
+    const auto off = run(common + "--set environment=null -o " + (dir_ / "b.exr").string());
+    EXPECT_NE(off.exit_code, 0);
+    EXPECT_NE(off.output.find("no light"), std::string::npos) << off.output;
+    EXPECT_NE(off.output.find("\"lights\""), std::string::npos) << off.output;
+    EXPECT_FALSE(fs::exists(dir_ / "b.exr"));
+
+    // A light from the job lights it instead, and the default stays off.
+    const auto lit = run(common + "--set 'lights=[{\"type\": \"directional\", \"direction\": [0, 0, -1], "
+                                  "\"irradiance\": 3}]' --integrator direct -o " +
+                         (dir_ / "c.exr").string() + " --stats-json " + (dir_ / "c.json").string());
+    ASSERT_EQ(lit.exit_code, 0) << lit.output;
+    const auto lit_stats = nlohmann::json::parse(read_file(dir_ / "c.json"));
+    EXPECT_EQ(lit_stats.at("lighting").at("job_lights"), 1);
+    EXPECT_EQ(lit_stats.at("lighting").at("environment"), "");
+    EXPECT_GT(photond::max_component(mean_of(dir_ / "c.exr")), 0.0f);
+}
+
+/// A Radiance RGBE file of one row of `width` texels of grey 0.5 (uncompressed: rows under 8
+/// texels are never run-length encoded).
+void write_grey_hdr(const fs::path& path, int width) {
+    std::ofstream out(path, std::ios::binary);
+    out << "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X " << width << "\n";
+    for (int i = 0; i < width; ++i) out << char(128) << char(128) << char(128) << char(128);  // 0.5 each
+}
+
+TEST_F(PhotondRender, EnvironmentImagesComeFromTheSceneRootOnly) {
+    // An EXR sky of one colour: camera rays that miss the scene see exactly it.
+    photond::ImageLayers sky;
+    sky.beauty = photond::Image(4, 2);
+    for (auto& c : sky.beauty.pixels()) c = photond::Color(0.25f, 0.5f, 1.0f);
+    ASSERT_TRUE(photond::write_exr(dir_ / "sky.exr", sky, {photond::ExrPixelType::Float, 32}).is_ok());
+    write_grey_hdr(dir_ / "grey.hdr", 4);
+    fs::copy_file(kLightlessScene, dir_ / "scene.gltf");
+    for (const auto& entry : fs::directory_iterator(kLightlessScene.parent_path())) {
+        if (entry.path().extension() == ".png" || entry.path().extension() == ".bin")
+            fs::copy_file(entry.path(), dir_ / entry.path().filename(), fs::copy_options::skip_existing);
+    }
+    const std::string common = "render " + (dir_ / "scene.gltf").string() +
+                               " --integrator direct --width 16 --height 16 --spp 1 ";
+    for (const auto& [file, expected] : {std::pair<std::string, photond::Color>{"sky.exr", {0.25f, 0.5f, 1.0f}},
+                                         {"grey.hdr", {0.5f, 0.5f, 0.5f}}}) {
+        const auto r = run(common + "--set 'environment={\"image\": \"" + file + "\", \"intensity\": 2}' " +
+                           "--set camera.look_from=[0,0,50] --set camera.look_at=[0,0,100] -o " +
+                           (dir_ / "e.exr").string());
+        ASSERT_EQ(r.exit_code, 0) << r.output;
+        const photond::Color mean = mean_of(dir_ / "e.exr");
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(mean[c], 2.0f * expected[c], 2e-3f) << file;
+    }
+    // Outside the scene root, through a link or not, and missing files are refused by name.
+    const fs::path outside = dir_.parent_path() / ("outside_" + std::to_string(::getpid()) + ".exr");
+    fs::copy_file(dir_ / "sky.exr", outside, fs::copy_options::overwrite_existing);
+    fs::create_symlink(outside, dir_ / "link.exr");
+    auto r = run(common + "--set 'environment={\"image\": \"link.exr\"}' -o " + (dir_ / "x.exr").string());
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_NE(r.output.find("outside the scene root"), std::string::npos) << r.output;
+    r = run(common + "--set 'environment={\"image\": \"none.exr\"}' -o " + (dir_ / "x.exr").string());
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_NE(r.output.find("none.exr"), std::string::npos) << r.output;
+    std::ofstream(dir_ / "broken.hdr") << "#?RADIANCE\nnot really\n";
+    r = run(common + "--set 'environment={\"image\": \"broken.hdr\"}' -o " + (dir_ / "x.exr").string());
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_NE(r.output.find("broken.hdr"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir_ / "x.exr"));
+    fs::remove(outside);
 }
 
 }  // namespace
