@@ -184,7 +184,7 @@ constexpr std::array<std::string_view, 5> kPhotonFields{"global", "caustic", "k_
 constexpr std::array<std::string_view, 1> kGatherFields{"rays"};
 constexpr std::array<std::string_view, 5> kIrradianceCacheFields{
     "enabled", "a", "gradients", "min_spacing_px", "max_spacing_px"};
-constexpr std::array<std::string_view, 2> kOutputFields{"pixel_type", "aovs"};
+constexpr std::array<std::string_view, 3> kOutputFields{"pixel_type", "aovs", "exposure_ev"};
 
 // ----------------------------------------------------------------------------------- scene
 
@@ -374,6 +374,8 @@ void overlay_output(const json& value, OutputSpec& output) {
         }
         output.aovs = std::move(aovs);
     }
+    if (const json* v = fields.find("exposure_ev"))
+        output.exposure_ev = read_number(*v, "output.exposure_ev", limits::kExposureEv);
 }
 
 // --------------------------------------------------------------- photons, gather, the cache
@@ -645,8 +647,14 @@ json output_schema() {
                  {"uniqueItems", true},
                  {"description", "extra EXR layers besides the beauty image"}};
     return object_schema(
-        {{"pixel_type", choice_schema(kPixelTypeNames, "EXR channel type")}, {"aovs", aovs}}, {},
-        "the OpenEXR output");
+        {{"pixel_type", choice_schema(kPixelTypeNames, "EXR channel type")},
+         {"aovs", aovs},
+         {"exposure_ev", number_schema(limits::kExposureEv,
+                                       "exposure of the PNG preview in stops (linear values x "
+                                       "2^exposure_ev, then the ACES filmic curve, then sRGB); "
+                                       "absent: automatic, the log-average luminance mapped to "
+                                       "0.18. The EXR stays linear")}},
+        {}, "the OpenEXR output and its PNG preview");
 }
 
 /// Writes each preset's value of every field as "x-preset-defaults" (and the default preset's as
@@ -757,6 +765,7 @@ nlohmann::json to_json(const Job& job) {
                                     {"min_spacing_px", cache.min_spacing_px},
                                     {"max_spacing_px", cache.max_spacing_px}};
     document["output"] = {{"pixel_type", job.output.pixel_type}, {"aovs", job.output.aovs}};
+    if (job.output.exposure_ev) document["output"]["exposure_ev"] = *job.output.exposure_ev;
     document["priority"] = job.priority;
     document["seed"] = job.seed;
     return document;
