@@ -221,7 +221,11 @@ std::optional<BundleFormat> detect_bundle_format(std::span<const uint8_t> bytes)
                           [](char m, uint8_t b) { return static_cast<uint8_t>(m) == b; });
     };
     if (starts_with(0, std::string_view("PK\x03\x04", 4))) return BundleFormat::Zip;
-    if (starts_with(257, "ustar")) return BundleFormat::Tar;  // POSIX "ustar\0" and GNU "ustar "
+    // POSIX "ustar\0" and GNU "ustar ". A tar header's first 257 bytes hold NUL-terminated
+    // fields, while glTF JSON never holds a NUL, so a .gltf with "ustar" there stays a .gltf.
+    if (starts_with(257, "ustar") &&
+        std::find(bytes.begin(), bytes.begin() + 257, uint8_t{0}) != bytes.begin() + 257)
+        return BundleFormat::Tar;
     if (starts_with(0, "\x1f\x8b")) return BundleFormat::TarGzip;
     return std::nullopt;
 }

@@ -25,7 +25,8 @@ namespace photond::service {
 
 enum class BundleFormat { Zip, Tar, TarGzip };
 
-/// By magic bytes: zip "PK\3\4", tar "ustar" at offset 257, gzip 1f 8b (taken as tar.gz).
+/// By magic bytes: zip "PK\3\4", tar "ustar" at offset 257 (after NUL-terminated header
+/// fields), gzip 1f 8b (taken as tar.gz).
 /// nullopt for anything else (a .glb or a .gltf).
 std::optional<BundleFormat> detect_bundle_format(std::span<const uint8_t> bytes);
 

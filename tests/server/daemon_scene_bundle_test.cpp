@@ -123,6 +123,17 @@ TEST_F(DaemonSceneBundle, ZipTarAndTarGzRenderLikeTheFilesOnDisk) {
     EXPECT_EQ(client.post("/v1/jobs", quad_job({{"id", id}}).dump()).status, 422);
 }
 
+TEST_F(DaemonSceneBundle, AGltfWithUstarAtTheTarMagicsOffsetIsNoTar) {
+    // A self-contained .gltf whose byte 257 starts "ustar" (where a tar has its magic).
+    const std::string gltf = read_file(fs::path(PHOTOND_TEST_DATA_DIR) / "gltf" / "texture.gltf");
+    const std::string text = "{" + std::string(255, ' ') + "\"ustar\": 1," + gltf.substr(1);
+    ASSERT_EQ(text.substr(257, 5), "ustar");
+    const HttpResponse created = daemon_->client().post("/v1/scenes", text);
+    ASSERT_EQ(created.status, 201) << created.body;
+    EXPECT_EQ(created.json_body().at("format"), "gltf");
+    EXPECT_FALSE(created.json_body().contains("bundle"));
+}
+
 TEST_F(DaemonSceneBundle, SandboxRulesAndLimitsAreRefusedByName) {
     const auto files = textured_quad_files();
     using Kind = ArchiveEntry::Kind;
