@@ -78,7 +78,7 @@ public:
     Expected<nlohmann::json> cancel(const std::string& id);
     /// GET /v1/jobs/{id}/image.exr (with ?wait=true: blocks until the job ends).
     Expected<std::string> image(const std::string& id, bool wait);
-    /// POST /v1/scenes with a .glb or self-contained .gltf body.
+    /// POST /v1/scenes with a .glb, a self-contained .gltf or a zip / tar / tar.gz bundle body.
     Expected<nlohmann::json> upload_scene(const std::string& bytes, std::string_view content_type);
 
     /// GET /v1/jobs/{id}/events, calling `on_event` for each event until it returns false or the

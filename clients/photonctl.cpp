@@ -61,7 +61,8 @@ constexpr const char* kUsage =
     "  cancel ID             cancel a queued or running job\n"
     "  fetch ID -o out.exr [--wait]\n"
     "                        save the job's image (--wait: wait for the job to finish)\n"
-    "  scenes upload FILE    upload a .glb or self-contained .gltf; prints the scene id to use\n"
+    "  scenes upload FILE    upload a .glb, a self-contained .gltf or a zip/tar/tar.gz bundle\n"
+    "                        of a .gltf with its files; prints the scene id to use\n"
     "                        as {\"scene\": {\"id\": ...}}\n"
     "\n"
     "The server is --server URL, else $PHOTOND_URL, else http://127.0.0.1:8080. A bearer token\n"
@@ -532,11 +533,15 @@ int command_scenes(ApiClient& api, const Options& options) {
     if (!bytes) return print_error(bytes.error().message);
     std::string extension = fs::path(path).extension().string();
     std::transform(extension.begin(), extension.end(), extension.begin(), ::tolower);
-    // .glb files start with the magic "glTF"; anything else is taken as glTF JSON.
+    // .glb files start with the magic "glTF"; anything else is taken as glTF JSON. (The server
+    // tells bundles and glTF apart by their magic bytes; the type is for proxies and logs.)
     const bool binary =
         extension == ".glb" || (extension != ".gltf" && bytes->rfind("glTF", 0) == 0);
-    Expected<json> answer =
-        api.upload_scene(*bytes, binary ? "model/gltf-binary" : "model/gltf+json");
+    const char* type = binary ? "model/gltf-binary" : "model/gltf+json";
+    if (extension == ".zip") type = "application/zip";
+    if (extension == ".tar") type = "application/x-tar";
+    if (extension == ".gz" || extension == ".tgz") type = "application/gzip";
+    Expected<json> answer = api.upload_scene(*bytes, type);
     if (!answer) return print_error(answer.error().message);
     if (!answer->is_object() || !answer->contains("id"))
         return print_error("the server accepted the scene but sent no id");

@@ -184,7 +184,7 @@ constexpr std::array<std::string_view, 5> kPhotonFields{"global", "caustic", "k_
 constexpr std::array<std::string_view, 1> kGatherFields{"rays"};
 constexpr std::array<std::string_view, 5> kIrradianceCacheFields{
     "enabled", "a", "gradients", "min_spacing_px", "max_spacing_px"};
-constexpr std::array<std::string_view, 2> kOutputFields{"pixel_type", "aovs"};
+constexpr std::array<std::string_view, 3> kOutputFields{"pixel_type", "aovs", "exposure_ev"};
 constexpr std::array<std::string_view, 4> kEnvironmentFields{"color", "image", "intensity",
                                                              "rotation_deg"};
 constexpr std::array<std::string_view, 4> kPointLightFields{"type", "position", "intensity",
@@ -386,6 +386,8 @@ void overlay_output(const json& value, OutputSpec& output) {
         }
         output.aovs = std::move(aovs);
     }
+    if (const json* v = fields.find("exposure_ev"))
+        output.exposure_ev = read_number(*v, "output.exposure_ev", limits::kExposureEv);
 }
 
 // --------------------------------------------------------------- photons, gather, the cache
@@ -788,8 +790,14 @@ json output_schema() {
                  {"uniqueItems", true},
                  {"description", "extra EXR layers besides the beauty image"}};
     return object_schema(
-        {{"pixel_type", choice_schema(kPixelTypeNames, "EXR channel type")}, {"aovs", aovs}}, {},
-        "the OpenEXR output");
+        {{"pixel_type", choice_schema(kPixelTypeNames, "EXR channel type")},
+         {"aovs", aovs},
+         {"exposure_ev", number_schema(limits::kExposureEv,
+                                       "exposure of the PNG preview in stops (linear values x "
+                                       "2^exposure_ev, then the ACES filmic curve, then sRGB); "
+                                       "absent: automatic, the log-average luminance mapped to "
+                                       "0.18. The EXR stays linear")}},
+        {}, "the OpenEXR output and its PNG preview");
 }
 
 json color_schema(std::string description) {
@@ -987,6 +995,7 @@ nlohmann::json to_json(const Job& job) {
                                     {"min_spacing_px", cache.min_spacing_px},
                                     {"max_spacing_px", cache.max_spacing_px}};
     document["output"] = {{"pixel_type", job.output.pixel_type}, {"aovs", job.output.aovs}};
+    if (job.output.exposure_ev) document["output"]["exposure_ev"] = *job.output.exposure_ev;
     const EnvironmentSpec& environment = job.environment;
     switch (environment.kind) {
         case EnvironmentSpec::Kind::Default:

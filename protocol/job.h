@@ -51,6 +51,8 @@ inline constexpr NumberRange kCacheAccuracy{0.0, 1.0, true, false};
 // Record spacing in pixels (Tabellion & Lamorlette 2004); also min_spacing_px <= max_spacing_px.
 inline constexpr NumberRange kCacheSpacingPx{0.0, 1024.0, true, false};
 inline constexpr IntegerRange kPriority{0, 100};
+// Stops of exposure of the PNG preview (2^30: about 1e9, from moonlight to the sun's disc).
+inline constexpr NumberRange kExposureEv{-30.0, 30.0};
 inline constexpr IntegerRange kGltfCameraIndex{0, std::numeric_limits<int32_t>::max()};
 inline constexpr NumberRange kVerticalFovDeg{0.0, 180.0, true, true};
 // Camera coordinates must survive the conversion to the renderer's 32-bit floats.
@@ -147,6 +149,9 @@ struct IrradianceCacheSpec {
 struct OutputSpec {
     std::string pixel_type;         // one of kPixelTypeNames
     std::vector<std::string> aovs;  // from kAovNames, no duplicates, in the order asked
+    // Exposure of the PNG preview in stops (linear values x 2^exposure_ev before the tone curve);
+    // absent: automatic, from the image's log-average luminance. The EXR is not affected.
+    std::optional<double> exposure_ev;
 
     bool operator==(const OutputSpec&) const = default;
 };

@@ -18,7 +18,8 @@ Job make_preset(std::string_view name, std::string integrator, ImageSpec image, 
     job.photons = photons;
     job.gather = gather;
     job.irradiance_cache = irradiance_cache;
-    job.output = OutputSpec{.pixel_type = "half", .aovs = {}};
+    // No preset fixes the preview's exposure: absent means automatic.
+    job.output = OutputSpec{.pixel_type = "half", .aovs = {}, .exposure_ev = std::nullopt};
     job.priority = 50;
     job.seed = 1;
     return job;

@@ -546,10 +546,14 @@ void HttpServer::Impl::job_preview(const Request& req, Response& res) {
 void HttpServer::Impl::upload_scene(const Request& req, Response& res) {
     const std::span<const uint8_t> bytes(reinterpret_cast<const uint8_t*>(req.body.data()),
                                          req.body.size());
-    auto added = services.scenes.add(bytes);
-    if (!added) throw ServiceError(ErrorKind::InvalidField, added.error().message);
-    res.set_header("Location", "/v1/scenes/" + added->info.id);
-    send_json(res, to_json(added->info), added->created ? 201 : 200);
+    auto result = services.scenes.add(bytes);
+    if (const auto* refused = std::get_if<SceneStore::Refused>(&result))
+        throw ServiceError(
+            refused->over_limit ? ErrorKind::PayloadTooLarge : ErrorKind::InvalidField,
+            refused->message);
+    const SceneStore::Added& added = std::get<SceneStore::Added>(result);
+    res.set_header("Location", "/v1/scenes/" + added.info.id);
+    send_json(res, to_json(added.info), added.created ? 201 : 200);
 }
 
 void HttpServer::Impl::list_scenes(const Request&, Response& res) {

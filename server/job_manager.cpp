@@ -7,7 +7,6 @@
 #include <system_error>
 
 #include "core/image/exr_io.h"
-#include "core/image/png_preview.h"
 #include "core/render/tile_renderer.h"
 #include "core/scene/builtin_scenes.h"
 #include "core/util/sha256.h"
@@ -248,6 +247,7 @@ PipelineOptions JobManager::pipeline_options() const {
     options.scene_root = options_.scene_root;
     options.photon_maps = photon_maps_;
     options.scene_lookup = [this](const std::string& id) { return scenes_->lookup(id); };
+    options.bundle_lookup = [this](const std::string& id) { return scenes_->bundle_root(id); };
     return options;
 }
 
@@ -576,7 +576,7 @@ std::vector<uint8_t> JobManager::preview_png(const std::string& id) {
         const auto image = final_image(entry);
         if (!image)
             throw ServiceError(ErrorKind::Internal, "job " + id + ": the image cannot be read");
-        auto png = encode_png_preview(image->beauty);
+        auto png = encode_job_preview(entry->submission.job, image->beauty);
         if (!png) throw ServiceError(ErrorKind::Internal, png.error().message);
         // Made on the first request rather than with every job; kept for the next one.
         (void)write_file_atomically(store_.preview_path(id),
@@ -590,7 +590,7 @@ std::vector<uint8_t> JobManager::preview_png(const std::string& id) {
         const PixelRect rect = *entry->rect_of(index);
         frame.paste(*pixels, rect.x0, rect.y0);
     }
-    auto png = encode_png_preview(frame);
+    auto png = encode_job_preview(job, frame);
     if (!png) throw ServiceError(ErrorKind::Internal, png.error().message);
     return std::move(png).value();
 }

@@ -96,6 +96,14 @@ json scene_info_schema() {
               {"lights", count},
               {"emissive_triangles", count},
               {"cameras", count},
+              {"bundle",
+               {{"type", "string"},
+                {"enum", {"zip", "tar", "tar.gz", "unknown"}},
+                {"description", "bundles only: the archive's format"}}},
+              {"entry",
+               {{"type", "string"},
+                {"description", "bundles only: the glTF file's path inside the bundle"}}},
+              {"files", count},
               {"bounds", {{"type", "object"}}}}}};
 }
 
@@ -199,11 +207,19 @@ json openapi_document() {
     paths["/v1/scenes"] = {
         {"post",
          operation("uploadScene",
-                   "Upload a .glb or a self-contained .gltf (validated by loading it)",
+                   "Upload a .glb, a self-contained .gltf, or a bundle: a zip, tar or tar.gz "
+                   "of a .gltf with its sibling files (buffers, textures, environment images), "
+                   "told apart by magic bytes. A bundle holds exactly one .gltf or .glb at its "
+                   "top level (or in its single top-level folder); only files and directories "
+                   "with relative paths inside the bundle (no '..', no links, no devices). The "
+                   "scene is validated by loading it; its id is the SHA-256 of the uploaded "
+                   "bytes",
                    {{"201", json_response("stored; Location: /v1/scenes/{id}", "SceneInfo")},
                     {"200", json_response("these bytes were already stored", "SceneInfo")},
-                    {"413", problem("request body too large")},
-                    {"422", problem("not a loadable glTF scene: the loader's message")}})},
+                    {"413", problem("request body too large, or a bundle beyond "
+                                    "--max-bundle-mb unpacked or --max-bundle-entries")},
+                    {"422", problem("not a loadable glTF scene, or a bundle entry against the "
+                                    "rules: the message names the entry")}})},
         {"get", operation("listScenes", "The uploaded scenes",
                           {{"200", response("the scenes",
                                             content("application/json",
@@ -217,7 +233,13 @@ json openapi_document() {
         {"content",
          {{"model/gltf-binary",
            {{"schema", {{"type", "string"}, {"contentMediaType", "model/gltf-binary"}}}}},
-          {"model/gltf+json", {{"schema", {{"type", "object"}}}}}}}};
+          {"model/gltf+json", {{"schema", {{"type", "object"}}}}},
+          {"application/zip",
+           {{"schema", {{"type", "string"}, {"contentMediaType", "application/zip"}}}}},
+          {"application/x-tar",
+           {{"schema", {{"type", "string"}, {"contentMediaType", "application/x-tar"}}}}},
+          {"application/gzip",
+           {{"schema", {{"type", "string"}, {"contentMediaType", "application/gzip"}}}}}}}};
     const json scene_id = path_parameter("id", "sha256:<64 hex digits>");
     paths["/v1/scenes/{id}"] = {
         {"get", operation("getScene", "An uploaded scene's size, triangles, lights and cameras",

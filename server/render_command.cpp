@@ -9,9 +9,9 @@
 #include <sstream>
 
 #include "core/image/exr_io.h"
-#include "core/image/png_preview.h"
 #include "protocol/job.h"
 #include "protocol/statistics.h"
+#include "server/atomic_file.h"
 #include "server/render_pipeline.h"
 
 namespace photond::service {
@@ -30,7 +30,9 @@ constexpr const char* kUsage =
     "  --threads N             worker threads (default: every core)\n"
     "  --scene-root DIR        directory that {\"path\": ...} scenes of --job are relative to\n"
     "  -o, --output OUT.exr    the tiled OpenEXR to write\n"
-    "  --preview OUT.png       also write an sRGB PNG preview\n"
+    "  --preview OUT.png       also write an sRGB PNG preview (ACES filmic tone curve)\n"
+    "  --exposure EV           the preview's exposure in stops (output.exposure_ev; default:\n"
+    "                          automatic, the log-average luminance mapped to middle grey)\n"
     "  --stats-json FILE       write the render statistics as JSON\n"
     "  --quiet                 no progress bar and no statistics on stderr\n";
 
@@ -75,6 +77,8 @@ Expected<Arguments> parse_arguments(std::span<const std::string> args) {
             status = as_override("--height", "image.height");
         } else if (arg == "--spp") {
             status = as_override("--spp", "image.spp");
+        } else if (arg == "--exposure") {
+            status = as_override("--exposure", "output.exposure_ev");
         } else if (arg == "--seed") {
             status = as_override("--seed", "seed");
         } else if (arg == "--set") {
@@ -257,7 +261,15 @@ int run_render_command(std::span<const std::string> args) {
         return 1;
     }
     if (!a.preview.empty()) {
-        if (Status st = write_png_preview(a.preview, result->layers.beauty); !st) {
+        auto png = encode_job_preview(*job, result->layers.beauty);
+        if (!png) {
+            std::fprintf(stderr, "photond render: PNG '%s': %s\n", a.preview.c_str(),
+                         png.error().message.c_str());
+            return 1;
+        }
+        if (Status st = write_file_atomically(
+                a.preview, {reinterpret_cast<const char*>(png->data()), png->size()});
+            !st) {
             std::fprintf(stderr, "photond render: %s\n", st.error().message.c_str());
             return 1;
         }

@@ -5,6 +5,7 @@
 #include <chrono>
 
 #include "core/camera/camera.h"
+#include "core/image/png_preview.h"
 #include "core/integrators/direct.h"
 #include "core/integrators/path.h"
 #include "core/integrators/photon_mapping.h"
@@ -414,6 +415,12 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     stats.total_seconds = seconds_since(start);
     result.layers.beauty = std::move(rendered.image);
     return result;
+}
+
+Expected<std::vector<uint8_t>> encode_job_preview(const protocol::Job& job, const Image& image) {
+    std::optional<float> exposure_ev;
+    if (job.output.exposure_ev) exposure_ev = static_cast<float>(*job.output.exposure_ev);
+    return encode_render_preview(image, exposure_ev);
 }
 
 }  // namespace photond::service

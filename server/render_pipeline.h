@@ -82,4 +82,9 @@ Expected<CameraDesc> resolve_camera(const protocol::Job& job, const Scene& scene
 Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<EmbreeDevice> device,
                                  const PipelineOptions& options);
 
+/// The PNG preview of a job's image (encode_render_preview with the job's output.exposure_ev):
+/// every preview, `photond render --preview` and the daemon's preview.png (finished, or the
+/// tiles so far), is made here.
+Expected<std::vector<uint8_t>> encode_job_preview(const protocol::Job& job, const Image& image);
+
 }  // namespace photond::service

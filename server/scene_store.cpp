@@ -1,6 +1,8 @@
 #include "server/scene_store.h"
 
 #include <algorithm>
+#include <fstream>
+#include <random>
 #include <regex>
 #include <system_error>
 
@@ -24,6 +26,8 @@ bool is_glb(std::span<const uint8_t> bytes) {
     return bytes.size() >= 4 && bytes[0] == 'g' && bytes[1] == 'l' && bytes[2] == 'T' &&
            bytes[3] == 'F';
 }
+
+constexpr std::string_view kBundleExtension = ".bundle";
 
 SceneInfo describe(const Scene& scene, const std::string& id, const std::string& format,
                    uint64_t bytes) {
@@ -61,6 +65,9 @@ std::optional<SceneInfo> info_from_json(const json& d) {
         info.lights = d.at("lights").get<uint64_t>();
         info.emissive_triangles = d.at("emissive_triangles").get<uint64_t>();
         info.cameras = d.at("cameras").get<uint64_t>();
+        info.bundle = d.value("bundle", std::string());
+        info.entry = d.value("entry", std::string());
+        info.files = d.value("files", uint64_t{0});
         if (d.contains("bounds")) {
             const auto& lower = d["bounds"].at("min");
             const auto& upper = d["bounds"].at("max");
@@ -73,6 +80,32 @@ std::optional<SceneInfo> info_from_json(const json& d) {
     } catch (const json::exception&) {
         return std::nullopt;
     }
+}
+
+/// The glTF file's format by its magic, as the loader tells them apart.
+std::string format_of_file(const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    char magic[4] = {};
+    in.read(magic, sizeof magic);
+    return in && std::string_view(magic, 4) == "glTF" ? "glb" : "gltf";
+}
+
+/// The loader's message with the bundle's directory taken out, so that it names the entry as the
+/// archive does ("textures/wood.png"), not the server's cache path.
+std::string bundle_relative(std::string message, const fs::path& bundle_dir) {
+    std::error_code ignored;
+    for (const fs::path& root : {bundle_dir, fs::weakly_canonical(bundle_dir, ignored)}) {
+        const std::string prefix = root.string() + "/";
+        for (size_t at = message.find(prefix); at != std::string::npos;
+             at = message.find(prefix, at))
+            message.erase(at, prefix.size());
+    }
+    return message;
+}
+
+std::string random_suffix() {
+    static thread_local std::mt19937_64 random{std::random_device{}()};
+    return std::to_string(random());
 }
 
 }  // namespace
@@ -89,14 +122,21 @@ json to_json(const SceneInfo& info) {
                      {"lights", info.lights},
                      {"emissive_triangles", info.emissive_triangles},
                      {"cameras", info.cameras}};
+    if (!info.bundle.empty()) {
+        document["bundle"] = info.bundle;
+        document["entry"] = info.entry;
+        document["files"] = info.files;
+    }
     if (!info.bounds.empty())
         document["bounds"] = {{"min", vec_json(info.bounds.lower)},
                               {"max", vec_json(info.bounds.upper)}};
     return document;
 }
 
-SceneStore::SceneStore(fs::path directory, size_t loaded_scenes_kept)
-    : directory_(std::move(directory)), loaded_scenes_kept_(loaded_scenes_kept) {
+SceneStore::SceneStore(fs::path directory, BundleLimits bundle_limits, size_t loaded_scenes_kept)
+    : directory_(std::move(directory)),
+      bundle_limits_(bundle_limits),
+      loaded_scenes_kept_(loaded_scenes_kept) {
     std::error_code ignored;
     fs::create_directories(directory_, ignored);
 }
@@ -121,55 +161,147 @@ fs::path SceneStore::metadata_file_of(const std::string& normalized_id) const {
     return directory_ / (hex_of(normalized_id) + ".json");
 }
 
-Expected<SceneStore::Added> SceneStore::add(std::span<const uint8_t> bytes) {
+fs::path SceneStore::bundle_dir_of(const std::string& normalized_id) const {
+    return directory_ / (hex_of(normalized_id) + std::string(kBundleExtension));
+}
+
+std::optional<fs::path> SceneStore::bundle_root(const std::string& id) const {
+    const auto normalized = normalize_id(id);
+    if (!normalized) return std::nullopt;
+    fs::path directory = bundle_dir_of(*normalized);
+    std::error_code error;
+    if (!fs::is_directory(directory, error)) return std::nullopt;
+    return directory;
+}
+
+void SceneStore::remember_loaded(const std::string& id, std::shared_ptr<const Scene> scene) {
+    std::lock_guard lock(mutex_);
+    loaded_.remove_if([&](const auto& entry) { return entry.first == id; });
+    loaded_.emplace_front(id, std::move(scene));
+    if (loaded_.size() > loaded_scenes_kept_) loaded_.pop_back();
+}
+
+std::variant<SceneStore::Added, SceneStore::Refused> SceneStore::add(
+    std::span<const uint8_t> bytes) {
     if (bytes.empty())
-        return Error{"the upload is empty: send a .glb or a self-contained .gltf as the body"};
+        return Refused{false,
+                       "the upload is empty: send a .glb, a self-contained .gltf or a zip, tar "
+                       "or tar.gz bundle as the body"};
     const std::string id = std::string(kIdPrefix) + sha256_hex(bytes);
     if (auto existing = info(id)) return Added{*existing, false};
+    if (const auto bundle = detect_bundle_format(bytes)) return add_bundle(bytes, *bundle, id);
 
     const std::string format = is_glb(bytes) ? "glb" : "gltf";
     auto scene = load_gltf_memory(bytes, "upload." + format);
-    if (!scene) return scene.error();
+    if (!scene) return Refused{false, scene.error().message};
     const SceneInfo scene_info = describe(*scene, id, format, bytes.size());
 
     const fs::path file = directory_ / (hex_of(id) + "." + format);
     if (Status written = write_file_atomically(
             file, {reinterpret_cast<const char*>(bytes.data()), bytes.size()});
         !written)
-        return written.error();
+        return Refused{false, written.error().message};
     const std::string metadata = to_json(scene_info).dump(2) + "\n";
     // The metadata only saves a load on GET; losing it costs nothing but time.
     (void)write_file_atomically(metadata_file_of(id), metadata);
-    {
-        std::lock_guard lock(mutex_);
-        loaded_.emplace_front(id, std::make_shared<const Scene>(std::move(scene).value()));
-        if (loaded_.size() > loaded_scenes_kept_) loaded_.pop_back();
-    }
+    remember_loaded(id, std::make_shared<const Scene>(std::move(scene).value()));
     return Added{scene_info, true};
+}
+
+std::variant<SceneStore::Added, SceneStore::Refused> SceneStore::add_bundle(
+    std::span<const uint8_t> bytes, BundleFormat format, const std::string& id) {
+    // Unpacked and loaded under a temporary name, then renamed into place in one step, so that
+    // no reader ever sees half a bundle.
+    const fs::path temporary =
+        directory_ / (hex_of(id) + std::string(kBundleExtension) + ".tmp-" + random_suffix());
+    auto unpacked = unpack_scene_bundle(bytes, format, temporary, bundle_limits_);
+    if (const auto* error = std::get_if<BundleError>(&unpacked))
+        return Refused{error->over_limit, error->message};
+    const UnpackedBundle& bundle = std::get<UnpackedBundle>(unpacked);
+    auto discard = [&](std::string message) {
+        std::error_code ignored;
+        fs::remove_all(temporary, ignored);
+        return Refused{false, std::move(message)};
+    };
+
+    GltfLoadOptions options;
+    options.bundle_root = temporary;
+    auto scene = load_gltf_file(temporary / bundle.scene_file, options);
+    if (!scene) return discard(bundle_relative(scene.error().message, temporary));
+    SceneInfo scene_info =
+        describe(*scene, id, format_of_file(temporary / bundle.scene_file), bytes.size());
+    scene_info.bundle = std::string(to_string(format));
+    scene_info.entry = bundle.scene_file.generic_string();
+    scene_info.files = bundle.files;
+
+    std::error_code error;
+    fs::rename(temporary, bundle_dir_of(id), error);
+    if (error) {
+        // Another upload of the same bytes (maybe by another daemon) got there first.
+        const bool stored = fs::is_directory(bundle_dir_of(id));
+        Refused refused = discard("the bundle cannot be stored: " + error.message());
+        if (!stored) return refused;
+    }
+    (void)write_file_atomically(metadata_file_of(id), to_json(scene_info).dump(2) + "\n");
+    remember_loaded(id, std::make_shared<const Scene>(std::move(scene).value()));
+    return Added{scene_info, true};
+}
+
+Expected<std::pair<Scene, SceneInfo>> SceneStore::load_stored(
+    const std::string& normalized_id) const {
+    if (const auto file = file_of(normalized_id)) {
+        auto bytes = read_file_bytes(*file);
+        if (!bytes) return Error{"scene.id: " + file->string() + " cannot be read"};
+        auto scene = load_gltf_memory(*bytes, file->filename().string());
+        if (!scene) return scene.error();
+        SceneInfo info = describe(*scene, normalized_id,
+                                  file->extension() == ".glb" ? "glb" : "gltf", bytes->size());
+        return std::pair{std::move(scene).value(), std::move(info)};
+    }
+    const fs::path bundle = bundle_dir_of(normalized_id);
+    std::error_code error;
+    if (!fs::is_directory(bundle, error))
+        return Error{"scene.id: no uploaded scene " + normalized_id +
+                     " (upload it with POST /v1/scenes)"};
+    auto entry = find_bundle_scene(bundle);
+    if (const auto* refused = std::get_if<BundleError>(&entry))
+        return Error{"scene.id: " + normalized_id + ": " + refused->message};
+    const fs::path& scene_file = std::get<fs::path>(entry);
+    GltfLoadOptions options;
+    options.bundle_root = bundle;
+    auto scene = load_gltf_file(bundle / scene_file, options);
+    if (!scene) return Error{bundle_relative(scene.error().message, bundle)};
+    // Without its metadata (lost, or written by another daemon) the archive's own size and
+    // format are unknown: the archive is not kept.
+    SceneInfo info = describe(*scene, normalized_id, format_of_file(bundle / scene_file), 0);
+    info.bundle = "unknown";
+    info.entry = scene_file.generic_string();
+    for (fs::recursive_directory_iterator it(bundle, error), end; !error && it != end;
+         it.increment(error))
+        if (it->is_regular_file(error)) ++info.files;
+    return std::pair{std::move(scene).value(), std::move(info)};
 }
 
 bool SceneStore::contains(const std::string& id) const {
     const auto normalized = normalize_id(id);
-    return normalized && file_of(*normalized).has_value();
+    std::error_code error;
+    return normalized && (file_of(*normalized).has_value() ||
+                          fs::is_directory(bundle_dir_of(*normalized), error));
 }
 
 std::optional<SceneInfo> SceneStore::info(const std::string& id) {
     const auto normalized = normalize_id(id);
     if (!normalized) return std::nullopt;
-    const auto file = file_of(*normalized);
-    if (!file) return std::nullopt;
+    if (!contains(*normalized)) return std::nullopt;
     if (auto bytes = read_file_bytes(metadata_file_of(*normalized))) {
         const json document = json::parse(bytes->begin(), bytes->end(), nullptr, false);
         if (!document.is_discarded())
             if (auto info = info_from_json(document); info && info->id == *normalized) return info;
     }
     // No metadata (stored by another daemon, or lost): load the scene to describe it.
-    auto bytes = read_file_bytes(*file);
-    if (!bytes) return std::nullopt;
-    auto scene = load_gltf_memory(*bytes, file->filename().string());
-    if (!scene) return std::nullopt;
-    return describe(*scene, *normalized, file->extension() == ".glb" ? "glb" : "gltf",
-                    bytes->size());
+    auto loaded = load_stored(*normalized);
+    if (!loaded) return std::nullopt;
+    return std::move(loaded->second);
 }
 
 bool SceneStore::remove(const std::string& id) {
@@ -180,8 +312,13 @@ bool SceneStore::remove(const std::string& id) {
         std::lock_guard lock(mutex_);
         loaded_.remove_if([&](const auto& entry) { return entry.first == *normalized; });
     }
-    if (!file) return false;
     std::error_code error;
+    if (!file) {
+        const fs::path bundle = bundle_dir_of(*normalized);
+        if (!fs::is_directory(bundle, error)) return false;
+        fs::remove(metadata_file_of(*normalized), error);
+        return fs::remove_all(bundle, error) > 0;
+    }
     fs::remove(metadata_file_of(*normalized), error);
     return fs::remove(*file, error);
 }
@@ -193,7 +330,9 @@ std::vector<SceneInfo> SceneStore::list() {
     for (fs::directory_iterator it(directory_, error), end; !error && it != end;
          it.increment(error)) {
         const fs::path& path = it->path();
-        if (path.extension() != ".glb" && path.extension() != ".gltf") continue;
+        if (path.extension() != ".glb" && path.extension() != ".gltf" &&
+            path.extension() != kBundleExtension)
+            continue;
         if (auto id = normalize_id(path.stem().string())) ids.push_back(*id);
     }
     std::sort(ids.begin(), ids.end());
@@ -215,9 +354,13 @@ Expected<std::shared_ptr<const Scene>> SceneStore::lookup(const std::string& id)
         }
     }
     const auto file = file_of(*normalized);
-    if (!file)
-        return Error{"scene.id: no uploaded scene " + *normalized +
-                     " (upload it with POST /v1/scenes)"};
+    if (!file) {
+        auto bundle = load_stored(*normalized);  // a bundle, or the "no uploaded scene" error
+        if (!bundle) return bundle.error();
+        auto shared = std::make_shared<const Scene>(std::move(bundle->first));
+        remember_loaded(*normalized, shared);
+        return shared;
+    }
     auto bytes = read_file_bytes(*file);
     if (!bytes) return Error{"scene.id: " + file->string() + " cannot be read"};
     auto scene = load_gltf_memory(*bytes, *normalized);

@@ -43,6 +43,9 @@ constexpr const char* kUsage =
     "  --scene-root DIR        the only directory {\"path\": ...} scenes may be read from\n"
     "                          (default: the current directory)\n"
     "  --max-body-mb N         largest request body, e.g. a scene upload (default 256)\n"
+    "  --max-bundle-mb N       largest unpacked size of an uploaded zip/tar scene bundle\n"
+    "                          (default 1024)\n"
+    "  --max-bundle-entries N  most entries of an uploaded scene bundle (default 4096)\n"
     "  --http-threads N        connections served at once; each open stream holds one (default "
     "128)\n"
     "  --access-log            log every request on stderr\n"
@@ -60,6 +63,7 @@ struct Arguments {
     fs::path token_file;
     fs::path scene_root;
     size_t max_body_mb = 256;
+    BundleLimits bundle_limits;
     int http_threads = 128;
     bool access_log = false;
 };
@@ -131,6 +135,14 @@ Expected<Arguments> parse_arguments(std::span<const std::string> args) {
             auto n = parse_count<size_t>(arg, *v, 1, size_t{1} << 20);
             if (!n) return n.error();
             a.max_body_mb = *n;
+        } else if (arg == "--max-bundle-mb") {
+            auto n = parse_count<uint64_t>(arg, *v, 1, uint64_t{1} << 24);
+            if (!n) return n.error();
+            a.bundle_limits.max_unpacked_bytes = *n << 20;
+        } else if (arg == "--max-bundle-entries") {
+            auto n = parse_count<uint64_t>(arg, *v, 1, 100'000'000);
+            if (!n) return n.error();
+            a.bundle_limits.max_entries = *n;
         } else if (arg == "--http-threads") {
             auto n = parse_count<int>(arg, *v, 4, 4096);
             if (!n) return n.error();
@@ -258,7 +270,7 @@ int run_serve_command(std::span<const std::string> args) {
     }
     Metrics metrics;
     PhotonMapCache photon_maps(a.cache_dir / "photon-maps", a.photon_cache_mb << 20, log_line);
-    SceneStore scenes(a.cache_dir / "scenes");
+    SceneStore scenes(a.cache_dir / "scenes", a.bundle_limits);
     JobManagerOptions job_options;
     job_options.cache_dir = a.cache_dir;
     job_options.scene_root = a.scene_root;

@@ -265,13 +265,18 @@ class PhotondClient:
     # -- scenes --------------------------------------------------------------------------------
 
     def upload_scene(self, path: str) -> str:
-        """POST /v1/scenes with a .glb or self-contained .gltf file; returns the scene's
-        content id ("sha256:..."), used as {"scene": {"id": ...}}."""
+        """POST /v1/scenes with a .glb, a self-contained .gltf, or a zip / tar / tar.gz bundle
+        of a .gltf with its files; returns the scene's content id ("sha256:..."), used as
+        {"scene": {"id": ...}}."""
         with open(path, "rb") as scene_file:
             body = scene_file.read()
         extension = os.path.splitext(path)[1].lower()
         binary = extension == ".glb" or (extension != ".gltf" and body[:4] == b"glTF")
         content_type = "model/gltf-binary" if binary else "model/gltf+json"
+        # The server tells bundles apart by their magic bytes; the type is for proxies and logs.
+        bundle_types = {".zip": "application/zip", ".tar": "application/x-tar",
+                        ".gz": "application/gzip", ".tgz": "application/gzip"}
+        content_type = bundle_types.get(extension, content_type)
         answer = self._json_body("POST", "/v1/scenes", body, content_type)
         if not isinstance(answer, dict) or "id" not in answer:
             raise PhotondError(0, "the server accepted the scene but sent no id")

@@ -134,5 +134,109 @@ TEST_F(PngPreviewTest, ZeroSizeAndBadPathAreErrors) {
     EXPECT_NE(bad_path.error().message.find("x.png"), std::string::npos);
 }
 
+// ------------------------------------------------------------------------- render previews
+
+/// The one grey code of a PNG whose pixels all share it, or -1.
+int uniform_code(const DecodedPng& png) {
+    if (png.rgb.empty()) return -1;
+    for (uint8_t code : png.rgb)
+        if (code != png.rgb[0]) return -1;
+    return png.rgb[0];
+}
+
+TEST(FilmicToneCurveTest, MonotonicFromZeroAndBelowOne) {
+    EXPECT_EQ(filmic_tone_curve(0.0f), 0.0f);
+    EXPECT_EQ(filmic_tone_curve(-1.0f), 0.0f);
+    EXPECT_EQ(filmic_tone_curve(std::numeric_limits<float>::quiet_NaN()), 0.0f);
+    // Narkowicz's ACES fit at middle grey and at 1.
+    EXPECT_NEAR(filmic_tone_curve(0.18f), 0.2669f, 1e-4f);
+    EXPECT_NEAR(filmic_tone_curve(1.0f), 0.8038f, 1e-4f);
+    float previous = 0.0f;
+    for (float x = 1e-4f; x < 1e6f; x *= 1.01f) {
+        const float y = filmic_tone_curve(x);
+        ASSERT_GE(y, previous) << x;  // monotonic
+        ASSERT_LE(y, 1.0f) << x;      // large values stay displayable
+        if (x < 7.0f) {
+            ASSERT_GT(y, previous) << x;  // strictly, below the white point
+        }
+        previous = y;
+    }
+    EXPECT_LT(filmic_tone_curve(4.0f), 1.0f);
+    EXPECT_EQ(filmic_tone_curve(1e30f), 1.0f);
+    EXPECT_EQ(filmic_tone_curve(std::numeric_limits<float>::infinity()), 1.0f);
+    // The curve compresses highlights: 1 maps well below the clamp of a linear preview.
+    EXPECT_LT(preview_srgb8(1.0f, 1.0f), linear_to_srgb8(1.0f));
+}
+
+TEST(AutomaticExposureTest, UniformImagesOfAnyRadianceGiveTheSameGrey) {
+    // log2(0.18 / L): the image's luminance lands on middle grey.
+    EXPECT_NEAR(automatic_exposure_ev(Image(8, 8, Color(1.0f))), std::log2(0.18f), 1e-5f);
+    int expected = -1;
+    for (float radiance : {1e-3f, 1.0f, 1e4f}) {
+        Expected<std::vector<uint8_t>> bytes = encode_render_preview(Image(16, 8, Color(radiance)));
+        ASSERT_TRUE(bytes) << bytes.error().message;
+        const int code = uniform_code(decode_png(*bytes));
+        // Middle grey through the curve: sRGB(f(0.18)) = sRGB(0.267) = 141.
+        EXPECT_EQ(code, 141) << radiance;
+        if (expected < 0) expected = code;
+        EXPECT_EQ(code, expected) << radiance;
+    }
+}
+
+TEST(AutomaticExposureTest, RobustToHotPixelsNonFiniteValuesAndBlack) {
+    Image image(64, 64, Color(0.5f));
+    for (int i = 0; i < 5; ++i) image.at(7 * i, 3) = Color(1e30f);  // fireflies
+    image.at(1, 1) = Color(std::nanf(""));
+    image.at(2, 1) = Color(std::numeric_limits<float>::infinity());
+    image.at(3, 1) = Color(0.0f);  // black (e.g. a tile not rendered yet) is left out too
+    const float uniform = automatic_exposure_ev(Image(64, 64, Color(0.5f)));
+    EXPECT_FLOAT_EQ(automatic_exposure_ev(image), uniform);
+    Expected<std::vector<uint8_t>> bytes = encode_render_preview(image);
+    ASSERT_TRUE(bytes);
+    const DecodedPng png = decode_png(*bytes);
+    EXPECT_EQ(png.at(10, 10, 1), 141);
+    EXPECT_EQ(png.at(0, 3, 0), 255);  // a firefly is white
+    EXPECT_EQ(png.at(1, 1, 0), 0);    // NaN is black
+
+    // All black: exposure 0, a black PNG, no NaN anywhere.
+    EXPECT_EQ(automatic_exposure_ev(Image(4, 4)), 0.0f);
+    Expected<std::vector<uint8_t>> black = encode_render_preview(Image(4, 4));
+    ASSERT_TRUE(black) << black.error().message;
+    EXPECT_EQ(uniform_code(decode_png(*black)), 0);
+    // Far beyond the job field's range, still finite.
+    EXPECT_EQ(automatic_exposure_ev(Image(2, 2, Color(1e-40f))), kMaxAutomaticExposureEv);
+}
+
+TEST(RenderPreviewTest, ExposureDoublesTheLinearValueBeforeTheCurve) {
+    Image image(3, 1);
+    image.at(0, 0) = Color(0.05f, 0.2f, 0.7f);
+    image.at(1, 0) = Color(0.01f, 1.5f, 3.0f);
+    image.at(2, 0) = Color(0.3f);
+    Image doubled = image;
+    for (Color& c : doubled.pixels()) c = c * 2.0f;
+    Expected<std::vector<uint8_t>> plus_one = encode_render_preview(image, 1.0f);
+    Expected<std::vector<uint8_t>> twice = encode_render_preview(doubled, 0.0f);
+    ASSERT_TRUE(plus_one && twice);
+    EXPECT_EQ(*plus_one, *twice);
+    const DecodedPng png = decode_png(*plus_one);
+    EXPECT_EQ(png.at(2, 0, 0), preview_srgb8(0.6f, 1.0f));
+    EXPECT_EQ(png.at(1, 0, 2), preview_srgb8(6.0f, 1.0f));
+    // Another exposure gives another picture; an explicit exposure is not the automatic one.
+    EXPECT_NE(*encode_render_preview(image, 0.0f), *plus_one);
+    EXPECT_NE(*encode_render_preview(image), *encode_render_preview(image, 0.0f));
+    EXPECT_FALSE(encode_render_preview(image, std::numeric_limits<float>::infinity()));
+    EXPECT_FALSE(encode_render_preview(Image()));
+}
+
+TEST_F(PngPreviewTest, RenderPreviewIsWrittenAtomically) {
+    const Image image(4, 4, Color(2.0f));
+    const Status status = write_render_preview(dir_ / "render.png", image, -3.0f);
+    ASSERT_TRUE(status) << status.error().message;
+    EXPECT_FALSE(fs::exists(dir_ / "render.png.tmp"));
+    EXPECT_EQ(uniform_code(decode_png(read_bytes(dir_ / "render.png"))),
+              preview_srgb8(2.0f, 0.125f));
+    EXPECT_FALSE(write_render_preview(dir_ / "missing_dir" / "x.png", image));
+}
+
 }  // namespace
 }  // namespace photond

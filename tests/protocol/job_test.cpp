@@ -161,7 +161,7 @@ Job full_job() {
     job.photons = PhotonSpec{123, 456, 9, 999, 0xfedcba9876543210ull};
     job.gather.rays = 333;
     job.irradiance_cache = IrradianceCacheSpec{false, 0.1234567890123, false, 0.1, 1024.0};
-    job.output = OutputSpec{"float", {"depth", "direct", "normal"}};
+    job.output = OutputSpec{"float", {"depth", "direct", "normal"}, -2.5};
     job.environment = EnvironmentSpec{.kind = EnvironmentSpec::Kind::Image,
                                       .image = "skies/noon.hdr",
                                       .intensity = 2.5,
@@ -548,6 +548,29 @@ TEST(JobValidation, AovsAreKnownAndDistinct) {
     document["output"]["aovs"] = all;
     EXPECT_EQ(parsed(document).output.aovs, all);
     EXPECT_TRUE(parsed(job_with({"output.aovs=[]"})).output.aovs.empty());
+}
+
+TEST(JobValidation, ExposureIsANumberInRangeOrAbsentForAutomatic) {
+    EXPECT_FALSE(parsed(base_job()).output.exposure_ev);  // automatic
+    EXPECT_FALSE(to_json(parsed(base_job()))["output"].contains("exposure_ev"));
+    EXPECT_EQ(parsed(job_with({"output.exposure_ev=1.5"})).output.exposure_ev, 1.5);
+    EXPECT_EQ(parsed(job_with({"output.exposure_ev=-30"})).output.exposure_ev, -30.0);
+    EXPECT_EQ(parsed(job_with({"output.exposure_ev=30"})).output.exposure_ev, 30.0);
+    EXPECT_EQ(to_json(parsed(job_with({"output.exposure_ev=2"})))["output"]["exposure_ev"], 2.0);
+    EXPECT_TRUE(rejects(job_with({"output.exposure_ev=30.5"}), "output.exposure_ev",
+                        "must be in [-30, 30]"));
+    EXPECT_TRUE(rejects(job_with({"output.exposure_ev=-31"}), "output.exposure_ev", "[-30, 30]"));
+    EXPECT_TRUE(rejects(job_with({"output.exposure_ev=bright"}), "output.exposure_ev",
+                        "must be a number"));
+    EXPECT_TRUE(rejects(job_with({"output.exposure_ev=NaN"}), "output.exposure_ev"));
+    EXPECT_TRUE(rejects(job_with({"output.exposure_ev=true"}), "output.exposure_ev"));
+    EXPECT_TRUE(rejects(job_with({"output.exposure_ev=null"}), "output.exposure_ev"));
+    EXPECT_TRUE(rejects(job_with({"output.exposure_ev=[1]"}), "output.exposure_ev"));
+    json document = base_job();
+    document["output"]["exposure_ev"] = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_TRUE(rejects(document, "output.exposure_ev"));
+    document["output"]["exposure_ev"] = std::numeric_limits<double>::infinity();
+    EXPECT_TRUE(rejects(document, "output.exposure_ev"));
 }
 
 TEST(JobValidation, PriorityLimits) {

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "core/image/exr_io.h"
+#include "core/image/png_preview.h"
 #include "protocol/job.h"
 #include "tests/server/daemon_harness.h"
 
@@ -155,6 +156,54 @@ TEST_F(DaemonApi, SubmitEventsTilesAndImageEqualToPhotondRender) {
     EXPECT_EQ(list.at("jobs")[0].at("id"), id);
 
     EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+}
+
+TEST_F(DaemonApi, PreviewPngHonoursTheJobsExposure) {
+    Daemon daemon(dir_.path() / "cache");
+    ASSERT_TRUE(daemon.started()) << daemon.log();
+    const HttpClient client = daemon.client();
+    // Float pixels, so that the EXR fetched holds exactly the values the preview is made from.
+    json job = {{"scene", {{"builtin", "cornell-box"}}},
+                {"integrator", "direct"},
+                {"image", {{"width", 32}, {"height", 24}, {"spp", 1}, {"tile_size", 16}}},
+                {"output", {{"pixel_type", "float"}}}};
+    std::string id;
+    auto preview_of = [&](const json& submitted_job, std::string* exr) {
+        const HttpResponse submitted = client.post("/v1/jobs", submitted_job.dump());
+        EXPECT_EQ(submitted.status, 202) << submitted.body;
+        id = submitted.json_body().value("id", "");
+        *exr = client.get("/v1/jobs/" + id + "/image.exr?wait=true").body;
+        const HttpResponse preview = client.get("/v1/jobs/" + id + "/preview.png");
+        EXPECT_EQ(preview.status, 200);
+        EXPECT_EQ(preview.header("content-type"), "image/png");
+        return preview.body;
+    };
+    std::string automatic_exr, exposed_exr;
+    const std::string automatic = preview_of(job, &automatic_exr);
+    job["output"]["exposure_ev"] = 2.5;
+    const std::string exposed = preview_of(job, &exposed_exr);
+    EXPECT_EQ(automatic_exr, exposed_exr);  // the EXR stays linear radiance
+    EXPECT_NE(automatic, exposed);
+
+    const auto image = decode_exr(bytes_of(exposed_exr));
+    ASSERT_TRUE(image.has_value()) << image.error().message;
+    for (const auto& [png, exposure] :
+         {std::pair{exposed, std::optional<float>(2.5f)}, std::pair{automatic, std::optional<float>()}}) {
+        auto expected = encode_render_preview(image->beauty, exposure);
+        ASSERT_TRUE(expected);
+        EXPECT_TRUE(png == std::string(expected->begin(), expected->end()))
+            << "exposure " << (exposure ? std::to_string(*exposure) : "automatic");
+    }
+    // Asked again (now from the file the daemon keeps): the same bytes.
+    EXPECT_EQ(client.get("/v1/jobs/" + id + "/preview.png").body, exposed);
+
+    // The field is validated by name.
+    for (const json& bad : {json(31), json("bright"), json(nullptr), json::array({1})}) {
+        job["output"]["exposure_ev"] = bad;
+        const HttpResponse refused = client.post("/v1/jobs", job.dump());
+        EXPECT_EQ(refused.status, 422) << bad;
+        EXPECT_EQ(refused.json_body().value("field", ""), "output.exposure_ev") << refused.body;
+    }
 }
 
 TEST_F(DaemonApi, LastEventIdResumesAfterThatEvent) {

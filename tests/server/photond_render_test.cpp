@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/image/exr_io.h"
+#include "core/image/png_preview.h"
 
 #ifndef PHOTOND_TEST_DATA_DIR
 #error "PHOTOND_TEST_DATA_DIR must be defined"
@@ -206,6 +207,39 @@ TEST_F(PhotondRender, EnvironmentImagesComeFromTheSceneRootOnly) {
     EXPECT_NE(r.output.find("broken.hdr"), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(dir_ / "x.exr"));
     fs::remove(outside);
+}
+
+TEST_F(PhotondRender, PreviewTakesTheExposureAndTheFilmicCurve) {
+    const std::string common =
+        "render builtin:cornell-box --integrator direct --spp 1 --width 32 --height 24 --quiet "
+        "--set output.pixel_type=float -o " + (dir_ / "a.exr").string() + " --preview ";
+    const auto automatic = run(common + (dir_ / "auto.png").string());
+    const auto flag = run(common + (dir_ / "flag.png").string() + " --exposure -1.5");
+    const auto set = run(common + (dir_ / "set.png").string() + " --set output.exposure_ev=-1.5");
+    ASSERT_EQ(automatic.exit_code, 0) << automatic.output;
+    ASSERT_EQ(flag.exit_code, 0) << flag.output;
+    ASSERT_EQ(set.exit_code, 0) << set.output;
+    const auto image = photond::read_exr(dir_ / "a.exr");  // float: the very pixels rendered
+    ASSERT_TRUE(image.has_value()) << image.error().message;
+
+    auto expected = photond::encode_render_preview(image->beauty, -1.5f);
+    ASSERT_TRUE(expected);
+    const std::string manual(expected->begin(), expected->end());
+    EXPECT_EQ(read_file(dir_ / "flag.png"), manual);
+    EXPECT_EQ(read_file(dir_ / "set.png"), manual);
+    auto automatic_png = photond::encode_render_preview(image->beauty);
+    ASSERT_TRUE(automatic_png);
+    EXPECT_EQ(read_file(dir_ / "auto.png"),
+              std::string(automatic_png->begin(), automatic_png->end()));
+    EXPECT_NE(read_file(dir_ / "auto.png"), manual);
+
+    // The field is validated by name, through the flag as through --set.
+    for (const std::string bad : {"--exposure 31", "--exposure bright", "--set output.exposure_ev=NaN"}) {
+        const auto refused = run(common + (dir_ / "bad.png").string() + " " + bad);
+        EXPECT_EQ(refused.exit_code, 2) << bad << ": " << refused.output;
+        EXPECT_NE(refused.output.find("output.exposure_ev"), std::string::npos) << refused.output;
+    }
+    EXPECT_FALSE(fs::exists(dir_ / "bad.png"));
 }
 
 }  // namespace
