@@ -80,6 +80,11 @@ Expected<Environment> load_environment_image(const protocol::Job& job, const Pip
     return environment;
 }
 
+/// Emissive surfaces whose power is below this share of a white sky's (radiance 1 through the
+/// scene's bounding disc) do not keep the default environment away: labels and glowing details
+/// do not light a model.
+constexpr float kEmissiveOnlyShareOfSky = 0.05f;
+
 constexpr const char* kNoLightMessage =
     "the scene has no light and the job turned the default environment off; add \"lights\" (point, "
     "spot, directional or quad) or an \"environment\" ({\"color\": [1, 1, 1]} or {\"image\": "
@@ -244,10 +249,31 @@ Expected<AddedLighting> job_lighting(const protocol::Job& job, const Scene& scen
                 *decision = {"environment", true, "the scene's own: '" + scene.environment->name + "'"};
                 break;
             }
-            if (!job.lights.empty() || scene_emits_light(scene)) {
+            if (!job.lights.empty() || !scene.lights.empty()) {
                 *decision = {"environment", false,
-                             "the scene" + std::string(job.lights.empty() ? "" : " or the job") +
+                             std::string(job.lights.empty() ? "the scene" : "the job") +
                                  " has lights of its own (add \"environment\" to light it from a sky too)"};
+                break;
+            }
+            if (scene_emits_light(scene)) {
+                // Only emissive surfaces: a lamp's glow, a screen, a label. Unless they could
+                // light the scene as well as a sky would, the model is shown under the sky too,
+                // as glTF viewers do.
+                const float own = average(LightSet(scene).total_power());
+                const float radius = std::max(scene.bounds.radius(), 1e-6f);
+                const float sky = 4.0f * kPi * kPi * radius * radius;  // radiance 1 through the scene's disc
+                if (own >= kEmissiveOnlyShareOfSky * sky) {
+                    *decision = {"environment", false,
+                                 "the scene's emissive surfaces light it (" + format_number(own) +
+                                     " W; add \"environment\" to light it from a sky too)"};
+                    break;
+                }
+                lighting.environment = Environment{};
+                lighting.environment->name = "default";
+                decision->reason = "default: a uniform white environment of radiance 1, since the scene's only "
+                                   "light is emissive surfaces of " + format_number(own) + " W, under " +
+                                   format_number(100.0 * kEmissiveOnlyShareOfSky) + " % of what such a sky sends (" +
+                                   format_number(sky) + " W; set \"environment\": null to render by them alone)";
                 break;
             }
             lighting.environment = Environment{};
