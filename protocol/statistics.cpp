@@ -18,6 +18,7 @@ nlohmann::json to_json(const RenderStatistics& s) {
         {"render_seconds", s.render_seconds},
         {"total_seconds", s.total_seconds},
         {"cancelled", s.cancelled},
+        {"warnings", s.warnings},
     };
     if (!s.plan.empty()) {
         nlohmann::json plan = nlohmann::json::array();

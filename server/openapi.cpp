@@ -96,6 +96,10 @@ json scene_info_schema() {
               {"lights", count},
               {"emissive_triangles", count},
               {"cameras", count},
+              {"warnings",
+               {{"type", "array"},
+                {"items", {{"type", "string"}}},
+                {"description", "glTF features of the file that the renderer ignores"}}},
               {"bounds", {{"type", "object"}}}}}};
 }
 

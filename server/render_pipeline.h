@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "core/accel/ray_tracer.h"
 #include "core/photon/photon_tracer.h"
@@ -56,6 +58,10 @@ Expected<std::shared_ptr<const Scene>> load_job_scene(const protocol::SceneRef& 
 /// The photon tracing settings of a photon-map job under its plan.
 PhotonTracingSettings photon_settings(const protocol::Job& job, const RenderPlan& plan,
                                       const PipelineOptions& options);
+
+/// A warning per photon map the emission cap stopped short, with what to change.
+std::vector<std::string> incomplete_photon_map_warnings(const PhotonTracingStatistics& photons,
+                                                        const PhotonTracingSettings& settings);
 
 /// The camera a job asks for: its own, the scene's glTF camera, or a view of the whole scene.
 Expected<CameraDesc> resolve_camera(const protocol::Job& job, const Scene& scene);

@@ -16,8 +16,8 @@ static_assert(sizeof(PunctualLight) == sizeof(std::string) + 56,
 static_assert(sizeof(Texture) == 8 + sizeof(std::vector<Color>),
               "Texture changed: hash the new field in scene_content_hash");
 // Scene::triangle_normals and flat_shaded are derived from the positions and normals and need no
-// hashing of their own.
-static_assert(sizeof(Scene) == sizeof(std::string) + 11 * sizeof(std::vector<int>) + sizeof(Bounds3),
+// hashing of their own; cameras and warnings do not affect light transport.
+static_assert(sizeof(Scene) == sizeof(std::string) + 12 * sizeof(std::vector<int>) + sizeof(Bounds3),
               "Scene changed: hash the new field in scene_content_hash");
 static_assert(sizeof(void*) != 8 || sizeof(PhotonTracingSettings) == 48,
               "PhotonTracingSettings changed: add the new field to photon_map_key if the maps "

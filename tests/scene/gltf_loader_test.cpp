@@ -166,9 +166,11 @@ TEST(GltfLoader, SparseAccessor) {
 
 TEST(GltfLoader, PerspectiveCamera) {
     const Scene scene = load_ok("camera.gltf");
-    ASSERT_EQ(scene.cameras.size(), 1u);  // the orthographic camera is skipped
+    ASSERT_EQ(scene.cameras.size(), 2u);  // one per entry of cameras[], in its order
     const CameraDesc& camera = scene.cameras[0];
     EXPECT_EQ(camera.name, "Persp");
+    EXPECT_EQ(camera.projection, CameraProjection::Perspective);
+    EXPECT_TRUE(camera.placed);
     expect_vec_near(camera.position, {1, 2, 3});
     expect_vec_near(glm::normalize(camera.look_at - camera.position), {-1, 0, 0});
     expect_vec_near(camera.up, {0, 1, 0});
@@ -188,20 +190,21 @@ TEST(GltfLoader, PunctualLights) {
     const PunctualLight& bulb = find("Bulb");
     EXPECT_EQ(bulb.type, PunctualLightType::Point);
     expect_vec_near(bulb.position, {0, 5, 0});
-    expect_vec_near(bulb.intensity, {10, 5, 2.5f});
+    // KHR_lights_punctual is photometric: 10 cd is 10 / 683 W/sr.
+    expect_vec_near(bulb.intensity, Vec3(10, 5, 2.5f) / 683.0f, 1e-7f);
 
     const PunctualLight& spot = find("Spot");
     EXPECT_EQ(spot.type, PunctualLightType::Spot);
     expect_vec_near(spot.position, {1, 2, 3});
     expect_vec_near(spot.direction, {0, -1, 0});
-    expect_vec_near(spot.intensity, {2, 2, 2});
+    expect_vec_near(spot.intensity, Vec3(2.0f / 683.0f), 1e-7f);
     EXPECT_NEAR(spot.cos_inner, std::cos(0.2f), 1e-6f);
     EXPECT_NEAR(spot.cos_outer, std::cos(0.6f), 1e-6f);
 
     const PunctualLight& sun = find("Sun");
     EXPECT_EQ(sun.type, PunctualLightType::Directional);
     expect_vec_near(sun.direction, {-1, 0, 0});
-    expect_vec_near(sun.intensity, {3, 3, 3});
+    expect_vec_near(sun.intensity, Vec3(3.0f / 683.0f), 1e-7f);  // 3 lx
     // Point and spot positions extend the scene bounds.
     EXPECT_GE(scene.bounds.upper.y, 5.0f);
 }
@@ -416,7 +419,7 @@ TEST(GltfLoaderErrors, SymlinkEscapingTheBundleIsRefused) {
 
 TEST(GltfLoaderErrors, UnsupportedRequiredExtension) {
     const std::string error = load_error("broken/unsupported_extension.gltf");
-    EXPECT_NE(error.find("requires the unsupported extension KHR_draco_mesh_compression"),
+    EXPECT_NE(error.find("requires the unsupported extension KHR_texture_basisu"),
               std::string::npos)
         << error;
 }

@@ -380,8 +380,8 @@ def broken():
     write("broken/absolute_uri.gltf", b.finish(uri="/etc/passwd"))
 
     b = quad_indexed(U8)
-    b.doc["extensionsUsed"] = ["KHR_draco_mesh_compression"]
-    b.doc["extensionsRequired"] = ["KHR_draco_mesh_compression"]
+    b.doc["extensionsUsed"] = ["KHR_texture_basisu"]
+    b.doc["extensionsRequired"] = ["KHR_texture_basisu"]
     write("broken/unsupported_extension.gltf", b.finish())
 
     b = Builder()
