@@ -1,5 +1,7 @@
 #include "core/scene/gltf_loader.h"
 
+#include "core/scene/gltf_compression.h"
+
 #include <tiny_gltf.h>
 
 #include <algorithm>
@@ -1429,6 +1431,11 @@ Expected<Scene> load_from_bytes(std::span<const uint8_t> bytes, const std::strin
                          std::to_string(bytes.size())};
     }
 
+    // EXT_meshopt_compression's fallback buffers are patched into something tinygltf parses.
+    Expected<MeshoptFallbackPatch> patched = patch_meshopt_fallback_buffers(bytes);
+    if (!patched) return Error{display_name + ": " + patched.error().message};
+    if (!patched->bytes.empty()) bytes = patched->bytes;
+
     tinygltf::Model model;
     tinygltf::TinyGLTF parser;
     parser.SetFsCallbacks(tinygltf::FsCallbacks{&sandbox_file_exists, &sandbox_expand_path,
@@ -1456,6 +1463,16 @@ Expected<Scene> load_from_bytes(std::span<const uint8_t> bytes, const std::strin
         if (detail.empty()) detail = trim_trailing_whitespace(warn);
         return Error{display_name + ": cannot load " + (binary ? "GLB" : "glTF") + ": " +
                      (detail.empty() ? "unknown error" : detail)};
+    }
+    // Compressed geometry becomes plain buffers before the reader checks any accessor.
+    for (Status (*decode)(tinygltf::Model&, uint64_t) :
+         {&decode_meshopt_buffer_views, &decode_draco_primitives}) {
+        try {
+            if (Status st = decode(model, kMaxFileBytes); !st)
+                return Error{display_name + ": " + st.error().message};
+        } catch (const std::exception& e) {
+            return Error{display_name + ": decoding compressed geometry: " + e.what()};
+        }
     }
     try {
         GltfSceneReader reader(model, display_name);
