@@ -77,8 +77,8 @@ int add_view(tinygltf::Model& model, int buffer, size_t length, size_t stride) {
 
 }  // namespace
 
-Expected<MeshoptFallbackPatch> patch_meshopt_fallback_buffers(std::span<const uint8_t> file) {
-    MeshoptFallbackPatch patch;
+Expected<CompressedFilePatch> patch_compressed_file_for_tinygltf(std::span<const uint8_t> file) {
+    CompressedFilePatch patch;
     const bool binary = file.size() >= 20 && std::memcmp(file.data(), "glTF", 4) == 0;
     std::string_view json_text;
     size_t json_end = file.size();
@@ -91,13 +91,28 @@ Expected<MeshoptFallbackPatch> patch_meshopt_fallback_buffers(std::span<const ui
     } else {
         json_text = {reinterpret_cast<const char*>(file.data()), file.size()};
     }
-    if (json_text.find(kMeshopt) == std::string_view::npos) return patch;
+    if (json_text.find(kMeshopt) == std::string_view::npos &&
+        json_text.find(kDraco) == std::string_view::npos)
+        return patch;
     nlohmann::json document = nlohmann::json::parse(json_text, nullptr, false);
-    if (document.is_discarded() || !document.is_object() || !document.contains("buffers") ||
-        !document["buffers"].is_array())
-        return patch;  // tinygltf reports what is wrong
+    if (document.is_discarded() || !document.is_object()) return patch;  // tinygltf says why
     bool changed = false;
-    nlohmann::json& buffers = document["buffers"];
+    if (auto meshes = document.find("meshes"); meshes != document.end() && meshes->is_array()) {
+        for (nlohmann::json& mesh : *meshes) {
+            if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array())
+                continue;
+            for (nlohmann::json& prim : mesh["primitives"]) {
+                if (!prim.is_object() || !prim.contains("extensions") ||
+                    !prim["extensions"].is_object() || !prim["extensions"].contains(kDraco))
+                    continue;
+                changed |= prim.erase("indices") > 0;
+            }
+        }
+    }
+    nlohmann::json empty_array = nlohmann::json::array();
+    nlohmann::json& buffers = document.contains("buffers") && document["buffers"].is_array()
+                                  ? document["buffers"]
+                                  : empty_array;
     for (size_t i = 0; i < buffers.size(); ++i) {
         nlohmann::json& buffer = buffers[i];
         if (!buffer.is_object() || buffer.contains("uri")) continue;
@@ -269,6 +284,7 @@ Status decode_draco_primitives(tinygltf::Model& model, uint64_t max_bytes) {
             indices.count = faces * 3;
             model.accessors.push_back(std::move(indices));
             prim.indices = static_cast<int>(model.accessors.size() - 1);
+            prim.mode = TINYGLTF_MODE_TRIANGLES;  // Draco decodes a triangle list
 
             const tinygltf::Value& attributes = d.Get("attributes");
             for (const std::string& name : attributes.Keys()) {

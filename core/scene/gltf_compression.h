@@ -20,15 +20,17 @@ class Model;
 
 namespace photond {
 
-/// tinygltf 2.7 cannot parse EXT_meshopt_compression's fallback buffers (no uri, a byteLength
-/// beyond the GLB's binary chunk). For a file that uses the extension, returns a copy of the file
-/// (.gltf text or .glb) in which each such buffer is a one-byte data: URI (only compressed views
-/// refer to a fallback buffer, and they are decoded into buffers of their own); returns nothing
-/// for any other file.
-struct MeshoptFallbackPatch {
+/// tinygltf 2.7 refuses two things compressed files are made of: EXT_meshopt_compression's
+/// fallback buffers (no uri, a byteLength beyond the GLB's binary chunk) and the index accessors
+/// of KHR_draco_mesh_compression primitives (no bufferView). For a file that uses either
+/// extension, returns a copy of the file (.gltf text or .glb) in which each fallback buffer is a
+/// one-byte data: URI (only compressed views refer to it, and they are decoded into buffers of
+/// their own) and each Draco primitive has no "indices" (decode_draco_primitives makes them);
+/// returns nothing for any other file.
+struct CompressedFilePatch {
     std::vector<uint8_t> bytes;  // the patched file; empty: use the original
 };
-Expected<MeshoptFallbackPatch> patch_meshopt_fallback_buffers(std::span<const uint8_t> file);
+Expected<CompressedFilePatch> patch_compressed_file_for_tinygltf(std::span<const uint8_t> file);
 
 /// Decodes every bufferView with EXT_meshopt_compression into a new buffer of the model and points
 /// the view at it. `max_bytes` bounds the decoded total.

@@ -1431,8 +1431,8 @@ Expected<Scene> load_from_bytes(std::span<const uint8_t> bytes, const std::strin
                          std::to_string(bytes.size())};
     }
 
-    // EXT_meshopt_compression's fallback buffers are patched into something tinygltf parses.
-    Expected<MeshoptFallbackPatch> patched = patch_meshopt_fallback_buffers(bytes);
+    // Compressed files are patched where tinygltf would refuse them (gltf_compression.h).
+    Expected<CompressedFilePatch> patched = patch_compressed_file_for_tinygltf(bytes);
     if (!patched) return Error{display_name + ": " + patched.error().message};
     if (!patched->bytes.empty()) bytes = patched->bytes;
 

@@ -487,10 +487,10 @@ def room():
         {"name": "Blue", "pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.3, 0.8, 1],
                                                    "metallicFactor": 0}},
     ]
-    quad = [[-2, 0, -2], [2, 0, -2], [2, 0, 2], [-2, 0, 2]]
+    quad = [[-4, 0, -3], [4, 0, -3], [4, 0, 4], [-4, 0, 4]]
     floor = mesh_primitive(b, quad, [[0, 1, 0]] * 4, [0, 2, 1, 0, 3, 2], 0,
                            uvs=[[0, 0], [1, 0], [1, 1], [0, 1]])
-    wall_quad = [[-2, 0, -2], [2, 0, -2], [2, 3, -2], [-2, 3, -2]]
+    wall_quad = [[-4, 0, -3], [4, 0, -3], [4, 4, -3], [-4, 4, -3]]
     wall = mesh_primitive(b, wall_quad, [[0, 0, 1]] * 4, [0, 1, 2, 0, 2, 3], 0)
     verts, faces = icosphere(2)
     sphere = mesh_primitive(b, verts, verts, [i for f in faces for i in f], 1)
