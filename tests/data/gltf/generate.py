@@ -663,6 +663,33 @@ def blender_lights():
     write("blender_lights.gltf", b.finish())
 
 
+def sparse_caustics():
+    """A point light over a wide floor and one small mirror above it that catches about 3 in
+    10,000 photons: the caustic map cannot fill within the emission cap (1,000 per requested
+    photon), which the render must report as a warning."""
+    b = Builder()
+    b.doc["extensionsUsed"] = ["KHR_lights_punctual"]
+    b.doc["materials"] = [
+        {"name": "Floor", "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1],
+                                                    "metallicFactor": 0}},
+        {"name": "Mirror", "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1],
+                                                     "metallicFactor": 1, "roughnessFactor": 0}}]
+    floor = mesh_primitive(b, [[-10, 0, -10], [10, 0, -10], [10, 0, 10], [-10, 0, 10]],
+                           [[0, 1, 0]] * 4, [0, 2, 1, 0, 3, 2], 0)
+    # A 0.1 x 0.1 mirror 1 above the light, facing down.
+    mirror = mesh_primitive(b, [[-0.05, 2, -0.05], [0.05, 2, -0.05], [0.05, 2, 0.05],
+                                [-0.05, 2, 0.05]], [[0, -1, 0]] * 4, [0, 1, 2, 0, 2, 3], 1)
+    b.doc["meshes"] = [{"name": "Room", "primitives": [floor, mirror]}]
+    b.doc["extensions"] = {"KHR_lights_punctual": {"lights": [
+        {"name": "Bulb", "type": "point", "intensity": 683}]}}
+    b.doc["cameras"] = [{"type": "perspective", "perspective": {"yfov": 1.0, "znear": 0.1}}]
+    b.doc["nodes"] = [{"mesh": 0}, {"translation": [0.3, 1, 0],
+                                    "extensions": {"KHR_lights_punctual": {"light": 0}}},
+                      {"camera": 0, "translation": [0, 1.5, 4]}]
+    b.doc["scenes"] = [{"nodes": [0, 1, 2]}]
+    write("sparse_caustics.gltf", b.finish())
+
+
 def main():
     os.makedirs(os.path.join(HERE, "broken"), exist_ok=True)
     write("indexed_u8.gltf", quad_indexed(U8).finish())
@@ -684,6 +711,7 @@ def main():
     warnings_file()
     transmission()
     blender_lights()
+    sparse_caustics()
     room()
 
 
