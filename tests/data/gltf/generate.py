@@ -630,12 +630,15 @@ def blender_lights():
     """What Blender's glTF exporter (io_scene_gltf2, lighting mode "Standard") writes for a point
     lamp of 1000 W and a sun of 3 W/m^2: intensity = W / (4 pi) * 683 cd and 3 * 683 lx, next to a
     quad emitting with strength 2 (emissiveFactor 1 x KHR_materials_emissive_strength 2, written
-    unchanged). The quad faces the camera (+Z) and lights nothing the test measures."""
+    unchanged). The quad faces +Z and lights nothing the test measures; the floor is pure
+    Lambertian (KHR_materials_specular 0, no specular layer) so that its radiance is rho E / pi."""
     b = Builder()
-    b.doc["extensionsUsed"] = ["KHR_lights_punctual", "KHR_materials_emissive_strength"]
+    b.doc["extensionsUsed"] = ["KHR_lights_punctual", "KHR_materials_emissive_strength",
+                               "KHR_materials_specular"]
     b.doc["materials"] = [
         {"name": "White", "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1],
-                                                    "metallicFactor": 0}},
+                                                    "metallicFactor": 0},
+         "extensions": {"KHR_materials_specular": {"specularFactor": 0}}},
         {"name": "Emitter", "emissiveFactor": [1, 1, 1],
          "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0},
          "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 2}}},
