@@ -7,8 +7,8 @@
 #include <algorithm>
 #include <cstring>
 #include <memory>
-#include <optional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string_view>
 
 namespace photond {
@@ -30,7 +30,8 @@ void append_le32(std::vector<uint8_t>& out, uint32_t v) {
 }
 
 // A number member of an extension object, or `fallback` when absent; nullopt when of another type.
-std::optional<double> number_member(const tinygltf::Value& object, const char* key, double fallback) {
+std::optional<double> number_member(const tinygltf::Value& object, const char* key,
+                                    double fallback) {
     if (!object.Has(key)) return fallback;
     const tinygltf::Value& v = object.Get(key);
     if (!v.IsNumber()) return std::nullopt;
@@ -161,7 +162,8 @@ Status decode_meshopt_buffer_views(tinygltf::Model& model, uint64_t max_bytes) {
         const auto stride = number_member(m, "byteStride", -1.0);
         const auto count = number_member(m, "count", -1.0);
         if (!buffer || !offset || !length || !stride || !count)
-            return Error{what + ": buffer, byteOffset, byteLength, byteStride and count must be "
+            return Error{what +
+                         ": buffer, byteOffset, byteLength, byteStride and count must be "
                          "numbers"};
         const std::string mode = string_member(m, "mode", "");
         const std::string filter = string_member(m, "filter", "NONE");
@@ -239,8 +241,8 @@ Status decode_draco_primitives(tinygltf::Model& model, uint64_t max_bytes) {
             const std::string what = "mesh " + std::to_string(mesh_index) + " primitive " +
                                      std::to_string(p) + " (KHR_draco_mesh_compression)";
             const tinygltf::Value& d = ext->second;
-            const auto view_index = d.IsObject() ? number_member(d, "bufferView", -1.0)
-                                                  : std::optional<double>();
+            const auto view_index =
+                d.IsObject() ? number_member(d, "bufferView", -1.0) : std::optional<double>();
             if (!view_index || !(*view_index >= 0.0) ||
                 *view_index >= double(model.bufferViews.size()))
                 return Error{what + " has no valid bufferView"};
@@ -277,8 +279,8 @@ Status decode_draco_primitives(tinygltf::Model& model, uint64_t max_bytes) {
                 }
             }
             tinygltf::Accessor indices;
-            indices.bufferView = add_view(model, add_buffer(model, std::move(index_bytes)),
-                                          faces * 12, 0);
+            indices.bufferView =
+                add_view(model, add_buffer(model, std::move(index_bytes)), faces * 12, 0);
             indices.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
             indices.type = TINYGLTF_TYPE_SCALAR;
             indices.count = faces * 3;
@@ -301,12 +303,13 @@ Status decode_draco_primitives(tinygltf::Model& model, uint64_t max_bytes) {
                                  std::to_string(int64_t(id.GetNumberAsDouble())) + " (" + name +
                                  ")"};
                 tinygltf::Accessor accessor = model.accessors[size_t(target->second)];
-                const int components = tinygltf::GetNumComponentsInType(static_cast<uint32_t>(accessor.type));
+                const int components =
+                    tinygltf::GetNumComponentsInType(static_cast<uint32_t>(accessor.type));
                 if (components <= 0 || components != attribute->num_components())
                     return Error{what + ": attribute " + name + " has " +
                                  std::to_string(attribute->num_components()) +
-                                 " components in the Draco data and " +
-                                 std::to_string(components) + " in its accessor"};
+                                 " components in the Draco data and " + std::to_string(components) +
+                                 " in its accessor"};
                 decoded_total += uint64_t(points) * uint64_t(components) * 4;
                 if (decoded_total > max_bytes)
                     return Error{what + " decodes to more than " + std::to_string(max_bytes) +
@@ -319,8 +322,8 @@ Status decode_draco_primitives(tinygltf::Model& model, uint64_t max_bytes) {
                         attribute->mapped_index(draco::PointIndex(uint32_t(i)));
                     if (!attribute->ConvertValue<float>(value, int8_t(components),
                                                         out + i * size_t(components)))
-                        return Error{what + ": attribute " + name + " value " +
-                                     std::to_string(i) + " cannot be converted"};
+                        return Error{what + ": attribute " + name + " value " + std::to_string(i) +
+                                     " cannot be converted"};
                 }
                 accessor.bufferView = add_view(model, add_buffer(model, std::move(values)),
                                                points * size_t(components) * 4, 0);

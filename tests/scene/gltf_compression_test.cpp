@@ -85,7 +85,8 @@ TEST(GltfCompression, OriginalIsLitAndFramed) {
 
 TEST(GltfCompression, MeshoptWithoutQuantizationRendersTheSameImage) {
     // Lossless: gltfpack only reorders vertices and triangles.
-    const ImageError e = compare(render(load(data_path("room_meshopt_float.glb"))), original_image());
+    const ImageError e =
+        compare(render(load(data_path("room_meshopt_float.glb"))), original_image());
     EXPECT_LT(std::abs(e.mean_bias), 1e-6) << e.mean_bias;  // measured 5e-10
     EXPECT_LT(e.relative_mse, 1e-10) << e.relative_mse;     // measured 3e-15
 }
@@ -97,7 +98,7 @@ TEST(GltfCompression, QuantizedAndMeshoptCopiesRenderTheSameImageToRounding) {
         SCOPED_TRACE(name);
         const ImageError e = compare(render(load(data_path(name))), original_image());
         EXPECT_LT(std::abs(e.mean_bias), 5e-4) << e.mean_bias;  // measured 7e-5
-        EXPECT_LT(e.relative_mse, 1e-4) << e.relative_mse;     // measured 8e-6
+        EXPECT_LT(e.relative_mse, 1e-4) << e.relative_mse;      // measured 8e-6
     }
 }
 
@@ -168,9 +169,8 @@ std::string draco_copy_of_room() {
         const int accessors = int(doc["accessors"].size());
         // Accessors of a Draco primitive have no bufferView; count and type describe the
         // decoded data.
-        doc["accessors"].push_back({{"componentType", 5125},
-                                    {"count", 3 * triangles.size()},
-                                    {"type", "SCALAR"}});
+        doc["accessors"].push_back(
+            {{"componentType", 5125}, {"count", 3 * triangles.size()}, {"type", "SCALAR"}});
         doc["accessors"].push_back(
             {{"componentType", 5126}, {"count", mesh->num_points()}, {"type", "VEC3"}});
         doc["accessors"].push_back(
@@ -190,10 +190,10 @@ std::string draco_copy_of_room() {
     json original_buffer = doc["buffers"][0];
     for (size_t v = 0; v + primitives.size() < doc["bufferViews"].size(); ++v)
         doc["bufferViews"][v]["buffer"] = 1;
-    doc["buffers"] = json::array(
-        {{{"byteLength", buffer.size()},
-          {"uri", "data:application/octet-stream;base64," + base64(buffer)}},
-         original_buffer});
+    doc["buffers"] =
+        json::array({{{"byteLength", buffer.size()},
+                      {"uri", "data:application/octet-stream;base64," + base64(buffer)}},
+                     original_buffer});
     doc["meshes"] = json::array({{{"name", "Draco"}, {"primitives", primitives}}});
     for (json& node : doc["nodes"]) {
         if (!node.contains("mesh")) continue;
@@ -211,8 +211,8 @@ std::string draco_copy_of_room() {
 TEST(GltfCompression, DracoCopyRendersTheSameImageToRounding) {
     const std::string text = draco_copy_of_room();
     ASSERT_FALSE(text.empty());
-    const fs::path file = fs::temp_directory_path() /
-                          ("photond_draco_room_" + std::to_string(::getpid()) + ".gltf");
+    const fs::path file =
+        fs::temp_directory_path() / ("photond_draco_room_" + std::to_string(::getpid()) + ".gltf");
     {
         std::ofstream out(file);
         out << text;
@@ -224,7 +224,7 @@ TEST(GltfCompression, DracoCopyRendersTheSameImageToRounding) {
     EXPECT_TRUE(draco.warnings.empty()) << draco.warnings.front();
     const ImageError e = compare(render(draco), original_image());
     EXPECT_LT(std::abs(e.mean_bias), 5e-4) << e.mean_bias;  // measured 3e-5
-    EXPECT_LT(e.relative_mse, 1e-4) << e.relative_mse;     // measured 1.4e-7
+    EXPECT_LT(e.relative_mse, 1e-4) << e.relative_mse;      // measured 1.4e-7
 }
 
 }  // namespace
