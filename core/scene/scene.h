@@ -66,13 +66,14 @@ enum class CameraProjection : uint8_t { Perspective, Orthographic };
 /// or the half-height of the view (orthographic, glTF's ymag).
 struct CameraDesc {
     std::string name;
-    CameraProjection projection = CameraProjection::Perspective;
     Vec3 position{0.0f, 0.0f, 1.0f};
     Vec3 look_at{0.0f};
     Vec3 up{0.0f, 1.0f, 0.0f};
     float vfov_deg = 40.0f;
+    float aspect = 0.0f;  // width / height from the file; 0 = take the image's
+    // Added after the original members, so that positional initializers keep their meaning.
+    CameraProjection projection = CameraProjection::Perspective;
     float ortho_half_height = 1.0f;  // orthographic: half the view's height in world units
-    float aspect = 0.0f;             // width / height from the file; 0 = take the image's
     /// False for a glTF camera that no node of the default scene places: it keeps its index in
     /// Scene::cameras but cannot be rendered from.
     bool placed = true;
