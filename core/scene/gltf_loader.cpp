@@ -1274,6 +1274,8 @@ Status GltfSceneReader::add_light(const tinygltf::Node& node, int node_index, co
     }
     // KHR_lights_punctual is photometric: candela (point, spot) and lux (directional). At
     // 683 lm/W, W/sr = cd / 683 and W/m^2 = lx / 683 (PunctualLight keeps radiometric units).
+    // A number beyond float range as written is refused, as before the conversion shrank it.
+    if (!std::isfinite(float(light.intensity))) return fail(what + " has a non-finite value");
     const float intensity = float(light.intensity / double(kLumensPerWatt));
     out.intensity = glm::max(color * intensity, Color(0.0f));
     out.position = Vec3(world[3]);
