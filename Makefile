@@ -6,7 +6,7 @@ JOBS ?= $(shell nproc)
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 DEBIAN_PACKAGES := cmake g++ make pkg-config libembree-dev libtbb-dev libopenexr-dev libimath-dev \
 	libtinygltf-dev libcpp-httplib-dev nlohmann-json3-dev libglm-dev libpng-dev libssl-dev libarchive-dev libgtest-dev \
-	libbenchmark-dev libstb-dev curl python3 gnuplot-nox
+	libbenchmark-dev curl python3 gnuplot-nox libmeshoptimizer-dev libdraco-dev libstb-dev gltfpack
 OUT ?= out
 
 .PHONY: all deps configure build test tsan demo bench clean format

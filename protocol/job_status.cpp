@@ -124,6 +124,7 @@ json to_json(const JobStatus& s, bool links) {
             plan.push_back({{"pass", e.pass}, {"enabled", e.enabled}, {"reason", e.reason}});
         document["plan"] = std::move(plan);
     }
+    if (!s.warnings.empty()) document["warnings"] = s.warnings;
     if (!s.timings.empty()) {
         json timings = json::object();
         for (const PassTime& t : s.timings) timings[t.name] = t.seconds;
@@ -172,6 +173,9 @@ Expected<JobStatus> job_status_from_json(const json& d) {
                 s.plan.push_back({e.at("pass").get<std::string>(), e.at("enabled").get<bool>(),
                                   e.value("reason", std::string())});
         }
+        if (const auto it = d.find("warnings"); it != d.end() && it->is_array())
+            for (const json& w : *it)
+                if (w.is_string()) s.warnings.push_back(w.get<std::string>());
         if (const auto it = d.find("statistics"); it != d.end()) {
             s.statistics = *it;
             // The pass order lives in the statistics; the "timings" object is sorted by name.
@@ -247,6 +251,12 @@ json job_status_json_schema() {
         {"finished_at", timestamp_schema("when it ended")},
         {"error", {{"type", "string"}, {"description", "why the job failed"}}},
         {"plan", {{"type", "array"}, {"items", plan_entry}}},
+        {"warnings",
+         {{"type", "array"},
+          {"items", {{"type", "string"}}},
+          {"description",
+           "what the render ignored or could not do as asked (unsupported glTF features, an "
+           "incomplete photon map), with what to change"}}},
         {"timings",
          {{"type", "object"},
           {"additionalProperties", {{"type", "number"}, {"minimum", 0}}},

@@ -75,6 +75,9 @@ struct JobStatus {
     std::vector<PlanEntry> plan;
     /// Pass durations so far, in the order the passes ran.
     std::vector<PassTime> timings;
+    /// What the user should know about the render (ignored glTF features, an incomplete photon
+    /// map, ...), one sentence each, once the render ended; the same as statistics.warnings.
+    std::vector<std::string> warnings;
     /// The render statistics (protocol::to_json(RenderStatistics)) once the render ended.
     std::optional<nlohmann::json> statistics;
     /// The job description with every default filled (absent in job lists).

@@ -18,6 +18,7 @@ nlohmann::json to_json(const RenderStatistics& s) {
         {"render_seconds", s.render_seconds},
         {"total_seconds", s.total_seconds},
         {"cancelled", s.cancelled},
+        {"warnings", s.warnings},
     };
     result["lighting"] = {{"lights", s.lighting.lights},
                           {"job_lights", s.lighting.job_lights},

@@ -731,6 +731,7 @@ void JobManager::finish_locked(Entry& e, JobState state, std::string error,
     if (statistics) {
         e.status.statistics = protocol::to_json(*statistics);
         e.status.plan = plan_of(*statistics);
+        e.status.warnings = statistics->warnings;
         e.status.photon_cache = statistics->photon_cache;
         e.status.photon_map_key = statistics->photon_map_key;
         e.status.timings.clear();

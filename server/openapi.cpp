@@ -104,6 +104,10 @@ json scene_info_schema() {
                {{"type", "string"},
                 {"description", "bundles only: the glTF file's path inside the bundle"}}},
               {"files", count},
+              {"warnings",
+               {{"type", "array"},
+                {"items", {{"type", "string"}}},
+                {"description", "glTF features of the file that the renderer ignores"}}},
               {"bounds", {{"type", "object"}}}}}};
 }
 

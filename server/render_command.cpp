@@ -34,7 +34,7 @@ constexpr const char* kUsage =
     "  --exposure EV           the preview's exposure in stops (output.exposure_ev; default:\n"
     "                          automatic, the log-average luminance mapped to middle grey)\n"
     "  --stats-json FILE       write the render statistics as JSON\n"
-    "  --quiet                 no progress bar and no statistics on stderr\n";
+    "  --quiet                 no progress bar and no statistics on stderr (warnings only)\n";
 
 struct Arguments {
     std::string scene;
@@ -181,6 +181,7 @@ void print_statistics(const RenderStatistics& s) {
     std::fprintf(stderr, "  rays %llu + shadow rays %llu, %.2f Mrays/s\n",
                  static_cast<unsigned long long>(s.rays), static_cast<unsigned long long>(s.shadow_rays),
                  s.rays_per_second() * 1e-6);
+    for (const std::string& warning : s.warnings) std::fprintf(stderr, "  warning: %s\n", warning.c_str());
 }
 
 }  // namespace
@@ -285,6 +286,10 @@ int run_render_command(std::span<const std::string> args) {
         }
     }
     if (!a.quiet) print_statistics(result->statistics);
+    // Warnings are never silenced: --quiet prints them alone.
+    if (a.quiet)
+        for (const std::string& warning : result->statistics.warnings)
+            std::fprintf(stderr, "photond render: warning: %s\n", warning.c_str());
     return 0;
 }
 

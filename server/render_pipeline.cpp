@@ -3,6 +3,7 @@
 #include <tbb/info.h>
 
 #include <chrono>
+#include <cstdio>
 
 #include "core/camera/camera.h"
 #include "core/image/png_preview.h"
@@ -132,6 +133,8 @@ Expected<std::shared_ptr<const PhotonMaps>> build_photon_maps(const protocol::Jo
     }
     stats.photons = maps->statistics;
     stats.photon_map_bytes = maps->bytes();
+    for (std::string& warning : incomplete_photon_map_warnings(maps->statistics, settings))
+        stats.warnings.push_back(std::move(warning));
     const bool traced_here = stats.photon_cache != "hit";
     stats.passes.push_back({"photon_tracing", traced_here ? maps->statistics.tracing_seconds : 0.0});
     stats.passes.push_back({"photon_kdtree", traced_here ? maps->statistics.build_seconds : 0.0});
@@ -169,6 +172,50 @@ Expected<std::unique_ptr<Integrator>> make_integrator(const protocol::Job& job,
 }
 
 }  // namespace
+
+std::vector<std::string> incomplete_photon_map_warnings(const PhotonTracingStatistics& photons,
+                                                        const PhotonTracingSettings& settings) {
+    std::vector<std::string> warnings;
+    const auto grouped = [](uint64_t n) {  // 1145 -> "1,145"
+        std::string digits = std::to_string(n), out;
+        for (size_t i = 0; i < digits.size(); ++i) {
+            if (i > 0 && (digits.size() - i) % 3 == 0) out += ',';
+            out += digits[i];
+        }
+        return out;
+    };
+    const auto millions = [](uint64_t n) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.1f M", static_cast<double>(n) * 1e-6);
+        return std::string(text);
+    };
+    // The emission cap allows max_emitted_per_stored emissions per requested photon: a map whose
+    // store rate is below that fills at no requested count, so fewer photons would not help.
+    const auto rate = [&](uint64_t stored, uint64_t emitted) {
+        return stored > 0 ? "1 photon stored per " + grouped((emitted + stored / 2) / stored) + " emitted"
+                          : std::string("no photon stored");
+    };
+    if (settings.caustic_photons > 0 && !photons.caustic_complete) {
+        warnings.push_back("photon map incomplete: the caustic map holds " + grouped(photons.stored_caustic) +
+                           " of the " + grouped(settings.caustic_photons) + " photons requested (" +
+                           rate(photons.stored_caustic, photons.emitted_caustic) + "; emission stopped at " +
+                           millions(photons.emitted_caustic) + " photons, the cap of " +
+                           grouped(settings.max_emitted_per_stored) +
+                           " per requested photon): little light reaches a diffuse surface through the specular "
+                           "ones, so its caustics are noisy. Set photons.caustic=0 to skip the caustic map, or "
+                           "give the scene more specular surfaces in the lights' reach");
+    }
+    if (settings.global_photons > 0 && !photons.global_complete) {
+        warnings.push_back("photon map incomplete: the global map holds " + grouped(photons.stored_global) +
+                           " of the " + grouped(settings.global_photons) + " photons requested (" +
+                           rate(photons.stored_global, photons.emitted_global) + "; emission stopped at " +
+                           millions(photons.emitted_global) + " photons, the cap of " +
+                           grouped(settings.max_emitted_per_stored) +
+                           " per requested photon): most photons leave the scene or land on nothing, so "
+                           "indirect light is noisy. Aim the lights at the geometry or close the scene");
+    }
+    return warnings;
+}
 
 PhotonTracingSettings photon_settings(const protocol::Job& job, const RenderPlan& plan,
                                       const PipelineOptions& options) {
@@ -332,7 +379,11 @@ Expected<CameraDesc> resolve_camera(const protocol::Job& job, const Scene& scene
             if (gltf->index < 0 || static_cast<size_t>(gltf->index) >= scene.cameras.size())
                 return Error{"camera.gltf_camera: the scene has " + std::to_string(scene.cameras.size()) +
                              " camera(s); index " + std::to_string(gltf->index) + " does not exist"};
-            return scene.cameras[static_cast<size_t>(gltf->index)];
+            const CameraDesc& camera = scene.cameras[static_cast<size_t>(gltf->index)];
+            if (!camera.placed)
+                return Error{"camera.gltf_camera: camera " + std::to_string(gltf->index) + " '" + camera.name +
+                             "' is placed by no node of the scene, so it has no position to render from"};
+            return camera;
         }
         const auto& look = std::get<protocol::LookAtCamera>(*job.camera);
         CameraDesc desc;
@@ -343,7 +394,9 @@ Expected<CameraDesc> resolve_camera(const protocol::Job& job, const Scene& scene
         desc.vfov_deg = static_cast<float>(look.vfov_deg);
         return desc;
     }
-    if (!scene.cameras.empty()) return scene.cameras.front();
+    // The scene's first camera that a node places (glTF: the lowest index into cameras[]).
+    for (const CameraDesc& camera : scene.cameras)
+        if (camera.placed) return camera;
     // No camera anywhere: look at the scene's bounds from the +z side, framing them.
     CameraDesc desc;
     desc.name = "default";
@@ -385,6 +438,7 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     stats.lighting.job_lights = job.lights.size();
     stats.lighting.environment = lit_scene->environment ? lit_scene->environment->name : "";
     stats.passes.push_back({"scene", seconds_since(pass_start)});
+    stats.warnings = (*scene)->warnings;
 
     pass_start = Clock::now();
     if (options.on_pass) options.on_pass("acceleration");

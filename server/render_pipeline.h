@@ -8,6 +8,8 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "core/accel/ray_tracer.h"
 #include "core/photon/photon_tracer.h"
@@ -74,6 +76,9 @@ Expected<AddedLighting> job_lighting(const protocol::Job& job, const Scene& scen
 /// 422 at once): an environment image that is missing or outside the scene root or bundle, and
 /// `"environment": null` on a scene without light (this one loads the scene).
 std::optional<protocol::FieldError> check_job_lighting(const protocol::Job& job, const PipelineOptions& options);
+/// A warning per photon map the emission cap stopped short, with what to change.
+std::vector<std::string> incomplete_photon_map_warnings(const PhotonTracingStatistics& photons,
+                                                        const PhotonTracingSettings& settings);
 
 /// The camera a job asks for: its own, the scene's glTF camera, or a view of the whole scene.
 Expected<CameraDesc> resolve_camera(const protocol::Job& job, const Scene& scene);

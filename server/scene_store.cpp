@@ -43,6 +43,7 @@ SceneInfo describe(const Scene& scene, const std::string& id, const std::string&
     info.lights = scene.lights.size();
     info.cameras = scene.cameras.size();
     info.bounds = scene.bounds;
+    info.warnings = scene.warnings;
     for (uint32_t material : scene.triangle_materials)
         if (material < scene.materials.size() && scene.materials[material].is_emissive())
             ++info.emissive_triangles;
@@ -68,6 +69,9 @@ std::optional<SceneInfo> info_from_json(const json& d) {
         info.bundle = d.value("bundle", std::string());
         info.entry = d.value("entry", std::string());
         info.files = d.value("files", uint64_t{0});
+        // Required: metadata written before warnings existed is refused, so the scene is
+        // loaded again and described with them.
+        info.warnings = d.at("warnings").get<std::vector<std::string>>();
         if (d.contains("bounds")) {
             const auto& lower = d["bounds"].at("min");
             const auto& upper = d["bounds"].at("max");
@@ -121,7 +125,8 @@ json to_json(const SceneInfo& info) {
                      {"textures", info.textures},
                      {"lights", info.lights},
                      {"emissive_triangles", info.emissive_triangles},
-                     {"cameras", info.cameras}};
+                     {"cameras", info.cameras},
+                     {"warnings", info.warnings}};
     if (!info.bundle.empty()) {
         document["bundle"] = info.bundle;
         document["entry"] = info.entry;

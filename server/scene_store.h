@@ -50,6 +50,8 @@ struct SceneInfo {
     uint64_t emissive_triangles = 0;
     uint64_t cameras = 0;
     Bounds3 bounds;
+    /// Scene::warnings: what the file holds that the renderer ignores or takes its own way.
+    std::vector<std::string> warnings;
 };
 
 nlohmann::json to_json(const SceneInfo& info);

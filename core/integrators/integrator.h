@@ -70,6 +70,16 @@ inline float pixel_spread(const CameraRay& ray) {
     return 0.5f * (glm::length(ray.direction_dx - ray.direction) + glm::length(ray.direction_dy - ray.direction));
 }
 
+/// The width of a camera ray's pixel along its path: `width` at the camera (an orthographic
+/// camera's pixel side; 0 for a pinhole) growing by `spread` per unit of distance travelled.
+struct RayFootprint {
+    float width = 0.0f;
+    float spread = 0.0f;
+    float at(float distance) const { return width + distance * spread; }
+};
+
+inline RayFootprint camera_footprint(const CameraRay& ray) { return {ray.pixel_width, pixel_spread(ray)}; }
+
 /// Intersection query that counts itself.
 inline std::optional<Hit> trace_ray(const RenderScene& rs, const Ray& ray, RayCounters& counters) {
     ++counters.rays;

@@ -25,7 +25,7 @@ constexpr float kCandidateY = 0.5f + 1.0f / 2048.0f;
 
 /// The Lambertian points a camera ray sees through ideal specular surfaces: every delta lobe
 /// for the first kBranchDepth bounces, then the heaviest one (deterministic, no random numbers).
-void collect_diffuse_points(const RenderScene& rs, const Ray& ray, float path_length, float spread, int depth,
+void collect_diffuse_points(const RenderScene& rs, const Ray& ray, float path_length, RayFootprint footprint, int depth,
                             int max_depth, RayCounters& counters, std::vector<DiffusePoint>& out) {
     if (out.size() >= kMaxPointsPerPixel) return;
     const std::optional<Hit> hit = trace_ray(rs, ray, counters);
@@ -37,7 +37,7 @@ void collect_diffuse_points(const RenderScene& rs, const Ray& ray, float path_le
     if (max_component(bsdf.diffuse_reflectance(wo)) > 0.0f) {
         const Vec3 n = glm::dot(si.shading_normal, wo) >= 0.0f ? si.shading_normal : -si.shading_normal;
         const Vec3 ng = glm::dot(si.geometric_normal, wo) >= 0.0f ? si.geometric_normal : -si.geometric_normal;
-        out.push_back({si.p, n, ng, length * spread});
+        out.push_back({si.p, n, ng, footprint.at(length)});
     }
     if (!bsdf.has_delta() || depth >= max_depth) return;
     std::array<BsdfSample, 2> lobes;
@@ -50,7 +50,7 @@ void collect_diffuse_points(const RenderScene& rs, const Ray& ray, float path_le
     }
     for (int i = first; i < last; ++i) {
         if (is_black(lobes[i].weight)) continue;
-        collect_diffuse_points(rs, spawn_ray(rs, si, lobes[i].wi), length, spread, depth + 1, max_depth, counters, out);
+        collect_diffuse_points(rs, spawn_ray(rs, si, lobes[i].wi), length, footprint, depth + 1, max_depth, counters, out);
     }
 }
 
@@ -129,7 +129,7 @@ std::unique_ptr<IrradianceCache> build_irradiance_cache(const RenderScene& rs, c
                 Candidate& c = candidates[i];
                 const CameraRay ray = camera.generate_ray(c.x + kCandidateX, c.y + kCandidateY);
                 std::vector<DiffusePoint> points;
-                collect_diffuse_points(rs, primary_ray(rs, ray), 0.0f, pixel_spread(ray), 0,
+                collect_diffuse_points(rs, primary_ray(rs, ray), 0.0f, camera_footprint(ray), 0,
                                        settings.max_specular_depth, c.counters, points);
                 c.points = points.size();
                 for (size_t k = 0; k < points.size(); ++k) {

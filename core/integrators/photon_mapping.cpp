@@ -45,7 +45,7 @@ void PhotonMapIntegrator::prepare(const Camera& camera, CacheBuildStatistics* st
 }
 
 Color PhotonMapIntegrator::radiance(const CameraRay& ray, SampleContext& context) const {
-    return radiance_along(primary_ray(*scene_, ray), 0, 0.0f, pixel_spread(ray), context);
+    return radiance_along(primary_ray(*scene_, ray), 0, 0.0f, camera_footprint(ray), context);
 }
 
 Color PhotonMapIntegrator::indirect_irradiance(const DiffusePoint& point, SampleContext& context) const {
@@ -65,7 +65,7 @@ Color PhotonMapIntegrator::indirect_irradiance(const DiffusePoint& point, Sample
     return g.irradiance;
 }
 
-Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_length, float spread,
+Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_length, RayFootprint footprint,
                                           SampleContext& context) const {
     const RenderScene& rs = *scene_;
     const std::optional<Hit> hit = trace_ray(rs, ray, context.counters);
@@ -85,7 +85,7 @@ Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_
             const Color rho = bsdf.diffuse_reflectance(wo);
             if (max_component(rho) > 0.0f) {
                 const Vec3 ng = glm::dot(si.geometric_normal, wo) >= 0.0f ? si.geometric_normal : -si.geometric_normal;
-                const DiffusePoint point{si.p, normal, ng, length * spread};
+                const DiffusePoint point{si.p, normal, ng, footprint.at(length)};
                 radiance += rho * kInvPi * indirect_irradiance(point, context);
             }
             if (bsdf.has_non_lambertian_non_delta()) {
@@ -111,7 +111,7 @@ Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_
     }
     if (bsdf.has_delta() && depth < settings_.max_specular_depth) {
         radiance += follow_delta_lobes(bsdf, wo, depth < kBranchDepth, context.rng, [&](const BsdfSample& s) {
-            return radiance_along(spawn_ray(rs, si, s.wi), depth + 1, length, spread, context);
+            return radiance_along(spawn_ray(rs, si, s.wi), depth + 1, length, footprint, context);
         });
     }
     return radiance;

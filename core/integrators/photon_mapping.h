@@ -52,7 +52,8 @@ public:
     const IrradianceCache* cache() const { return cache_.get(); }
 
 private:
-    Color radiance_along(const Ray& ray, int depth, float path_length, float spread, SampleContext& context) const;
+    Color radiance_along(const Ray& ray, int depth, float path_length, RayFootprint footprint,
+                         SampleContext& context) const;
     Color indirect_irradiance(const DiffusePoint& point, SampleContext& context) const;
 
     std::shared_ptr<const RenderScene> scene_;

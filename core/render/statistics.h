@@ -61,6 +61,11 @@ struct RenderStatistics {
     };
     std::optional<IrradianceCacheFigures> irradiance_cache;
 
+    /// What the user should know about this render: the scene's warnings (Scene::warnings:
+    /// ignored glTF features), then the render's own (an incomplete photon map). One sentence
+    /// each; any pass may append.
+    std::vector<std::string> warnings;
+
     double rays_per_second() const {
         return render_seconds > 0.0 ? static_cast<double>(rays + shadow_rays) / render_seconds : 0.0;
     }

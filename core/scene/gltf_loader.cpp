@@ -1,8 +1,11 @@
 #include "core/scene/gltf_loader.h"
 
+#include "core/scene/gltf_compression.h"
+
 #include <tiny_gltf.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <exception>
@@ -34,6 +37,16 @@ constexpr uint64_t kMaxImagePixels = uint64_t(1) << 26;
 const std::set<std::string, std::less<>> kSupportedRequiredExtensions = {
     "KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_transmission",
     "KHR_materials_ior", "KHR_materials_specular"};
+
+// Geometry and file extensions (kept apart from the material ones above): decoded by the loader,
+// so a file may require them.
+const std::set<std::string, std::less<>> kSupportedGeometryExtensions = {
+    "KHR_mesh_quantization", "EXT_meshopt_compression", "KHR_draco_mesh_compression"};
+
+bool is_supported_extension(const std::string& name) {
+    return kSupportedRequiredExtensions.count(name) > 0 ||
+           kSupportedGeometryExtensions.count(name) > 0;
+}
 
 std::string quoted(const std::string& name) { return name.empty() ? "" : " '" + name + "'"; }
 
@@ -468,6 +481,8 @@ public:
         : model_(model), file_(std::move(display_name)), builder_(file_) {
         for (const tinygltf::Buffer& buffer : model_.buffers)
             total_buffer_bytes_ += buffer.data.size();
+        const auto& used = model_.extensionsUsed;
+        quantized_ = std::find(used.begin(), used.end(), "KHR_mesh_quantization") != used.end();
     }
 
     Expected<Scene> read();
@@ -486,6 +501,11 @@ private:
     Expected<int> scene_texture(int texture_index, const std::string& context);
     Status visit_node(int node_index, const Mat4& parent, int depth);
     Status add_camera(const tinygltf::Node& node, int node_index, const Mat4& world);
+    void add_cameras();
+    void note_dropped_primitive_features(const tinygltf::Primitive& prim,
+                                         const std::vector<Vec3>& positions,
+                                         const std::vector<glm::uvec3>& triangles);
+    void add_feature_warnings();
     Status add_light(const tinygltf::Node& node, int node_index, const Mat4& world);
     Expected<Mat4> local_transform(const tinygltf::Node& node, int node_index) const;
 
@@ -501,10 +521,17 @@ private:
     std::string file_;
     SceneBuilder builder_;
     size_t total_buffer_bytes_ = 0;
+    bool quantized_ = false;  // KHR_mesh_quantization declared: integer attributes allowed
     std::vector<std::optional<std::vector<DecodedPrimitive>>> meshes_;
     std::map<int, uint32_t> materials_;  // glTF material (-1: default) -> scene material
     std::map<int, int> textures_;        // glTF image -> scene texture
     std::vector<uint8_t> on_path_;       // cycle detection during the node walk
+    std::vector<std::optional<CameraDesc>> cameras_;  // per glTF camera, from the first node
+    std::vector<std::vector<int>> camera_nodes_;      // per glTF camera, the nodes placing it
+    // What the walk met and drops or takes its own way, for add_feature_warnings.
+    size_t skipped_point_line_primitives_ = 0;
+    std::set<std::string> ignored_attributes_;      // attribute names read by nothing
+    std::set<int> solid_transmission_materials_;    // on closed meshes without KHR_materials_volume
     size_t node_visits_ = 0;
     size_t triangle_count_ = 0;
     size_t vertex_count_ = 0;
@@ -544,9 +571,12 @@ Status GltfSceneReader::check_view_range(int view_index, size_t byte_offset, siz
     return Status::ok();
 }
 
+const AccessorRule& effective_rule(const AccessorRule& rule, bool quantized);
+
 Expected<PackedAccessor> GltfSceneReader::pack_accessor(int index, const std::string& context,
                                                         const std::string& role,
-                                                        const AccessorRule& rule) {
+                                                        const AccessorRule& core_rule) {
+    const AccessorRule& rule = effective_rule(core_rule, quantized_);
     if (index < 0 || static_cast<size_t>(index) >= model_.accessors.size())
         return fail(context + role + " uses accessor " + std::to_string(index) +
                     ", which does not exist");
@@ -564,10 +594,18 @@ Expected<PackedAccessor> GltfSceneReader::pack_accessor(int index, const std::st
     const bool accepted = contains(rule.float_component_types, ct) ||
                           (accessor.normalized && contains(rule.normalized_component_types, ct)) ||
                           (!accessor.normalized && contains(rule.integer_component_types, ct));
-    if (!accepted)
+    if (!accepted) {
+        const AccessorRule& widened = effective_rule(core_rule, true);
+        const bool quantization_would_allow =
+            !quantized_ && (contains(widened.normalized_component_types, ct) ||
+                            contains(widened.integer_component_types, ct));
         return fail(what + " has componentType " + component_type_name(ct) +
                     (accessor.normalized ? " (normalized)" : "") + ", which " + role +
-                    " does not allow");
+                    " does not allow" +
+                    (quantization_would_allow
+                         ? " without KHR_mesh_quantization in extensionsUsed"
+                         : ""));
+    }
 
     PackedAccessor packed;
     packed.count = accessor.count;
@@ -662,6 +700,34 @@ const AccessorRule kTexcoordRule{
     {TINYGLTF_COMPONENT_TYPE_FLOAT},
     {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
     {}};
+
+// KHR_mesh_quantization widens the rules: POSITION and TEXCOORD_n may be any 8- or 16-bit
+// integer, normalized or not, NORMAL a normalized signed one. The dequantizing scale and offset
+// live in the node transform (and for texture coordinates in KHR_texture_transform).
+constexpr int kByte = TINYGLTF_COMPONENT_TYPE_BYTE;
+constexpr int kUnsignedByte = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+constexpr int kShort = TINYGLTF_COMPONENT_TYPE_SHORT;
+constexpr int kUnsignedShort = TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+const AccessorRule kQuantizedPositionRule{{TINYGLTF_TYPE_VEC3},
+                                          {TINYGLTF_COMPONENT_TYPE_FLOAT},
+                                          {kByte, kUnsignedByte, kShort, kUnsignedShort},
+                                          {kByte, kUnsignedByte, kShort, kUnsignedShort}};
+const AccessorRule kQuantizedNormalRule{
+    {TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, {kByte, kShort}, {}};
+const AccessorRule kQuantizedTexcoordRule{{TINYGLTF_TYPE_VEC2},
+                                          {TINYGLTF_COMPONENT_TYPE_FLOAT},
+                                          {kByte, kUnsignedByte, kShort, kUnsignedShort},
+                                          {kByte, kUnsignedByte, kShort, kUnsignedShort}};
+
+// The rule an attribute follows in this file: the core rule, widened where the file declares
+// KHR_mesh_quantization.
+const AccessorRule& effective_rule(const AccessorRule& rule, bool quantized) {
+    if (!quantized) return rule;
+    if (&rule == &kPositionRule) return kQuantizedPositionRule;
+    if (&rule == &kNormalRule) return kQuantizedNormalRule;
+    if (&rule == &kTexcoordRule) return kQuantizedTexcoordRule;
+    return rule;
+}
 const AccessorRule kIndexRule{
     {TINYGLTF_TYPE_SCALAR},
     {},
@@ -794,8 +860,10 @@ Status GltfSceneReader::load_mesh(int mesh_index) {
                                     " primitive " + std::to_string(p) + ": ";
         const int mode = prim.mode;
         if (mode == TINYGLTF_MODE_POINTS || mode == TINYGLTF_MODE_LINE ||
-            mode == TINYGLTF_MODE_LINE_LOOP || mode == TINYGLTF_MODE_LINE_STRIP)
-            continue;  // points and lines have no area to render
+            mode == TINYGLTF_MODE_LINE_LOOP || mode == TINYGLTF_MODE_LINE_STRIP) {
+            ++skipped_point_line_primitives_;  // points and lines have no area to render
+            continue;
+        }
         if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
             mode != TINYGLTF_MODE_TRIANGLE_FAN)
             return fail(context + "unknown primitive mode " + std::to_string(mode));
@@ -899,10 +967,150 @@ Status GltfSceneReader::load_mesh(int mesh_index) {
             for (size_t i = 1; i + 1 < n; ++i)
                 out.triangles.emplace_back(indices[0], indices[i], indices[i + 1]);
         }
+        note_dropped_primitive_features(prim, out.positions, out.triangles);
         decoded.push_back(std::move(out));
     }
     meshes_[static_cast<size_t>(mesh_index)] = std::move(decoded);
     return Status::ok();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Warnings: what a file holds that the loader drops or takes its own way. Keep this list in step
+// with what the loader reads: remove an entry when its feature is implemented.
+
+// Every edge of the triangles (vertices welded by position) is shared by exactly two of them.
+bool is_closed_surface(const std::vector<Vec3>& positions,
+                       const std::vector<glm::uvec3>& triangles) {
+    if (triangles.empty()) return false;
+    std::map<std::array<float, 3>, uint32_t> welded;
+    std::vector<uint32_t> vertex(positions.size());
+    for (size_t i = 0; i < positions.size(); ++i)
+        vertex[i] = welded.emplace(std::array<float, 3>{positions[i].x, positions[i].y,
+                                                        positions[i].z},
+                                   static_cast<uint32_t>(welded.size()))
+                        .first->second;
+    std::map<std::pair<uint32_t, uint32_t>, int> edges;
+    for (const glm::uvec3& t : triangles) {
+        const uint32_t v[3] = {vertex[t.x], vertex[t.y], vertex[t.z]};
+        for (int k = 0; k < 3; ++k)
+            ++edges[std::minmax(v[k], v[(k + 1) % 3])];
+    }
+    return std::all_of(edges.begin(), edges.end(), [](const auto& e) { return e.second == 2; });
+}
+
+// "'A', 'B' and 3 more" for a warning naming the materials (or other things) involved.
+std::string name_list(const std::vector<std::string>& names) {
+    constexpr size_t kShown = 3;
+    std::string list;
+    for (size_t i = 0; i < names.size() && i < kShown; ++i)
+        list += (i == 0 ? "" : i + 1 == names.size() ? " and " : ", ") + ("'" + names[i] + "'");
+    if (names.size() > kShown) list += " and " + std::to_string(names.size() - kShown) + " more";
+    return list;
+}
+
+void GltfSceneReader::note_dropped_primitive_features(const tinygltf::Primitive& prim,
+                                                      const std::vector<Vec3>& positions,
+                                                      const std::vector<glm::uvec3>& triangles) {
+    for (const auto& [name, accessor] : prim.attributes) {
+        if (name.rfind("COLOR_", 0) == 0 || name.rfind("JOINTS_", 0) == 0 ||
+            name.rfind("WEIGHTS_", 0) == 0)
+            ignored_attributes_.insert(name.substr(0, name.find('_')));
+    }
+    if (!prim.targets.empty()) ignored_attributes_.insert("morph targets");
+    if (prim.material < 0 || static_cast<size_t>(prim.material) >= model_.materials.size()) return;
+    // KHR_materials_transmission without KHR_materials_volume is thin-walled by the glTF
+    // specification; the renderer takes every transmissive surface as the boundary of a solid
+    // dielectric (as Blender's exporter means a glass sphere). Where that differs (a closed mesh
+    // is solid glass, not a thin shell), say so.
+    const auto& ext = model_.materials[static_cast<size_t>(prim.material)].extensions;
+    const Expected<double> transmission =
+        extension_number(ext, "KHR_materials_transmission", "transmissionFactor", 0.0);
+    if (transmission && *transmission > 0.0 && !ext.count("KHR_materials_volume") &&
+        is_closed_surface(positions, triangles))
+        solid_transmission_materials_.insert(prim.material);
+}
+
+void GltfSceneReader::add_feature_warnings() {
+    if (skipped_point_line_primitives_ > 0)
+        builder_.add_warning(std::to_string(skipped_point_line_primitives_) +
+                             " point or line primitive(s) are not rendered (they have no area)");
+    for (const std::string& what : ignored_attributes_) {
+        if (what == "COLOR")
+            builder_.add_warning("vertex colours (COLOR_n) are ignored");
+        else if (what == "morph targets")
+            builder_.add_warning("morph targets are ignored: meshes are rendered in their base shape");
+        else
+            builder_.add_warning("skinning (" + what + "_n) is ignored: skinned meshes are rendered "
+                                 "in their bind pose");
+    }
+    if (!model_.animations.empty())
+        builder_.add_warning(std::to_string(model_.animations.size()) +
+                             " animation(s) are ignored: the nodes' static transforms are rendered");
+    if (model_.scenes.size() > 1)
+        builder_.add_warning("the file has " + std::to_string(model_.scenes.size()) +
+                             " scenes; only the default scene is rendered");
+
+    // Material features the reader does not take (it reads the factors, baseColorTexture and
+    // the extensions of kSupportedRequiredExtensions). occlusionTexture is ignored by design: it
+    // approximates for rasterizers what global illumination computes.
+    struct MaterialFeature {
+        const char* what;
+        bool (*present)(const tinygltf::Material&, const tinygltf::Model&);
+    };
+    static const MaterialFeature kDropped[] = {
+        {"normalTexture is ignored (no normal mapping)",
+         [](const tinygltf::Material& m, const tinygltf::Model&) {
+             return m.normalTexture.index >= 0;
+         }},
+        {"emissiveTexture is ignored (emission is emissiveFactor alone)",
+         [](const tinygltf::Material& m, const tinygltf::Model&) {
+             return m.emissiveTexture.index >= 0;
+         }},
+        {"metallicRoughnessTexture is ignored (metallic and roughness are the factors alone)",
+         [](const tinygltf::Material& m, const tinygltf::Model&) {
+             return m.pbrMetallicRoughness.metallicRoughnessTexture.index >= 0;
+         }},
+        {"alphaMode MASK or BLEND is ignored (surfaces are opaque)",
+         [](const tinygltf::Material& m, const tinygltf::Model&) {
+             return m.alphaMode == "MASK" || m.alphaMode == "BLEND";
+         }},
+        {"the base-colour texture's sampler (wrap mode or filter) is ignored: textures repeat and "
+         "are filtered bilinearly",
+         [](const tinygltf::Material& m, const tinygltf::Model& model) {
+             const int t = m.pbrMetallicRoughness.baseColorTexture.index;
+             if (t < 0 || static_cast<size_t>(t) >= model.textures.size()) return false;
+             const int s = model.textures[static_cast<size_t>(t)].sampler;
+             if (s < 0 || static_cast<size_t>(s) >= model.samplers.size()) return false;
+             const tinygltf::Sampler& sampler = model.samplers[static_cast<size_t>(s)];
+             return sampler.wrapS != TINYGLTF_TEXTURE_WRAP_REPEAT ||
+                    sampler.wrapT != TINYGLTF_TEXTURE_WRAP_REPEAT ||
+                    sampler.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST;
+         }},
+    };
+    const auto material_name = [&](int index) {
+        const std::string& name = model_.materials[static_cast<size_t>(index)].name;
+        return name.empty() ? "material " + std::to_string(index) : name;
+    };
+    for (const MaterialFeature& feature : kDropped) {
+        std::vector<std::string> names;
+        for (const auto& [index, unused] : materials_) {
+            if (index >= 0 && feature.present(model_.materials[static_cast<size_t>(index)], model_))
+                names.push_back(material_name(index));
+        }
+        if (!names.empty())
+            builder_.add_warning(std::string(feature.what) + ": material" +
+                                 (names.size() > 1 ? "s " : " ") + name_list(names));
+    }
+    if (!solid_transmission_materials_.empty()) {
+        std::vector<std::string> names;
+        for (int index : solid_transmission_materials_) names.push_back(material_name(index));
+        builder_.add_warning(
+            "KHR_materials_transmission without KHR_materials_volume on a closed mesh (material" +
+            std::string(names.size() > 1 ? "s " : " ") + name_list(names) +
+            "): rendered as solid glass that refracts, not as the thin-walled shell the glTF "
+            "specification describes (add KHR_materials_volume with a thickness to say it is "
+            "solid)");
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -958,12 +1166,34 @@ Status GltfSceneReader::add_camera(const tinygltf::Node& node, int node_index, c
     const std::string context = "node " + std::to_string(node_index) + quoted(node.name) + ": ";
     if (node.camera < 0 || static_cast<size_t>(node.camera) >= model_.cameras.size())
         return fail(context + "camera " + std::to_string(node.camera) + " does not exist");
-    const tinygltf::Camera& camera = model_.cameras[static_cast<size_t>(node.camera)];
-    if (camera.type != "perspective") return Status::ok();  // orthographic cameras: skipped
-    const double yfov = camera.perspective.yfov;
-    if (!(yfov > 0.0 && yfov < double(kPi)))
-        return fail(context + "camera " + std::to_string(node.camera) + quoted(camera.name) +
-                    " has yfov " + std::to_string(yfov) + ", outside (0, pi)");
+    const auto camera_index = static_cast<size_t>(node.camera);
+    const tinygltf::Camera& camera = model_.cameras[camera_index];
+    const std::string what = context + "camera " + std::to_string(node.camera) + quoted(camera.name);
+    camera_nodes_[camera_index].push_back(node_index);
+    if (camera_nodes_[camera_index].size() > 1) return Status::ok();  // the first node places it
+    CameraDesc desc;
+    if (camera.type == "perspective") {
+        const double yfov = camera.perspective.yfov;
+        if (!(yfov > 0.0 && yfov < double(kPi)))
+            return fail(what + " has yfov " + std::to_string(yfov) + ", outside (0, pi)");
+        desc.vfov_deg = float(yfov * 180.0 / double(kPi));
+        const double aspect = camera.perspective.aspectRatio;
+        desc.aspect = aspect > 0.0 && std::isfinite(aspect) ? float(aspect) : 0.0f;
+    } else if (camera.type == "orthographic") {
+        // xmag and ymag are half the view's width and height; the spec forbids zero and
+        // discourages negative values, which are taken by magnitude.
+        const double xmag = std::abs(camera.orthographic.xmag);
+        const double ymag = std::abs(camera.orthographic.ymag);
+        if (!(xmag > 0.0 && ymag > 0.0 && std::isfinite(xmag) && std::isfinite(ymag)))
+            return fail(what + " has xmag " + std::to_string(camera.orthographic.xmag) +
+                        " and ymag " + std::to_string(camera.orthographic.ymag) +
+                        ": both must be finite and non-zero");
+        desc.projection = CameraProjection::Orthographic;
+        desc.ortho_half_height = float(ymag);
+        desc.aspect = float(xmag / ymag);
+    } else {
+        return fail(what + " has unknown type '" + camera.type + "'");
+    }
     const Mat3 linear(world);
     const Vec3 forward_raw = linear * Vec3(0.0f, 0.0f, -1.0f);
     const Vec3 up_raw = linear * Vec3(0.0f, 1.0f, 0.0f);
@@ -977,17 +1207,41 @@ Status GltfSceneReader::add_camera(const tinygltf::Node& node, int node_index, c
         return fail(context + "camera transform is degenerate");
     up /= up_len;
 
-    CameraDesc desc;
     desc.name = !camera.name.empty() ? camera.name : node.name;
     desc.position = Vec3(world[3]);
     desc.look_at = desc.position + forward;
     desc.up = up;
-    desc.vfov_deg = float(yfov * 180.0 / double(kPi));
-    const double aspect = camera.perspective.aspectRatio;
-    desc.aspect = aspect > 0.0 && std::isfinite(aspect) ? float(aspect) : 0.0f;
     if (!is_finite(desc.position)) return fail(context + "camera position is not finite");
-    builder_.add_camera(std::move(desc));
+    cameras_[camera_index] = std::move(desc);
     return Status::ok();
+}
+
+void GltfSceneReader::add_cameras() {
+    // Scene::cameras[i] is the file's cameras[i], so that a job's gltf_camera indexes cameras[].
+    for (size_t i = 0; i < model_.cameras.size(); ++i) {
+        const std::string name = model_.cameras[i].name;
+        const std::string what = "camera " + std::to_string(i) + quoted(name);
+        const std::vector<int>& nodes = camera_nodes_[i];
+        if (!cameras_[i]) {
+            CameraDesc unplaced;
+            unplaced.name = name.empty() ? what : name;
+            unplaced.placed = false;
+            builder_.add_camera(std::move(unplaced));
+            builder_.add_warning(what + " is placed by no node of the rendered scene: it cannot be "
+                                 "rendered from (gltf_camera " + std::to_string(i) + " is refused)");
+            continue;
+        }
+        if (nodes.size() > 1) {
+            std::string list;
+            for (size_t k = 0; k < nodes.size() && k < 4; ++k)
+                list += (k > 0 ? ", " : "") + std::to_string(nodes[k]);
+            if (nodes.size() > 4) list += ", ...";
+            builder_.add_warning(what + " is placed by " + std::to_string(nodes.size()) +
+                                 " nodes (" + list + "): gltf_camera " + std::to_string(i) +
+                                 " renders from the first, node " + std::to_string(nodes[0]));
+        }
+        builder_.add_camera(std::move(*cameras_[i]));
+    }
 }
 
 Status GltfSceneReader::add_light(const tinygltf::Node& node, int node_index, const Mat4& world) {
@@ -1018,7 +1272,11 @@ Status GltfSceneReader::add_light(const tinygltf::Node& node, int node_index, co
         if (light.color.size() != 3) return fail(what + " color must have 3 components");
         color = Color(float(light.color[0]), float(light.color[1]), float(light.color[2]));
     }
-    const float intensity = float(light.intensity);
+    // KHR_lights_punctual is photometric: candela (point, spot) and lux (directional). At
+    // 683 lm/W, W/sr = cd / 683 and W/m^2 = lx / 683 (PunctualLight keeps radiometric units).
+    // A number beyond float range as written is refused, as before the conversion shrank it.
+    if (!std::isfinite(float(light.intensity))) return fail(what + " has a non-finite value");
+    const float intensity = float(light.intensity / double(kLumensPerWatt));
     out.intensity = glm::max(color * intensity, Color(0.0f));
     out.position = Vec3(world[3]);
     const Vec3 direction = Mat3(world) * Vec3(0.0f, 0.0f, -1.0f);
@@ -1037,6 +1295,11 @@ Status GltfSceneReader::add_light(const tinygltf::Node& node, int node_index, co
     if (!is_finite(out.intensity) || !is_finite(out.position) || !is_finite(out.direction) ||
         !std::isfinite(out.cos_inner) || !std::isfinite(out.cos_outer))
         return fail(what + " has a non-finite value");
+    if (light.range > 0.0 && out.type != PunctualLightType::Directional)
+        builder_.add_warning("light " + std::to_string(index) + quoted(light.name) + ": range " +
+                             std::to_string(light.range) +
+                             " is ignored (the light falls off with the inverse square of the "
+                             "distance everywhere)");
     builder_.add_light(std::move(out));
     return Status::ok();
 }
@@ -1103,11 +1366,18 @@ Status GltfSceneReader::visit_node(int node_index, const Mat4& parent, int depth
 
 Expected<Scene> GltfSceneReader::read() {
     for (const std::string& extension : model_.extensionsRequired) {
-        if (!kSupportedRequiredExtensions.count(extension))
+        if (!is_supported_extension(extension))
             return fail("requires the unsupported extension " + extension);
+    }
+    for (const std::string& extension : model_.extensionsUsed) {
+        if (!is_supported_extension(extension))
+            builder_.add_warning("glTF extension " + extension +
+                                 " is not supported: what it adds to the file is ignored");
     }
     meshes_.resize(model_.meshes.size());
     on_path_.assign(model_.nodes.size(), 0);
+    cameras_.assign(model_.cameras.size(), std::nullopt);
+    camera_nodes_.assign(model_.cameras.size(), {});
 
     std::vector<int> roots;
     if (model_.defaultScene >= 0 || !model_.scenes.empty()) {
@@ -1134,6 +1404,8 @@ Expected<Scene> GltfSceneReader::read() {
         if (Status st = visit_node(root, Mat4(1.0f), 0); !st) return st.error();
 
     if (triangle_count_ == 0) return fail("contains no triangles");
+    add_cameras();
+    add_feature_warnings();
     Expected<Scene> scene = builder_.build();
     if (!scene) return fail(scene.error().message);
     return scene;
@@ -1160,6 +1432,11 @@ Expected<Scene> load_from_bytes(std::span<const uint8_t> bytes, const std::strin
                          std::to_string(declared) + " bytes, the data has " +
                          std::to_string(bytes.size())};
     }
+
+    // Compressed files are patched where tinygltf would refuse them (gltf_compression.h).
+    Expected<CompressedFilePatch> patched = patch_compressed_file_for_tinygltf(bytes);
+    if (!patched) return Error{display_name + ": " + patched.error().message};
+    if (!patched->bytes.empty()) bytes = patched->bytes;
 
     tinygltf::Model model;
     tinygltf::TinyGLTF parser;
@@ -1188,6 +1465,16 @@ Expected<Scene> load_from_bytes(std::span<const uint8_t> bytes, const std::strin
         if (detail.empty()) detail = trim_trailing_whitespace(warn);
         return Error{display_name + ": cannot load " + (binary ? "GLB" : "glTF") + ": " +
                      (detail.empty() ? "unknown error" : detail)};
+    }
+    // Compressed geometry becomes plain buffers before the reader checks any accessor.
+    for (Status (*decode)(tinygltf::Model&, uint64_t) :
+         {&decode_meshopt_buffer_views, &decode_draco_primitives}) {
+        try {
+            if (Status st = decode(model, kMaxFileBytes); !st)
+                return Error{display_name + ": " + st.error().message};
+        } catch (const std::exception& e) {
+            return Error{display_name + ": decoding compressed geometry: " + e.what()};
+        }
     }
     try {
         GltfSceneReader reader(model, display_name);

@@ -1,9 +1,13 @@
 // glTF 2.0 loader (.gltf and .glb) producing a photond::Scene through SceneBuilder.
 //
 // Reads triangle meshes (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN; points and lines are skipped)
-// under the default scene's node hierarchy, metallic-roughness materials with
-// KHR_materials_emissive_strength / _transmission / _ior / _specular, base-colour textures (PNG
-// or JPEG, decoded to linear RGB), perspective cameras and KHR_lights_punctual lights.
+// under the default scene's node hierarchy, also quantized (KHR_mesh_quantization) and compressed
+// (EXT_meshopt_compression, KHR_draco_mesh_compression: gltf_compression.h), metallic-roughness
+// materials with KHR_materials_emissive_strength / _transmission / _ior / _specular, base-colour
+// textures (PNG or JPEG, decoded to linear RGB), perspective and orthographic cameras (one
+// Scene::cameras entry per cameras[] entry) and KHR_lights_punctual lights (candela and lux
+// converted to W/sr and W/m^2). What the file holds and the loader ignores is named in
+// Scene::warnings.
 //
 // Untrusted input is expected: every accessor, index and buffer range is checked before use, no
 // file outside the bundle root is ever opened, and every failure comes back as an Error whose

@@ -1,5 +1,6 @@
 #include "core/scene/scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -112,6 +113,12 @@ uint32_t SceneBuilder::add_texture(Texture texture) {
 void SceneBuilder::add_light(PunctualLight light) { scene_.lights.push_back(std::move(light)); }
 
 void SceneBuilder::add_camera(CameraDesc camera) { scene_.cameras.push_back(std::move(camera)); }
+
+void SceneBuilder::add_warning(std::string warning) {
+    std::vector<std::string>& warnings = scene_.warnings;
+    if (std::find(warnings.begin(), warnings.end(), warning) == warnings.end())
+        warnings.push_back(std::move(warning));
+}
 
 Status SceneBuilder::add_mesh(std::span<const Vec3> positions, std::span<const Vec3> normals,
                               std::span<const Vec2> uvs, std::span<const glm::uvec3> triangles,

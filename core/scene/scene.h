@@ -44,8 +44,13 @@ struct Material {
 
 enum class PunctualLightType : uint8_t { Point, Spot, Directional };
 
-/// KHR_lights_punctual. Units are radiometric: intensity in W/sr (point, spot), irradiance in
-/// W/m^2 (directional). The glTF photometric values are taken as these numbers unchanged.
+/// The luminous efficacy that converts photometric light units to radiometric ones: 683 lm/W, the
+/// SI definition of the candela (monochromatic 540 THz light), as glTF exporters use it.
+inline constexpr float kLumensPerWatt = 683.0f;
+
+/// A punctual light. Units are radiometric: intensity in W/sr (point, spot), irradiance in W/m^2
+/// (directional). The glTF loader converts KHR_lights_punctual's photometric values (candela,
+/// lux) at 683 lm/W: W/sr = cd / 683, W/m^2 = lx / 683 (see kLumensPerWatt).
 struct PunctualLight {
     PunctualLightType type = PunctualLightType::Point;
     std::string name;
@@ -77,7 +82,10 @@ struct Environment {
     bool has_image() const { return width > 0 && height > 0; }
 };
 
-/// A pinhole camera: position, orientation and vertical field of view.
+enum class CameraProjection : uint8_t { Perspective, Orthographic };
+
+/// A camera: position, orientation and either a vertical field of view (perspective, a pinhole)
+/// or the half-height of the view (orthographic, glTF's ymag).
 struct CameraDesc {
     std::string name;
     Vec3 position{0.0f, 0.0f, 1.0f};
@@ -85,6 +93,12 @@ struct CameraDesc {
     Vec3 up{0.0f, 1.0f, 0.0f};
     float vfov_deg = 40.0f;
     float aspect = 0.0f;  // width / height from the file; 0 = take the image's
+    // Added after the original members, so that positional initializers keep their meaning.
+    CameraProjection projection = CameraProjection::Perspective;
+    float ortho_half_height = 1.0f;  // orthographic: half the view's height in world units
+    /// False for a glTF camera that no node of the default scene places: it keeps its index in
+    /// Scene::cameras but cannot be rendered from.
+    bool placed = true;
 };
 
 struct Bounds3 {
@@ -120,9 +134,15 @@ struct Scene {
     std::vector<Material> materials;
     std::vector<Texture> textures;
     std::vector<PunctualLight> lights;
+    /// glTF files: one per entry of the file's cameras[] array, same index (placed by the first
+    /// node that instantiates it). Built-in scenes: their own views.
     std::vector<CameraDesc> cameras;
     /// Distant light around the scene; absent: none (only the scene's own lights shine).
     std::optional<Environment> environment;
+    /// What the scene's source holds and the renderer ignores or takes differently than the file
+    /// may mean (unsupported extensions, dropped features), one self-contained sentence each.
+    /// Anyone may append (SceneBuilder::add_warning); reported in the statistics and job status.
+    std::vector<std::string> warnings;
     Bounds3 bounds;  // of all triangles (and of punctual light positions)
 
     /// Checks the invariants every consumer relies on (sizes, index ranges, finite data).
@@ -155,6 +175,8 @@ public:
     uint32_t add_texture(Texture texture);
     void add_light(PunctualLight light);
     void add_camera(CameraDesc camera);
+    /// Appends a warning to Scene::warnings (once: a repeated message is dropped).
+    void add_warning(std::string warning);
 
     /// Adds an indexed triangle mesh under a transform. `normals` and `uvs` may be empty (flat
     /// normals are generated; uv = 0) or have one entry per position. A transform with a negative

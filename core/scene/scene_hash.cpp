@@ -16,10 +16,10 @@ static_assert(sizeof(PunctualLight) == sizeof(std::string) + 56,
 static_assert(sizeof(Texture) == 8 + sizeof(std::vector<Color>),
               "Texture changed: hash the new field in scene_content_hash");
 // Scene::triangle_normals and flat_shaded are derived from the positions and normals and need no
-// hashing of their own.
+// hashing of their own; cameras and warnings do not affect light transport.
 static_assert(sizeof(Environment) == sizeof(std::string) + sizeof(std::vector<Color>) + 32,
               "Environment changed: hash the new field in scene_content_hash");
-static_assert(sizeof(Scene) == sizeof(std::string) + 11 * sizeof(std::vector<int>) +
+static_assert(sizeof(Scene) == sizeof(std::string) + 12 * sizeof(std::vector<int>) +
                                    sizeof(std::optional<Environment>) + sizeof(Bounds3),
               "Scene changed: hash the new field in scene_content_hash");
 static_assert(sizeof(void*) != 8 || sizeof(PhotonTracingSettings) == 48,

@@ -243,6 +243,34 @@ TEST_F(DaemonCache, JobRunningWhenTheDaemonDiedFailsWithItsReason) {
               409);
 }
 
+TEST_F(DaemonCache, WarningsOfAnUploadAreInItsInfoAndInTheJobStatus) {
+    Daemon daemon(dir_.path() / "cache");
+    ASSERT_TRUE(daemon.started()) << daemon.log();
+    const HttpClient client = daemon.client();
+    const std::string gltf = read_file(fs::path(PHOTOND_TEST_DATA_DIR) / "gltf" / "warnings.gltf");
+    const HttpResponse created = client.post("/v1/scenes", gltf);
+    ASSERT_EQ(created.status, 201) << created.body;
+    const std::string id = created.json_body().at("id");
+    const auto names = [](const json& warnings) {
+        std::string all;
+        for (const json& w : warnings) all += w.get<std::string>() + "\n";
+        return all;
+    };
+    const json info = client.get("/v1/scenes/" + id).json_body();
+    EXPECT_NE(names(info.at("warnings")).find("KHR_materials_iridescence is not supported"),
+              std::string::npos)
+        << info.dump();
+    const json job = {{"scene", {{"id", id}}},
+                      {"integrator", "direct"},
+                      {"image", {{"width", 8}, {"height", 8}, {"spp", 1}}}};
+    const json status = render(client, job);
+    ASSERT_EQ(status.at("state"), "done") << status.dump();
+    EXPECT_NE(names(status.at("warnings")).find("KHR_materials_anisotropy is not supported"),
+              std::string::npos)
+        << status.dump();
+    EXPECT_EQ(status.at("warnings"), status.at("statistics").at("warnings"));
+}
+
 TEST_F(DaemonCache, UploadedScenesAreStoredByContentAndRenderedById) {
     Daemon daemon(dir_.path() / "cache");
     ASSERT_TRUE(daemon.started()) << daemon.log();

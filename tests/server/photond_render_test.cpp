@@ -242,4 +242,78 @@ TEST_F(PhotondRender, PreviewTakesTheExposureAndTheFilmicCurve) {
     EXPECT_FALSE(fs::exists(dir_ / "bad.png"));
 }
 
+const fs::path kGltfData = fs::path(PHOTOND_TEST_DATA_DIR) / "gltf";
+
+bool contains_warning(const nlohmann::json& warnings, const std::string& text) {
+    for (const auto& w : warnings)
+        if (w.get<std::string>().find(text) != std::string::npos) return true;
+    return false;
+}
+
+TEST_F(PhotondRender, IncompletePhotonMapIsAWarningThatSaysWhatToChange) {
+    // One small mirror catches about 1 in 1,400 photons: 2,000 caustic photons need 2.8 M
+    // emissions, beyond the cap of 1,000 per requested photon.
+    const auto r = run("render " + (kGltfData / "sparse_caustics.gltf").string() +
+                       " --width 16 --height 16 --spp 1 --set photons.caustic=2000"
+                       " --set photons.global=2000 --set gather.rays=16 --stats-json " +
+                       (dir_ / "s.json").string() + " -o " + (dir_ / "c.exr").string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("  warning: photon map incomplete: the caustic map holds "),
+              std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("of the 2,000 photons requested"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("Set photons.caustic=0 to skip the caustic map"), std::string::npos)
+        << r.output;
+    const auto stats = nlohmann::json::parse(read_file(dir_ / "s.json"));
+    EXPECT_FALSE(stats.at("photons").at("caustic_complete").get<bool>());
+    EXPECT_TRUE(contains_warning(stats.at("warnings"), "photon map incomplete: the caustic map"))
+        << stats.at("warnings").dump();
+    EXPECT_FALSE(contains_warning(stats.at("warnings"), "the global map")) << stats.dump();
+}
+
+TEST_F(PhotondRender, IgnoredGltfFeaturesAreWarningsEvenWhenQuiet) {
+    const auto r = run("render " + (kGltfData / "warnings.gltf").string() +
+                       " --integrator direct --width 8 --height 8 --spp 1 --quiet --stats-json " +
+                       (dir_ / "s.json").string() + " -o " + (dir_ / "w.exr").string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("photond render: warning: glTF extension KHR_materials_sheen is not "
+                            "supported"),
+              std::string::npos)
+        << r.output;
+    const auto stats = nlohmann::json::parse(read_file(dir_ / "s.json"));
+    for (const char* name : {"KHR_materials_sheen", "KHR_materials_iridescence",
+                             "KHR_materials_anisotropy", "normalTexture", "COLOR_n"})
+        EXPECT_TRUE(contains_warning(stats.at("warnings"), name)) << name << stats.dump();
+    // A file without ignored features has an empty list.
+    const auto clean = run("render builtin:furnace --integrator direct --width 8 --height 8 "
+                           "--spp 1 --quiet --stats-json " + (dir_ / "f.json").string() + " -o " +
+                           (dir_ / "f.exr").string());
+    ASSERT_EQ(clean.exit_code, 0) << clean.output;
+    EXPECT_EQ(nlohmann::json::parse(read_file(dir_ / "f.json")).at("warnings"),
+              nlohmann::json::array());
+}
+
+TEST_F(PhotondRender, GltfCameraIndexesTheFilesCamerasArray) {
+    const std::string scene = (kGltfData / "camera_indexing.gltf").string();
+    const std::string common = " --integrator direct --width 8 --height 8 --spp 1 --quiet -o ";
+    // cameras[0] is placed by no node: refused by name.
+    auto r = run("render " + scene + " --set camera.gltf_camera=0" + common +
+                 (dir_ / "0.exr").string());
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_NE(r.output.find("camera.gltf_camera: camera 0 'Unplaced' is placed by no node"),
+              std::string::npos)
+        << r.output;
+    // cameras[2] is orthographic, cameras[1] placed twice: both render.
+    for (const char* index : {"1", "2"}) {
+        r = run("render " + scene + " --set camera.gltf_camera=" + index + common +
+                (dir_ / "c.exr").string());
+        EXPECT_EQ(r.exit_code, 0) << index << ": " << r.output;
+    }
+    r = run("render " + scene + " --set camera.gltf_camera=3" + common + (dir_ / "3.exr").string());
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_NE(r.output.find("the scene has 3 camera(s); index 3 does not exist"),
+              std::string::npos)
+        << r.output;
+}
+
 }  // namespace

@@ -8,7 +8,9 @@ import base64
 import json
 import math
 import os
+import shutil
 import struct
+import subprocess
 import zlib
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -380,8 +382,8 @@ def broken():
     write("broken/absolute_uri.gltf", b.finish(uri="/etc/passwd"))
 
     b = quad_indexed(U8)
-    b.doc["extensionsUsed"] = ["KHR_draco_mesh_compression"]
-    b.doc["extensionsRequired"] = ["KHR_draco_mesh_compression"]
+    b.doc["extensionsUsed"] = ["KHR_texture_basisu"]
+    b.doc["extensionsRequired"] = ["KHR_texture_basisu"]
     write("broken/unsupported_extension.gltf", b.finish())
 
     b = Builder()
@@ -409,6 +411,288 @@ def broken():
         f.write(bytes(b.data))
 
 
+def icosphere(subdivisions):
+    """Unit icosphere: (positions, triangles), counter-clockwise seen from outside."""
+    t = (1 + math.sqrt(5)) / 2
+    verts = [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t), (0, -1, -t),
+             (0, 1, -t), (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]
+    verts = [tuple(c / math.sqrt(sum(x * x for x in v)) for c in v) for v in verts]
+    faces = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4),
+             (11, 10, 2), (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8),
+             (3, 8, 9), (4, 9, 5), (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1)]
+    for _ in range(subdivisions):
+        cache = {}
+
+        def middle(a, b):
+            key = (min(a, b), max(a, b))
+            if key not in cache:
+                m = [(verts[a][k] + verts[b][k]) / 2 for k in range(3)]
+                n = math.sqrt(sum(x * x for x in m))
+                verts.append(tuple(x / n for x in m))
+                cache[key] = len(verts) - 1
+            return cache[key]
+        new_faces = []
+        for a, b, c in faces:
+            ab, bc, ca = middle(a, b), middle(b, c), middle(c, a)
+            new_faces += [(a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca)]
+        faces = new_faces
+    return verts, faces
+
+
+def box_mesh():
+    """Unit cube [-0.5, 0.5]^3 with flat normals: 24 vertices, 12 triangles facing out."""
+    positions, normals, indices = [], [], []
+    for axis in range(3):
+        for sign in (-1, 1):
+            n = [0, 0, 0]
+            n[axis] = sign
+            u, v = [(axis + 1) % 3, (axis + 2) % 3]
+            base = len(positions)
+            for du, dv in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
+                p = [0, 0, 0]
+                p[axis] = 0.5 * sign
+                p[u] = 0.5 * du
+                p[v] = 0.5 * dv
+                positions.append(p)
+                normals.append(n)
+            quad = [0, 1, 2, 0, 2, 3] if sign > 0 else [0, 2, 1, 0, 3, 2]
+            indices += [base + i for i in quad]
+    return positions, normals, indices
+
+
+def mesh_primitive(b, positions, normals, indices, material, uvs=None):
+    pos = b.floats([c for p in positions for c in p], "VEC3")
+    lo = [min(p[k] for p in positions) for k in range(3)]
+    hi = [max(p[k] for p in positions) for k in range(3)]
+    b.doc["accessors"][pos]["min"] = lo
+    b.doc["accessors"][pos]["max"] = hi
+    attrs = {"POSITION": pos, "NORMAL": b.floats([c for n in normals for c in n], "VEC3")}
+    if uvs is not None:
+        attrs["TEXCOORD_0"] = b.floats([c for uv in uvs for c in uv], "VEC2")
+    idx = b.indices(indices, U16)
+    return {"attributes": attrs, "indices": idx, "material": material}
+
+
+def room():
+    """A lit test scene for the mesh-compression tests: a floor, a back wall, a smooth sphere and a
+    turned, scaled box under a point light, with a camera. gltfpack writes its quantized and
+    meshopt-compressed copies (tests/scene/gltf_compression_test.cpp)."""
+    b = Builder()
+    b.doc["extensionsUsed"] = ["KHR_lights_punctual"]
+    b.doc["materials"] = [
+        {"name": "Floor", "pbrMetallicRoughness": {"baseColorFactor": [0.7, 0.7, 0.7, 1],
+                                                    "metallicFactor": 0}},
+        {"name": "Red", "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.2, 0.15, 1],
+                                                  "metallicFactor": 0, "roughnessFactor": 0.5}},
+        {"name": "Blue", "pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.3, 0.8, 1],
+                                                   "metallicFactor": 0}},
+    ]
+    quad = [[-4, 0, -3], [4, 0, -3], [4, 0, 4], [-4, 0, 4]]
+    floor = mesh_primitive(b, quad, [[0, 1, 0]] * 4, [0, 2, 1, 0, 3, 2], 0,
+                           uvs=[[0, 0], [1, 0], [1, 1], [0, 1]])
+    wall_quad = [[-4, 0, -3], [4, 0, -3], [4, 4, -3], [-4, 4, -3]]
+    wall = mesh_primitive(b, wall_quad, [[0, 0, 1]] * 4, [0, 1, 2, 0, 2, 3], 0)
+    verts, faces = icosphere(2)
+    sphere = mesh_primitive(b, verts, verts, [i for f in faces for i in f], 1)
+    bp, bn, bi = box_mesh()
+    box = mesh_primitive(b, bp, bn, bi, 2)
+    b.doc["meshes"] = [{"name": "Floor", "primitives": [floor, wall]},
+                       {"name": "Sphere", "primitives": [sphere]},
+                       {"name": "Box", "primitives": [box]}]
+    b.doc["extensions"] = {"KHR_lights_punctual": {"lights": [
+        {"name": "Bulb", "type": "point", "color": [1, 0.95, 0.9], "intensity": 8000}]}}
+    b.doc["cameras"] = [{"name": "View", "type": "perspective",
+                         "perspective": {"yfov": 0.8, "znear": 0.05}}]
+    s = math.sin(0.3)
+    c = math.cos(0.3)
+    b.doc["nodes"] = [
+        {"name": "FloorNode", "mesh": 0},
+        {"name": "SphereNode", "mesh": 1, "translation": [-0.4, 0.7, 0], "scale": [0.7, 0.7, 0.7]},
+        {"name": "BoxNode", "mesh": 2, "translation": [1.1, 0.35, -0.3],
+         "rotation": [0, s, 0, c], "scale": [0.7, 0.7, 0.9]},
+        {"name": "LightNode", "translation": [0.5, 2.6, 1.5],
+         "extensions": {"KHR_lights_punctual": {"light": 0}}},
+        # Looking down 0.3 rad from (0, 1.6, 4.5).
+        {"name": "CameraNode", "camera": 0, "translation": [0, 1.6, 4.5],
+         "rotation": [-math.sin(0.15), 0, 0, math.cos(0.15)]},
+    ]
+    b.doc["scenes"] = [{"nodes": [0, 1, 2, 3, 4]}]
+    b.doc["scene"] = 0
+    write("compression/room.gltf", b.finish())
+    gltfpack = shutil.which("gltfpack")
+    if not gltfpack:
+        print("gltfpack not found (Debian package gltfpack): compressed copies not rewritten")
+        return
+    source = os.path.join(HERE, "compression", "room.gltf")
+    for name, flags in (("room_quantized.glb", []), ("room_meshopt.glb", ["-cc"]),
+                        ("room_meshopt_float.glb", ["-cc", "-noq"])):
+        subprocess.run([gltfpack, "-i", source, "-o", os.path.join(HERE, "compression", name),
+                        "-kn", "-km"] + flags, check=True, stdout=subprocess.DEVNULL)
+
+
+def camera_indexing():
+    """cameras[0] is placed by no node, cameras[1] by two, cameras[2] is orthographic."""
+    b = Builder()
+    b.doc["meshes"] = [{"name": "Tri", "primitives": [{"attributes": triangle(b)}]}]
+    b.doc["cameras"] = [
+        {"name": "Unplaced", "type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1}},
+        {"name": "Shared", "type": "perspective", "perspective": {"yfov": 0.6, "znear": 0.1}},
+        {"name": "Ortho", "type": "orthographic",
+         "orthographic": {"xmag": 2, "ymag": 1, "znear": 0.1, "zfar": 100}},
+    ]
+    b.doc["nodes"] = [
+        {"name": "Geometry", "mesh": 0},
+        {"name": "OrthoNode", "translation": [0.25, 0.25, 4], "camera": 2},
+        {"name": "SharedFirst", "translation": [0, 0, 5], "camera": 1},
+        {"name": "SharedSecond", "translation": [9, 9, 9], "camera": 1},
+    ]
+    b.doc["scenes"] = [{"nodes": [0, 1, 2, 3]}]
+    write("camera_indexing.gltf", b.finish())
+
+
+def quantized():
+    """KHR_mesh_quantization: SHORT positions dequantized by the node's scale and translation,
+    normalized BYTE normals, UNSIGNED_BYTE (not normalized) texture coordinates."""
+    def build(declared):
+        b = Builder()
+        if declared:
+            b.doc["extensionsUsed"] = ["KHR_mesh_quantization"]
+            b.doc["extensionsRequired"] = ["KHR_mesh_quantization"]
+        # 6-byte elements at a stride of 8, which keeps vertex attributes 4-byte aligned.
+        pos_view = b.view(b"".join(struct.pack("<3hxx", *p) for p in
+                                   [(0, 0, 0), (1000, 0, 0), (1000, 1000, 0), (0, 1000, 0)]),
+                          stride=8)
+        pos = b.accessor(pos_view, 5122, 4, "VEC3", min=[0, 0, 0], max=[1000, 1000, 0])
+        nrm_view = b.view(struct.pack("<16b", *([0, 0, 127, 0] * 4)), stride=4)
+        nrm = b.accessor(nrm_view, 5120, 4, "VEC3", normalized=True)
+        uv = b.accessor(b.view(bytes([0, 0, 2, 0, 2, 2, 0, 2])), U8, 4, "VEC2")
+        idx = b.indices(QUAD_INDICES, U16)
+        b.doc["meshes"] = [{"name": "QuantizedQuad", "primitives": [
+            {"attributes": {"POSITION": pos, "NORMAL": nrm, "TEXCOORD_0": uv}, "indices": idx}]}]
+        b.doc["nodes"] = [{"name": "Dequantize", "mesh": 0, "translation": [1, 0, 0],
+                           "scale": [0.002, 0.002, 0.002]}]
+        b.doc["scenes"] = [{"nodes": [0]}]
+        return b.finish()
+    write("quantized.gltf", build(True))
+    write("broken/quantized_undeclared.gltf", build(False))
+
+
+def warnings_file():
+    """Features the loader ignores, each of which must come back as a warning."""
+    b = Builder()
+    b.doc["extensionsUsed"] = ["KHR_lights_punctual", "KHR_materials_sheen",
+                               "KHR_materials_iridescence", "KHR_materials_anisotropy"]
+    data = png(2, 2, TEXTURE_ROWS)
+    b.doc["images"] = [{"uri": png_data_uri(data)}]
+    b.doc["samplers"] = [{"wrapS": 33071, "wrapT": 33071}]
+    b.doc["textures"] = [{"source": 0, "sampler": 0}]
+    b.doc["materials"] = [
+        {"name": "Velvet", "normalTexture": {"index": 0}, "alphaMode": "MASK",
+         "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}},
+         "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1]},
+                        "KHR_materials_iridescence": {"iridescenceFactor": 1},
+                        "KHR_materials_anisotropy": {"anisotropyStrength": 0.5}}}]
+    attrs = triangle(b)
+    attrs["COLOR_0"] = b.floats([1, 0, 0, 0, 1, 0, 0, 0, 1], "VEC3")
+    b.doc["meshes"] = [{"name": "Tri", "primitives": [{"attributes": attrs, "material": 0},
+                                                      {"attributes": triangle(b), "mode": 1}]}]
+    b.doc["extensions"] = {"KHR_lights_punctual": {"lights": [
+        {"name": "Ranged", "type": "point", "intensity": 100, "range": 5}]}}
+    b.doc["cameras"] = [{"name": "Nowhere", "type": "perspective",
+                         "perspective": {"yfov": 0.5, "znear": 0.1}}]
+    b.doc["nodes"] = [{"name": "Geometry", "mesh": 0},
+                      {"name": "Light", "translation": [0, 0, 2],
+                       "extensions": {"KHR_lights_punctual": {"light": 0}}}]
+    b.doc["scenes"] = [{"nodes": [0, 1]}]
+    write("warnings.gltf", b.finish())
+
+
+def transmission():
+    """A closed glass box and an open glass pane, both KHR_materials_transmission without
+    KHR_materials_volume: only the box is worth a warning (solid glass, not thin-walled)."""
+    b = Builder()
+    b.doc["extensionsUsed"] = ["KHR_materials_transmission"]
+    glass = {"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "roughnessFactor": 0},
+             "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1}}}
+    b.doc["materials"] = [dict(glass, name="BoxGlass"), dict(glass, name="PaneGlass")]
+    bp, bn, bi = box_mesh()
+    box = mesh_primitive(b, bp, bn, bi, 0)
+    pane = mesh_primitive(b, [[0, 0, 2], [1, 0, 2], [1, 1, 2], [0, 1, 2]], [[0, 0, 1]] * 4,
+                          QUAD_INDICES, 1)
+    b.doc["meshes"] = [{"name": "GlassBox", "primitives": [box]},
+                       {"name": "GlassPane", "primitives": [pane]}]
+    b.doc["nodes"] = [{"mesh": 0}, {"mesh": 1}]
+    b.doc["scenes"] = [{"nodes": [0, 1]}]
+    write("transmission.gltf", b.finish())
+
+
+def blender_lights():
+    """What Blender's glTF exporter (io_scene_gltf2, lighting mode "Standard") writes for a point
+    lamp of 1000 W and a sun of 3 W/m^2: intensity = W / (4 pi) * 683 cd and 3 * 683 lx, next to a
+    quad emitting with strength 2 (emissiveFactor 1 x KHR_materials_emissive_strength 2, written
+    unchanged). The quad faces +Z and lights nothing the test measures; the floor is pure
+    Lambertian (KHR_materials_specular 0, no specular layer) so that its radiance is rho E / pi."""
+    b = Builder()
+    b.doc["extensionsUsed"] = ["KHR_lights_punctual", "KHR_materials_emissive_strength",
+                               "KHR_materials_specular"]
+    b.doc["materials"] = [
+        {"name": "White", "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1],
+                                                    "metallicFactor": 0},
+         "extensions": {"KHR_materials_specular": {"specularFactor": 0}}},
+        {"name": "Emitter", "emissiveFactor": [1, 1, 1],
+         "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0},
+         "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 2}}},
+    ]
+    floor = mesh_primitive(b, [[-3, 0, -3], [3, 0, -3], [3, 0, 3], [-3, 0, 3]], [[0, 1, 0]] * 4,
+                           [0, 2, 1, 0, 3, 2], 0)
+    emitter = mesh_primitive(b, [[1, 0.5, 0], [2, 0.5, 0], [2, 1.5, 0], [1, 1.5, 0]],
+                             [[0, 0, 1]] * 4, QUAD_INDICES, 1)
+    b.doc["meshes"] = [{"name": "Floor", "primitives": [floor]},
+                       {"name": "Emitter", "primitives": [emitter]}]
+    b.doc["extensions"] = {"KHR_lights_punctual": {"lights": [
+        {"name": "Point", "type": "point", "color": [1, 1, 1],
+         "intensity": 1000 / (4 * math.pi) * 683},
+        {"name": "Sun", "type": "directional", "color": [1, 1, 1], "intensity": 3 * 683}]}}
+    b.doc["nodes"] = [
+        {"name": "Floor", "mesh": 0},
+        {"name": "Emitter", "mesh": 1},
+        {"name": "Point", "translation": [-1, 2, 0],
+         "extensions": {"KHR_lights_punctual": {"light": 0}}},
+        # Pointing straight down (-Y).
+        {"name": "Sun", "rotation": [-math.sqrt(0.5), 0, 0, math.sqrt(0.5)],
+         "extensions": {"KHR_lights_punctual": {"light": 1}}},
+    ]
+    b.doc["scenes"] = [{"nodes": [0, 1, 2, 3]}]
+    write("blender_lights.gltf", b.finish())
+
+
+def sparse_caustics():
+    """A point light over a wide floor and one small mirror above it that catches about 3 in
+    10,000 photons: the caustic map cannot fill within the emission cap (1,000 per requested
+    photon), which the render must report as a warning."""
+    b = Builder()
+    b.doc["extensionsUsed"] = ["KHR_lights_punctual"]
+    b.doc["materials"] = [
+        {"name": "Floor", "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1],
+                                                    "metallicFactor": 0}},
+        {"name": "Mirror", "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1],
+                                                     "metallicFactor": 1, "roughnessFactor": 0}}]
+    floor = mesh_primitive(b, [[-10, 0, -10], [10, 0, -10], [10, 0, 10], [-10, 0, 10]],
+                           [[0, 1, 0]] * 4, [0, 2, 1, 0, 3, 2], 0)
+    # A 0.1 x 0.1 mirror 1 above the light, facing down.
+    mirror = mesh_primitive(b, [[-0.05, 2, -0.05], [0.05, 2, -0.05], [0.05, 2, 0.05],
+                                [-0.05, 2, 0.05]], [[0, -1, 0]] * 4, [0, 1, 2, 0, 2, 3], 1)
+    b.doc["meshes"] = [{"name": "Room", "primitives": [floor, mirror]}]
+    b.doc["extensions"] = {"KHR_lights_punctual": {"lights": [
+        {"name": "Bulb", "type": "point", "intensity": 683}]}}
+    b.doc["cameras"] = [{"type": "perspective", "perspective": {"yfov": 1.0, "znear": 0.1}}]
+    b.doc["nodes"] = [{"mesh": 0}, {"translation": [0.3, 1, 0],
+                                    "extensions": {"KHR_lights_punctual": {"light": 0}}},
+                      {"camera": 0, "translation": [0, 1.5, 4]}]
+    b.doc["scenes"] = [{"nodes": [0, 1, 2]}]
+    write("sparse_caustics.gltf", b.finish())
+
+
 def main():
     os.makedirs(os.path.join(HERE, "broken"), exist_ok=True)
     write("indexed_u8.gltf", quad_indexed(U8).finish())
@@ -425,6 +709,13 @@ def main():
     textures()
     sparse()
     broken()
+    camera_indexing()
+    quantized()
+    warnings_file()
+    transmission()
+    blender_lights()
+    sparse_caustics()
+    room()
 
 
 if __name__ == "__main__":
