@@ -352,12 +352,9 @@ Expected<AddedLighting> job_lighting(const protocol::Job& job, const Scene& scen
             break;
         }
     }
-    if (lighting.environment) {
-        // A black environment lights nothing: say so rather than render black in silence.
-        Scene probe;
-        probe.environment = lighting.environment;
-        if (!scene_emits_light(probe)) decision->reason += "; it is black and adds no light";
-    }
+    // A black environment lights nothing: say so rather than render black in silence.
+    if (lighting.environment && !environment_emits_light(*lighting.environment))
+        decision->reason += "; it is black and adds no light";
     return lighting;
 }
 
@@ -439,6 +436,15 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     stats.lighting.environment = lit_scene->environment ? lit_scene->environment->name : "";
     stats.passes.push_back({"scene", seconds_since(pass_start)});
     stats.warnings = (*scene)->warnings;
+    for (size_t i = 0; i < job.lights.size(); ++i) {
+        const protocol::LightSpec& light = job.lights[i];
+        if (light.strength * std::max({light.color[0], light.color[1], light.color[2]}) <= 0.0)
+            stats.warnings.push_back("lights[" + std::to_string(i) + "] (" + light.type + ") has no " +
+                                     std::string(protocol::light_strength_field(light.type)) +
+                                     " or a black colour: it adds no light");
+    }
+    if (lit_scene->environment && !environment_emits_light(*lit_scene->environment))
+        stats.warnings.push_back("the environment '" + lit_scene->environment->name + "' is black: it adds no light");
 
     pass_start = Clock::now();
     if (options.on_pass) options.on_pass("acceleration");

@@ -4,6 +4,15 @@
 
 namespace photond {
 
+bool environment_emits_light(const Environment& e) {
+    if (!(e.intensity > 0.0f)) return false;
+    if (!e.has_image()) return max_component(e.color) > 0.0f;
+    for (const Color& c : e.texels) {
+        if (max_component(c) > 0.0f) return true;
+    }
+    return false;
+}
+
 bool scene_emits_light(const Scene& scene) {
     for (const PunctualLight& l : scene.lights) {
         if (max_component(l.intensity) > 0.0f) return true;
@@ -11,15 +20,7 @@ bool scene_emits_light(const Scene& scene) {
     for (uint32_t t = 0; t < scene.triangles.size(); ++t) {
         if (scene.materials[scene.triangle_materials[t]].is_emissive() && scene.triangle_area(t) > 0.0f) return true;
     }
-    if (const std::optional<Environment>& e = scene.environment) {
-        if (e->intensity > 0.0f) {
-            if (!e->has_image()) return max_component(e->color) > 0.0f;
-            for (const Color& c : e->texels) {
-                if (max_component(c) > 0.0f) return true;
-            }
-        }
-    }
-    return false;
+    return scene.environment && environment_emits_light(*scene.environment);
 }
 
 Expected<Scene> with_added_lighting(const Scene& scene, const AddedLighting& lighting) {

@@ -31,6 +31,9 @@ struct AddedLighting {
     bool empty() const { return lights.empty() && quads.empty() && !environment; }
 };
 
+/// Whether an environment sends any light (a positive intensity and a texel or colour above 0).
+bool environment_emits_light(const Environment& environment);
+
 /// Whether anything in the scene emits: a punctual light of positive intensity, an emissive
 /// material on a triangle of positive area, or an environment that is not black.
 bool scene_emits_light(const Scene& scene);

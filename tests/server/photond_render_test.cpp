@@ -158,6 +158,15 @@ TEST_F(PhotondRender, SceneWithoutLightRendersUnderTheDefaultEnvironmentAndSaysS
     EXPECT_EQ(lit_stats.at("lighting").at("job_lights"), 1);
     EXPECT_EQ(lit_stats.at("lighting").at("environment"), "");
     EXPECT_GT(photond::max_component(mean_of(dir_ / "c.exr")), 0.0f);
+
+    // A light that cannot contribute is a warning, not silence.
+    const auto dark = run(common + "--set 'lights=[{\"type\": \"point\", \"position\": [0, 0, 2], "
+                                   "\"intensity\": 0}]' --integrator direct -o " +
+                          (dir_ / "d.exr").string() + " --stats-json " + (dir_ / "d.json").string());
+    ASSERT_EQ(dark.exit_code, 0) << dark.output;
+    EXPECT_NE(dark.output.find("lights[0] (point) has no intensity"), std::string::npos) << dark.output;
+    const auto dark_stats = nlohmann::json::parse(read_file(dir_ / "d.json"));
+    EXPECT_NE(dark_stats.at("warnings").dump().find("adds no light"), std::string::npos) << dark_stats.dump();
 }
 
 /// A Radiance RGBE file of one row of `width` texels of grey 0.5 (uncompressed: rows under 8
