@@ -123,6 +123,43 @@ TEST_F(DaemonSceneBundle, ZipTarAndTarGzRenderLikeTheFilesOnDisk) {
     EXPECT_EQ(client.post("/v1/jobs", quad_job({{"id", id}}).dump()).status, 422);
 }
 
+TEST_F(DaemonSceneBundle, EnvironmentImagesAreReadFromTheUploadedBundle) {
+    const HttpClient client = daemon_->client();
+    // A Radiance RGBE sky of 4 x 1 texels of grey 0.5 (rows under 8 texels are not run-length
+    // encoded), in the bundle beside the scene.
+    std::string hdr = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 4\n";
+    for (int i = 0; i < 4; ++i) hdr += std::string(4, char(128));
+    auto files = textured_quad_files();
+    files.push_back({"skies/grey.hdr", hdr});
+    const HttpResponse created = client.post("/v1/scenes", make_archive(as_entries(files), "zip"));
+    ASSERT_EQ(created.status, 201) << created.body;
+    const std::string id = created.json_body().at("id");
+
+    // Looking away from the quad, the camera sees the sky: 0.5 x intensity 3.
+    json job = quad_job({{"id", id}});
+    job["camera"] = {{"look_from", {0.5, 0.5, 2.0}}, {"look_at", {0.5, 0.5, 4.0}}, {"vfov_deg", 40}};
+    job["environment"] = {{"image", "skies/grey.hdr"}, {"intensity", 3}};
+    const ImageLayers sky = render(client, job);
+    ASSERT_FALSE(sky.beauty.empty());
+    for (const Color& c : sky.beauty.pixels()) ASSERT_NEAR(c.y, 1.5f, 1e-3f);
+
+    // Not in the bundle, or outside it: refused at submission, naming the field.
+    for (const std::string image : {"skies/none.hdr", "../root/skies/grey.hdr"}) {
+        job["environment"] = {{"image", image}};
+        const HttpResponse refused = client.post("/v1/jobs", job.dump());
+        EXPECT_EQ(refused.status, 422) << image << ": " << refused.body;
+        EXPECT_EQ(refused.json_body().value("field", ""), "environment.image") << refused.body;
+    }
+    // A plain upload has no files besides the scene.
+    const HttpResponse plain = client.post("/v1/scenes", read_file(fs::path(PHOTOND_TEST_DATA_DIR) / "gltf" / "texture.gltf"));
+    ASSERT_EQ(plain.status, 201) << plain.body;
+    json plain_job = quad_job({{"id", plain.json_body().at("id")}});
+    plain_job["environment"] = {{"image", "sky.hdr"}};
+    const HttpResponse no_bundle = client.post("/v1/jobs", plain_job.dump());
+    EXPECT_EQ(no_bundle.status, 422) << no_bundle.body;
+    EXPECT_NE(no_bundle.body.find("bundle"), std::string::npos) << no_bundle.body;
+}
+
 TEST_F(DaemonSceneBundle, AGltfWithUstarAtTheTarMagicsOffsetIsNoTar) {
     // A self-contained .gltf whose byte 257 starts "ustar" (where a tar has its magic).
     const std::string gltf = read_file(fs::path(PHOTOND_TEST_DATA_DIR) / "gltf" / "texture.gltf");
