@@ -256,7 +256,21 @@ Color LightSet::emitted_radiance(const SurfaceInteraction& si, const Vec3& wo) c
     return m.emission;
 }
 
-std::optional<EmissionSample> LightSet::sample_emission(float u_select, Vec2 u_position, Vec2 u_direction) const {
+Vec3 LightSet::parallel_origin(const Vec3& direction, Vec2 u, const EmissionFocus& focus, float* area_ratio) const {
+    const float radius = std::min(focus.radius, scene_radius_);
+    *area_ratio = (radius * radius) / (scene_radius_ * scene_radius_);
+    const Frame frame(direction);
+    const Vec2 d = sample_concentric_disk(u) * radius;
+    // On the focus disc, then back along the ray to outside the scene's bounding sphere, so that
+    // whatever lies in front of the focus still blocks the photon.
+    const Vec3 on_disc = focus.center + frame.s * d.x + frame.t * d.y;
+    const Vec3 to_center = scene_center_ - on_disc;
+    const float along = glm::dot(to_center, direction);
+    return on_disc + direction * (along - 2.0f * scene_radius_);
+}
+
+std::optional<EmissionSample> LightSet::sample_emission(float u_select, Vec2 u_position, Vec2 u_direction,
+                                                        const EmissionFocus* focus) const {
     if (empty()) return std::nullopt;
     float choice_pdf = 0.0f;
     const uint32_t index = selection_.sample(u_select, &choice_pdf);
@@ -290,9 +304,11 @@ std::optional<EmissionSample> LightSet::sample_emission(float u_select, Vec2 u_p
             s.direction = l.angular_radius > 0.0f
                               ? Frame(l.direction).to_world(sample_uniform_cone(u_direction, std::cos(l.angular_radius)))
                               : l.direction;
-            s.origin = parallel_origin(s.direction, u_position);
+            float area_ratio = 1.0f;
+            s.origin = focus ? parallel_origin(s.direction, u_position, *focus, &area_ratio)
+                             : parallel_origin(s.direction, u_position);
             s.normal = s.direction;
-            s.flux_weight = e.emission_weight;
+            s.flux_weight = e.emission_weight * area_ratio;
             break;
         }
         case LightKind::Environment: {
@@ -300,9 +316,11 @@ std::optional<EmissionSample> LightSet::sample_emission(float u_select, Vec2 u_p
             const Vec3 towards_sky = environment_->sample(u_direction, &pdf);
             if (!(pdf > 0.0f)) return std::nullopt;
             s.direction = -towards_sky;
-            s.origin = parallel_origin(s.direction, u_position);
+            float area_ratio = 1.0f;
+            s.origin = focus ? parallel_origin(s.direction, u_position, *focus, &area_ratio)
+                             : parallel_origin(s.direction, u_position);
             s.normal = s.direction;
-            s.flux_weight = e.emission_weight * environment_->radiance(towards_sky) / pdf;
+            s.flux_weight = e.emission_weight * environment_->radiance(towards_sky) * (area_ratio / pdf);
             break;
         }
         case LightKind::Triangle: {

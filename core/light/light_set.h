@@ -38,6 +38,14 @@ struct EmissionSample {
     uint32_t light = 0;    // index into LightSet
 };
 
+/// A sphere that parallel photons (directional lights, soft suns, the environment) are aimed
+/// at instead of the whole scene: photons meant for the caustic map alone need only reach the
+/// specular surfaces (a projection map for distant lights, Jensen 2001, section 5.3).
+struct EmissionFocus {
+    Vec3 center{0.0f};
+    float radius = 0.0f;
+};
+
 class LightSet {
 public:
     explicit LightSet(const Scene& scene);
@@ -80,7 +88,11 @@ public:
     /// triangles (uniform by area, cosine-weighted direction), the environment (directions by
     /// its importance distribution, parallel from a disc of the scene's bounding sphere).
     /// The random numbers by value: references would keep a caller's in memory.
-    std::optional<EmissionSample> sample_emission(float u_select, Vec2 u_position, Vec2 u_direction) const;
+    /// With `focus`, parallel photons start on a disc of the focus sphere's radius around its
+    /// centre (still outside the scene's bounding sphere) and their flux is scaled by the
+    /// smaller disc's area: unbiased for every path whose first hit lies in that sphere.
+    std::optional<EmissionSample> sample_emission(float u_select, Vec2 u_position, Vec2 u_direction,
+                                                  const EmissionFocus* focus = nullptr) const;
 
     /// Spot light angular falloff of KHR_lights_punctual (quadratic in the cosine).
     static float spot_falloff(const PunctualLight& light, float cos_angle);
@@ -96,6 +108,8 @@ private:
     /// The origin of a parallel photon travelling in `direction`: a point of a disc of the
     /// scene's bounding radius perpendicular to it, outside the scene.
     Vec3 parallel_origin(const Vec3& direction, Vec2 u) const;
+    /// The same aimed at `focus`; writes the ratio of the focus disc's area to the scene's.
+    Vec3 parallel_origin(const Vec3& direction, Vec2 u, const EmissionFocus& focus, float* area_ratio) const;
 
     struct Entry {
         LightKind kind;

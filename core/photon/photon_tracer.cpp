@@ -94,7 +94,9 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
     const float u_select = rng.next_float();
     const Vec2 u_position = rng.next_vec2();
     const Vec2 u_direction = rng.next_vec2();
-    const std::optional<EmissionSample> emission = rs.lights->sample_emission(u_select, u_position, u_direction);
+    // Photons for the caustic map alone are aimed at its casters when they come from far away.
+    const EmissionFocus* focus = !want_global && rs.caustic_casters ? &rs.caustic_focus : nullptr;
+    const std::optional<EmissionSample> emission = rs.lights->sample_emission(u_select, u_position, u_direction, focus);
     if (!emission || is_black(emission->flux_weight)) return;
 
     Color flux = emission->flux_weight;

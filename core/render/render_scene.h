@@ -29,6 +29,9 @@ struct RenderScene {
     /// glossy lobe; null when there are none. Photons emitted for the caustic map alone that miss
     /// all of them are dropped after this one cheap ray instead of a trace through the scene.
     std::unique_ptr<RayTracer> caustic_casters;
+    /// The bounding sphere of those triangles, which parallel photons for the caustic map alone
+    /// are aimed at (LightSet::sample_emission).
+    EmissionFocus caustic_focus;
 
     static Expected<std::shared_ptr<const RenderScene>> create(std::shared_ptr<EmbreeDevice> device,
                                                                std::shared_ptr<const Scene> scene);

@@ -206,6 +206,50 @@ std::vector<CameraRay> rays_at_sphere() {
     return rays;
 }
 
+/// Whether the ray (origin, unit direction) meets the sphere.
+bool ray_meets_sphere(const Vec3& origin, const Vec3& direction, const EmissionFocus& sphere) {
+    const Vec3 to_center = sphere.center - origin;
+    const float along = glm::dot(to_center, direction);
+    return along > 0.0f && glm::dot(to_center, to_center) - along * along <= sphere.radius * sphere.radius;
+}
+
+TEST(EnvironmentLight, FocusedEmissionCarriesTheSameFluxIntoItsSphere) {
+    // A big scene (sphere of radius 1 plus a far corner) and a small target inside it: the flux
+    // of the photons that meet the target is the same whether they are aimed at it or not.
+    Scene scene = sphere_under(test_sky(), 0.5f);
+    scene.bounds.extend(Vec3(6.0f, 5.0f, -4.0f));
+    PunctualLight sun;
+    sun.type = PunctualLightType::Directional;
+    sun.direction = glm::normalize(Vec3(-1.0f, -2.0f, 0.5f));
+    sun.intensity = Color(40.0f);
+    sun.angular_radius = 0.05f;
+    scene.lights.push_back(sun);
+    const LightSet lights(scene);
+    const EmissionFocus target{Vec3(0.3f, 0.2f, -0.1f), 0.6f};
+    constexpr int kSamples = 1000000;
+    // The mean flux per emitted photon that meets the target, and how many met it.
+    const auto into_target = [&](const EmissionFocus* focus, int* inside) {
+        Rng rng(21, 22);
+        DVec3 flux(0.0);
+        *inside = 0;
+        for (int i = 0; i < kSamples; ++i) {
+            const auto e = lights.sample_emission(rng.next_float(), rng.next_vec2(), rng.next_vec2(), focus);
+            if (!e) continue;
+            EXPECT_GT(glm::length(e->origin - scene.bounds.center()), scene.bounds.radius());
+            if (!ray_meets_sphere(e->origin, e->direction, target)) continue;
+            flux += DVec3(e->flux_weight);
+            ++*inside;
+        }
+        return flux / static_cast<double>(kSamples);
+    };
+    int inside_unfocused = 0, inside_focused = 0;
+    const DVec3 unfocused = into_target(nullptr, &inside_unfocused);
+    const DVec3 focused = into_target(&target, &inside_focused);
+    EXPECT_LT(inside_unfocused, kSamples / 10);  // most photons miss the target
+    EXPECT_GT(inside_focused, kSamples / 2);     // aimed, most meet it
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(focused[c] / unfocused[c], 1.0, 0.03) << c;
+}
+
 TEST(EnvironmentLight, ConvexLambertianUnderUniformSkyIsAlbedoTimesRadiance) {
     Environment sky;
     sky.color = Color(1.0f, 2.0f, 4.0f);
