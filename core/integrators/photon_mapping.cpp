@@ -67,11 +67,12 @@ Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_
     const RenderScene& rs = *scene_;
     const std::optional<Hit> hit = trace_ray(rs, ray, context.counters);
     if (!hit) return Color(0.0f);
-    const SurfaceInteraction si = make_interaction(*rs.scene, *hit, ray.direction);
+    const float length = path_length + hit->t;
+    // The camera's ray cone, widened along ideal specular bounces, picks the texture level.
+    const SurfaceInteraction si = make_interaction(*rs.scene, *hit, ray.direction, length * spread);
     const Vec3 wo = -ray.direction;
     Color radiance = rs.lights->emitted_radiance(si, wo);
     const Bsdf bsdf = make_bsdf(rs, si, wo);
-    const float length = path_length + hit->t;
     if (bsdf.has_non_delta()) {
         radiance += sample_direct_light(rs, si, bsdf, wo, context, false);
         const Vec3 normal = glm::dot(si.shading_normal, wo) >= 0.0f ? si.shading_normal : -si.shading_normal;

@@ -260,11 +260,11 @@ SpecularAlbedo specular_albedo_terms(int cell, float w_roughness, float mu) {
 
 }  // namespace
 
-BsdfMaterial::BsdfMaterial(const Material& material) {
+BsdfMaterial::BsdfMaterial(const Material& material, float metallic_value, float roughness_value) {
     // Clamp to the ranges the glTF spec allows, which is what the energy guarantee needs.
-    metallic = std::clamp(material.metallic, 0.0f, 1.0f);
+    metallic = std::isfinite(metallic_value) ? std::clamp(metallic_value, 0.0f, 1.0f) : 0.0f;
     transmission = std::clamp(material.transmission, 0.0f, 1.0f);
-    roughness = std::clamp(material.roughness, 0.0f, 1.0f);
+    roughness = std::isfinite(roughness_value) ? std::clamp(roughness_value, 0.0f, 1.0f) : 1.0f;
     ior = std::isfinite(material.ior) ? std::max(material.ior, 1.0f) : 1.5f;
     const float specular = std::clamp(material.specular, 0.0f, 1.0f);
 
@@ -300,6 +300,34 @@ BsdfMaterial::BsdfMaterial(const Material& material) {
     if (reflects) other_lobes |= mask_of(specular_kind);
     if (glass_weight > 0.0f) other_lobes |= mask_of(glass_kind);
     lambertian_only = metallic <= 0.0f && glass_weight <= 0.0f && specular_f90 <= 0.0f;
+}
+
+LobeMask possible_lobes(const Scene& scene, const Material& m) {
+    float metallic[2] = {m.metallic, m.metallic}, roughness[2] = {m.roughness, m.roughness};
+    if (m.metallic_roughness_texture.present()) {
+        const Texture& t = scene.textures[static_cast<size_t>(m.metallic_roughness_texture.texture)];
+        float g[2] = {1.0f, 0.0f}, b[2] = {1.0f, 0.0f};
+        for (const Color& c : t.texels) {
+            g[0] = std::min(g[0], c.y), g[1] = std::max(g[1], c.y);
+            b[0] = std::min(b[0], c.z), b[1] = std::max(b[1], c.z);
+        }
+        if (t.texels.empty()) g[0] = g[1] = b[0] = b[1] = 1.0f;
+        for (int i = 0; i < 2; ++i) {
+            roughness[i] = m.roughness * g[i];
+            metallic[i] = m.metallic * b[i];
+        }
+    }
+    const Color colour = m.base_color_texture.present() ? Color(1.0f) : m.base_color;
+    // The range's ends, and a glossy roughness where the range holds one between them.
+    const float glossy = std::clamp(0.5f * (kDeltaRoughness + kGlossyRoughness), roughness[0], roughness[1]);
+    LobeMask lobes = 0;
+    for (float mv : metallic) {
+        for (float rv : {roughness[0], roughness[1], glossy}) {
+            const BsdfMaterial constants(m, mv, rv);
+            lobes |= Bsdf(constants, colour, Frame(Vec3(0, 0, 1)), Vec3(0, 0, 1)).lobes();
+        }
+    }
+    return lobes;
 }
 
 Color Bsdf::layer_albedo(float cos_theta) const {

@@ -57,7 +57,10 @@ struct BsdfSample {
 /// per material (RenderScene::bsdf_materials), so that a Bsdf at a hit only adds the base colour
 /// and the frames: deriving it at every hit was a tenth of a photon bounce.
 struct BsdfMaterial {
-    explicit BsdfMaterial(const Material& material);
+    explicit BsdfMaterial(const Material& material)
+        : BsdfMaterial(material, material.metallic, material.roughness) {}
+    /// With metallic and roughness read from the material's texture at one point.
+    BsdfMaterial(const Material& material, float metallic, float roughness);
 
     Color specular_f0;       // dielectric layer F0 (from ior and KHR_materials_specular)
     float specular_f90;      // dielectric layer F90 (the specular factor)
@@ -81,6 +84,11 @@ struct BsdfMaterial {
     float albedo_cell_weight = 0.0f;  // interpolation weight within that cell
 };
 
+/// The lobe kinds a material can have anywhere on its surface: with a metallicRoughnessTexture,
+/// the union over its texels' extremes of metallic and roughness (the base colour taken as
+/// white, so a texture can only remove lobes). For the render plan and the caustic casters.
+LobeMask possible_lobes(const Scene& scene, const Material& material);
+
 class Bsdf {
 public:
     /// `shading` is the interpolated-normal frame and `geometric_normal` the triangle's normal, both
@@ -92,15 +100,30 @@ public:
     Bsdf(const BsdfMaterial& material, const Color& base_color, const Frame& shading,
          const Vec3& geometric_normal)
         : m_(&material), frame_(shading), geometric_normal_(geometric_normal) {
-        base_color_ = glm::clamp(base_color, Color(0.0f), Color(1.0f));
-        diffuse_weight_ = m_->layer_weight * base_color_;
-        diffuse_ = diffuse_weight_ * m_->diffuse_remaining;
-        lobes_ = m_->other_lobes;
-        if (max_component(diffuse_) > 0.0f) lobes_ |= mask_of(LobeKind::Diffuse);
-        pure_lambertian_ = lobes_ == mask_of(LobeKind::Diffuse) && m_->lambertian_only;
+        init(base_color);
     }
-    /// Not from a temporary: the Bsdf would point to it after it is gone.
-    Bsdf(BsdfMaterial&&, const Color&, const Frame&, const Vec3&) = delete;
+    /// A Bsdf that keeps its own material constants: for materials whose metallic and roughness
+    /// vary over the surface (metallicRoughnessTexture), derived at the hit.
+    Bsdf(BsdfMaterial&& material, const Color& base_color, const Frame& shading,
+         const Vec3& geometric_normal)
+        : m_(nullptr), own_(std::move(material)), frame_(shading), geometric_normal_(geometric_normal) {
+        m_ = &*own_;
+        init(base_color);
+    }
+    Bsdf(const Bsdf& other) { *this = other; }
+    Bsdf& operator=(const Bsdf& other) {
+        if (this == &other) return *this;
+        own_ = other.own_;
+        m_ = own_ ? &*own_ : other.m_;
+        frame_ = other.frame_;
+        geometric_normal_ = other.geometric_normal_;
+        base_color_ = other.base_color_;
+        diffuse_ = other.diffuse_;
+        diffuse_weight_ = other.diffuse_weight_;
+        lobes_ = other.lobes_;
+        pure_lambertian_ = other.pure_lambertian_;
+        return *this;
+    }
 
     /// Sum of the non-delta lobes in `mask` (no cosine). Zero for delta-only materials.
     /// Reflection vs transmission is decided by the geometric normal (reflection iff wo and wi
@@ -200,7 +223,17 @@ private:
         return s;
     }
 
+    void init(const Color& base_color) {
+        base_color_ = glm::clamp(base_color, Color(0.0f), Color(1.0f));
+        diffuse_weight_ = m_->layer_weight * base_color_;
+        diffuse_ = diffuse_weight_ * m_->diffuse_remaining;
+        lobes_ = m_->other_lobes;
+        if (max_component(diffuse_) > 0.0f) lobes_ |= mask_of(LobeKind::Diffuse);
+        pure_lambertian_ = lobes_ == mask_of(LobeKind::Diffuse) && m_->lambertian_only;
+    }
+
     const BsdfMaterial* m_;
+    std::optional<BsdfMaterial> own_;  // set when the constants vary over the surface
     Frame frame_;
     Vec3 geometric_normal_;
     Color base_color_;

@@ -222,7 +222,7 @@ TEST(GltfLoader, MaterialsWithExtensionsAndDefaults) {
     EXPECT_FLOAT_EQ(m.ior, 1.33f);
     EXPECT_FLOAT_EQ(m.specular, 0.6f);
     expect_vec_near(m.specular_color, {0.9f, 0.8f, 0.7f});
-    EXPECT_EQ(m.base_color_texture, -1);
+    EXPECT_EQ(m.base_color_texture.texture, -1);
     EXPECT_TRUE(m.is_emissive());
 
     // No material: the glTF default material (base 1, metallic 1, roughness 1).
@@ -258,7 +258,7 @@ void expect_checker_texture(const Scene& scene) {
     expect_vec_near(tex.texels[3], Vec3(srgb_eotf(188.0f / 255.0f)));
     // Texture times baseColorFactor (0.5, 1, 1) at texel centres.
     ASSERT_EQ(scene.materials.size(), 1u);
-    EXPECT_EQ(scene.materials[0].base_color_texture, 0);
+    EXPECT_EQ(scene.materials[0].base_color_texture.texture, 0);
     expect_vec_near(scene.base_color(0, {0.25f, 0.25f}), {0.5f, 0, 0});
     expect_vec_near(scene.base_color(0, {0.75f, 0.25f}), {0, 0.21586050f, 0});
     expect_vec_near(scene.base_color(0, {0.25f, 0.75f}), {0, 0, srgb_eotf(64.0f / 255.0f)});
