@@ -26,7 +26,7 @@ Color DirectIntegrator::radiance_along(const Ray& ray, int depth, SampleContext&
             return radiance_along(spawn_ray(rs, si, s.wi), depth + 1, context, length, spread);
         });
     }
-    return radiance;
+    return volume_transmittance(*rs.scene, si) * radiance;
 }
 
 }  // namespace photond

@@ -99,10 +99,11 @@ inline Bsdf make_bsdf(const RenderScene& rs, const SurfaceInteraction& si, const
     if (!material.textured() && rs.scene->colors.empty())
         return Bsdf(rs.bsdf_materials[si.material], material.base_color, Frame(ns), ng);
     const MaterialPoint mp = rs.scene->material_point(si.material, si.tex);
-    if (!material.metallic_roughness_texture.present())
+    if (!material.varying_bsdf())
         return Bsdf(rs.bsdf_materials[si.material], mp.base_color, Frame(ns), ng);
-    // Metallic and roughness vary over the surface: the constants are derived here.
-    return Bsdf(BsdfMaterial(material, mp.metallic, mp.roughness), mp.base_color, Frame(ns), ng);
+    // Metallic, roughness or the clearcoat vary over the surface: the constants are derived here.
+    return Bsdf(BsdfMaterial(material, mp.metallic, mp.roughness, mp.clearcoat, mp.clearcoat_roughness),
+                mp.base_color, Frame(ns), ng);
 }
 
 /// Next-event estimation: one light sample with a shadow ray, lobes in `mask` only. With

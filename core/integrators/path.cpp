@@ -27,6 +27,7 @@ Color PathIntegrator::radiance(const CameraRay& camera_ray, SampleContext& conte
         const SurfaceInteraction si =
             make_interaction(*rs.scene, *hit, ray.direction, cone_alive ? cone_length * spread : 0.0f);
         const Vec3 wo = -ray.direction;
+        throughput *= volume_transmittance(*rs.scene, si);
 
         const Color emitted = rs.lights->emitted_radiance(si, wo);
         if (!is_black(emitted)) {

@@ -111,7 +111,7 @@ Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_
             return radiance_along(spawn_ray(rs, si, s.wi), depth + 1, length, spread, context);
         });
     }
-    return radiance;
+    return volume_transmittance(*rs.scene, si) * radiance;
 }
 
 }  // namespace photond

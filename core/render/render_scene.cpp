@@ -17,8 +17,7 @@ Expected<std::shared_ptr<const RenderScene>> RenderScene::create(std::shared_ptr
     std::vector<LobeMask> lobes(scene->materials.size());
     for (size_t i = 0; i < lobes.size(); ++i) {
         const Material& m = scene->materials[i];
-        lobes[i] = m.metallic_roughness_texture.present() ? possible_lobes(*scene, m)
-                                                          : render_scene->bsdf_materials[i].other_lobes;
+        lobes[i] = m.varying_bsdf() ? possible_lobes(*scene, m) : render_scene->bsdf_materials[i].other_lobes;
     }
     for (uint32_t t = 0; t < scene->triangles.size(); ++t) {
         if (lobes[scene->triangle_materials[t]] & kCausticLobes) specular.push_back(t);

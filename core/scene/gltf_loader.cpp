@@ -36,7 +36,8 @@ constexpr uint64_t kMaxImagePixels = uint64_t(1) << 26;
 
 const std::set<std::string, std::less<>> kSupportedRequiredExtensions = {
     "KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_transmission",
-    "KHR_materials_ior", "KHR_materials_specular", "KHR_texture_transform"};
+    "KHR_materials_ior", "KHR_materials_specular", "KHR_texture_transform",
+    "KHR_materials_clearcoat", "KHR_materials_volume"};
 
 std::string quoted(const std::string& name) { return name.empty() ? "" : " '" + name + "'"; }
 
@@ -918,6 +919,53 @@ Expected<uint32_t> GltfSceneReader::scene_material(int material_index) {
         // occlusionTexture is ignored by design: ambient occlusion is for rasterisers; a global
         // illumination renderer computes occlusion itself.
         m.normal_scale = std::isfinite(g.normalTexture.scale) ? float(g.normalTexture.scale) : 1.0f;
+
+        // KHR_materials_clearcoat (clearcoatNormalTexture is not applied: the coat shares the
+        // base's shading normal) and KHR_materials_volume (attenuation inside the solid;
+        // thicknessFactor is for rasterisers that do not trace the solid).
+        Expected<double> coat = extension_number(ext, "KHR_materials_clearcoat", "clearcoatFactor", 0.0);
+        Expected<double> coat_roughness =
+            extension_number(ext, "KHR_materials_clearcoat", "clearcoatRoughnessFactor", 0.0);
+        Expected<double> attenuation_distance = extension_number(
+            ext, "KHR_materials_volume", "attenuationDistance", std::numeric_limits<double>::infinity());
+        Expected<Color> attenuation_color =
+            extension_color(ext, "KHR_materials_volume", "attenuationColor", Color(1.0f));
+        for (const Error* e : {coat ? nullptr : &coat.error(), coat_roughness ? nullptr : &coat_roughness.error(),
+                               attenuation_distance ? nullptr : &attenuation_distance.error(),
+                               attenuation_color ? nullptr : &attenuation_color.error()}) {
+            if (e) return fail(context + e->message);
+        }
+        m.clearcoat = std::isfinite(*coat) ? std::clamp(float(*coat), 0.0f, 1.0f) : 0.0f;
+        m.clearcoat_roughness = std::isfinite(*coat_roughness) ? std::clamp(float(*coat_roughness), 0.0f, 1.0f) : 0.0f;
+        if (const auto it = ext.find("KHR_materials_clearcoat"); it != ext.end() && it->second.IsObject()) {
+            for (const auto& [key, target] : {std::pair<const char*, TextureRef*>{"clearcoatTexture", &m.clearcoat_texture},
+                                              {"clearcoatRoughnessTexture", &m.clearcoat_roughness_texture}}) {
+                if (!it->second.Has(key)) continue;
+                const tinygltf::Value& info = it->second.Get(key);
+                if (!info.IsObject() || !info.Has("index") || !info.Get("index").IsNumber())
+                    return fail(context + "KHR_materials_clearcoat." + key + " has no texture index");
+                const int tex_coord = info.Has("texCoord") && info.Get("texCoord").IsNumber()
+                                          ? info.Get("texCoord").GetNumberAsInt() : 0;
+                tinygltf::ExtensionMap info_extensions;
+                if (info.Has("extensions") && info.Get("extensions").IsObject()) {
+                    const tinygltf::Value& e = info.Get("extensions");
+                    for (const std::string& name : e.Keys()) info_extensions[name] = e.Get(name);
+                }
+                Expected<TextureRef> ref = texture_ref(info.Get("index").GetNumberAsInt(), tex_coord, info_extensions,
+                                                       context, key, false, sets);
+                if (!ref) return ref.error();
+                *target = *ref;
+            }
+        }
+        // sigma = -ln(attenuationColor) / attenuationDistance (KHR_materials_volume), only in
+        // transmissive solids (an opaque surface has no inside that light crosses).
+        const double distance = *attenuation_distance;
+        if (m.transmission > 0.0f && distance > 0.0 && std::isfinite(distance)) {
+            for (int c = 0; c < 3; ++c) {
+                const float colour = std::clamp((*attenuation_color)[c], 1e-6f, 1.0f);
+                m.attenuation[c] = float(-std::log(double(colour)) / distance);
+            }
+        }
         if (m.alpha_mode == AlphaMode::Opaque && !m.base_color_texture.present()) m.base_alpha = 1.0f;
     }
     const uint32_t index = builder_.add_material(std::move(m));

@@ -28,6 +28,16 @@ inline Vec3 oriented_shading_normal(const Vec3& shading, const Vec3& geometric) 
     return glm::dot(shading, geometric) < 0.0f ? -shading : shading;
 }
 
+/// Beer-Lambert transmittance of the ray segment that ends at si (KHR_materials_volume): a ray
+/// that reaches a volume material's surface from inside (its back face: the solid's normals
+/// point out) crossed t of its medium, exp(-sigma t). Closed, non-nested solids; a segment that
+/// ends on another surface inside the solid is not attenuated.
+inline Color volume_transmittance(const Scene& scene, const SurfaceInteraction& si) {
+    const Material& m = scene.materials[si.material];
+    if (si.front_face || !m.has_volume()) return Color(1.0f);
+    return glm::exp(-m.attenuation * si.distance);
+}
+
 /// The shading normal bent by a material's normal texture (glTF 2.0 section 3.9.3): the texel
 /// (2 rgb - 1) * (scale, scale, 1) in the frame (T, B = w cross(N, T), N), T the interpolated
 /// tangent made orthogonal to N. Unchanged where the triangle has no tangent.

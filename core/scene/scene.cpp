@@ -123,7 +123,11 @@ Vec4 Scene::sample(const TextureRef& ref, const TexturePoint& tp) const {
 
 MaterialPoint Scene::material_point(uint32_t material, const TexturePoint& tp) const {
     const Material& m = materials[material];
-    MaterialPoint mp{m.base_color, m.base_alpha, m.metallic, m.roughness};
+    MaterialPoint mp{m.base_color, m.base_alpha, m.metallic, m.roughness, m.clearcoat, m.clearcoat_roughness};
+    // KHR_materials_clearcoat: R of clearcoatTexture, G of clearcoatRoughnessTexture.
+    if (m.clearcoat_texture.present()) mp.clearcoat *= sample(m.clearcoat_texture, tp).x;
+    if (m.clearcoat_roughness_texture.present())
+        mp.clearcoat_roughness *= sample(m.clearcoat_roughness_texture, tp).y;
     if (m.base_color_texture.present()) {
         const Vec4 c = sample(m.base_color_texture, tp);
         mp.base_color *= Color(c);

@@ -87,17 +87,32 @@ struct Material {
     Color specular_color{1.0f};  // KHR_materials_specular colour factor
     Color emission{0.0f};        // emitted radiance: emissiveFactor * emissive_strength
     TextureRef emissive_texture;  // multiplies emission
+    /// KHR_materials_clearcoat: a GGX dielectric layer (F0 0.04) over the whole material.
+    float clearcoat = 0.0f;
+    TextureRef clearcoat_texture;  // R multiplies clearcoat
+    float clearcoat_roughness = 0.0f;
+    TextureRef clearcoat_roughness_texture;  // G multiplies clearcoat_roughness
+    /// KHR_materials_volume inside a transmissive solid: Beer-Lambert attenuation coefficient
+    /// -ln(attenuationColor) / attenuationDistance per channel, per world unit (0: clear).
+    Color attenuation{0.0f};
     AlphaMode alpha_mode = AlphaMode::Opaque;
     float alpha_cutoff = 0.5f;   // MASK: covered where alpha >= cutoff
     bool double_sided = false;   // emits from both faces when true (else the front face only)
 
     bool is_emissive() const { return max_component(emission) > 0.0f; }
+    /// Metallic, roughness or the clearcoat vary over the surface: BSDF constants per hit.
+    bool varying_bsdf() const {
+        return metallic_roughness_texture.present() || clearcoat_texture.present() ||
+               clearcoat_roughness_texture.present();
+    }
+    bool has_volume() const { return max_component(attenuation) > 0.0f; }
     /// Rays may pass its surface (MASK or BLEND): its triangles get Embree's alpha filter.
     bool alpha_tested() const { return alpha_mode != AlphaMode::Opaque; }
     /// Whether shading reads texture coordinates or vertex colours at all.
     bool textured() const {
         return base_color_texture.present() || metallic_roughness_texture.present() ||
-               normal_texture.present() || emissive_texture.present();
+               normal_texture.present() || emissive_texture.present() ||
+               clearcoat_texture.present() || clearcoat_roughness_texture.present();
     }
 };
 
@@ -107,6 +122,8 @@ struct MaterialPoint {
     float alpha = 1.0f;
     float metallic = 0.0f;
     float roughness = 1.0f;
+    float clearcoat = 0.0f;
+    float clearcoat_roughness = 0.0f;
 };
 
 /// Where a surface point lies in texture space: both TEXCOORD slots, the vertex colour, and the

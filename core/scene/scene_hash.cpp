@@ -9,7 +9,7 @@ namespace {
 
 // These fire when a field is added to a struct the hashes read: hash the new field (if it affects
 // light transport) in scene_content_hash or photon_map_key, then update the size here.
-static_assert(sizeof(Material) == sizeof(std::string) + 208,
+static_assert(sizeof(Material) == sizeof(std::string) + 288,
               "Material changed: hash the new field in scene_content_hash");
 static_assert(sizeof(PunctualLight) == sizeof(std::string) + 56,
               "PunctualLight changed: hash the new field in scene_content_hash");
@@ -86,6 +86,11 @@ Sha256Digest scene_content_hash(const Scene& scene) {
         hash_ref(m.normal_texture);
         hash_float(hasher, m.normal_scale);
         hash_ref(m.emissive_texture);
+        hash_float(hasher, m.clearcoat);
+        hash_ref(m.clearcoat_texture);
+        hash_float(hasher, m.clearcoat_roughness);
+        hash_ref(m.clearcoat_roughness_texture);
+        hash_vec3(hasher, m.attenuation);
         hasher.update_value(uint8_t(m.alpha_mode));
         hash_float(hasher, m.alpha_cutoff);
         hash_float(hasher, m.metallic);

@@ -199,5 +199,25 @@ TEST(MipMaps, LevelsAreBoxMeansAndTheFootprintPicksThem) {
     EXPECT_NEAR(t.sample_rgba(Vec2(0.0625f, 0.0625f), 1.0f).x, 0.5f, 1e-6f);
 }
 
+TEST(Extensions, ClearcoatAndVolumeAreRead) {
+    const Scene scene = load("coat_volume.gltf");  // both extensions required
+    ASSERT_EQ(scene.materials.size(), 3u);
+    const Material& coated = scene.materials[0];
+    EXPECT_FLOAT_EQ(coated.clearcoat, 0.7f);
+    EXPECT_FLOAT_EQ(coated.clearcoat_roughness, 0.2f);
+    ASSERT_TRUE(coated.clearcoat_texture.present());
+    EXPECT_TRUE(coated.clearcoat_texture.transformed);
+    TexturePoint tp;
+    tp.uv = Vec2(0.3f, 0.6f);
+    // R of the clearcoat texture (stored linearly): 0.7 * 128 / 255.
+    EXPECT_NEAR(scene.material_point(0, tp).clearcoat, 0.7f * 128.0f / 255.0f, 1e-5f);
+    // sigma = -ln(attenuationColor) / attenuationDistance, in transmissive solids only.
+    const Material& glass = scene.materials[1];
+    EXPECT_NEAR(glass.attenuation.x, std::log(2.0f) / 2.0f, 1e-6f);
+    EXPECT_NEAR(glass.attenuation.y, std::log(4.0f) / 2.0f, 1e-6f);
+    EXPECT_EQ(glass.attenuation.z, 0.0f);
+    EXPECT_FALSE(scene.materials[2].has_volume());
+}
+
 }  // namespace
 }  // namespace photond

@@ -419,6 +419,33 @@ def material_textures():
     b.doc["scene"] = 0
     write("alpha_normal.gltf", b.finish())
 
+    # KHR_materials_clearcoat (factor, roughness, a transformed clearcoatTexture) and
+    # KHR_materials_volume (attenuation inside a transmissive solid), both required.
+    b = Builder()
+    pos = b.floats(QUAD_POSITIONS, "VEC3")
+    uv = b.floats(QUAD_UVS, "VEC2")
+    idx = b.indices(QUAD_INDICES, U16)
+    b.doc["images"] = [{"uri": png_data_uri(png(1, 1, [[(128, 64, 255)]]))}]
+    b.doc["textures"] = [{"source": 0}]
+    b.doc["extensionsUsed"] = ["KHR_materials_clearcoat", "KHR_materials_volume",
+                               "KHR_materials_transmission", "KHR_texture_transform"]
+    b.doc["extensionsRequired"] = ["KHR_materials_clearcoat", "KHR_materials_volume"]
+    b.doc["materials"] = [
+        {"name": "Coated", "extensions": {"KHR_materials_clearcoat": {
+            "clearcoatFactor": 0.7, "clearcoatRoughnessFactor": 0.2,
+            "clearcoatTexture": {"index": 0, "extensions": {
+                "KHR_texture_transform": {"scale": [2, 2]}}}}}},
+        {"name": "Tinted glass", "extensions": {
+            "KHR_materials_transmission": {"transmissionFactor": 1.0},
+            "KHR_materials_volume": {"thicknessFactor": 0.1, "attenuationDistance": 2.0,
+                                     "attenuationColor": [0.5, 0.25, 1.0]}}},
+        {"name": "Opaque with volume", "extensions": {
+            "KHR_materials_volume": {"attenuationDistance": 2.0, "attenuationColor": [0.5, 0.5, 0.5]}}}]
+    attrs = {"POSITION": pos, "TEXCOORD_0": uv}
+    single_mesh_scene(b, [{"attributes": attrs, "indices": idx, "material": k} for k in range(3)],
+                      "CoatVolume")
+    write("coat_volume.gltf", b.finish())
+
 
 def sparse():
     """Quad whose vertex 2 is moved to (2, 2, 0) by a sparse substitution."""
