@@ -6,6 +6,18 @@
 
 namespace photond {
 
+namespace {
+
+/// The probability that a ray meets an alpha-tested surface at barycentrics b (RayTracer's
+/// filter): MASK 1 or 0 by the cutoff, BLEND alpha.
+float emitter_coverage(const Material& m, const Scene& scene, uint32_t triangle, Vec2 b) {
+    const float alpha = scene.alpha_at(triangle, b.x, b.y);
+    if (m.alpha_mode == AlphaMode::Mask) return alpha >= m.alpha_cutoff ? 1.0f : 0.0f;
+    return std::clamp(alpha, 0.0f, 1.0f);
+}
+
+}  // namespace
+
 float LightSet::spot_falloff(const PunctualLight& light, float cos_angle) {
     return spot_falloff_from_axis(light, 1.0f - cos_angle);
 }
@@ -151,6 +163,9 @@ std::optional<LightSample> LightSet::sample_incident(const Vec3& p, float u_sele
             const float abs_cos = std::abs(cos_light);
             if (!(abs_cos > 0.0f)) return std::nullopt;
             s.radiance = e.textured ? m.emission * emissive_texel(e, b) : m.emission;
+            // An alpha-tested emitter emits where it is present: a ray that finds it there (the
+            // BSDF-sampled estimate) passes its coverage test with this probability.
+            if (m.alpha_tested()) s.radiance *= emitter_coverage(m, *scene_, e.index, b);
             s.pdf = choice_pdf * dist2 / (abs_cos * e.area);
             if (!std::isfinite(s.pdf)) return std::nullopt;
             s.point = q;
@@ -277,6 +292,8 @@ std::optional<EmissionSample> LightSet::sample_emission(float u_select, Vec2 u_p
             s.normal = face->n;
             s.direction = face->to_world(sample_cosine_hemisphere(ud));
             s.flux_weight = e.textured ? e.emission_weight * emissive_texel(e, b) : e.emission_weight;
+            const Material& m = scene_->materials[scene_->triangle_materials[e.index]];
+            if (m.alpha_tested()) s.flux_weight *= emitter_coverage(m, *scene_, e.index, b);
             break;
         }
     }

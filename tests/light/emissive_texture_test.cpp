@@ -14,7 +14,7 @@ namespace {
 
 /// A 2 x 1 emitter in the plane z = 1 facing down (-z), emissive factor 3 times a 4 x 4 texture
 /// with texels (x + 4 y) / 15 * (1, 0.5, 0.25), repeat wrapping, bilinear.
-Scene textured_emitter_scene() {
+Scene textured_emitter_scene(bool masked = false) {
     SceneBuilder builder("emissive-texture");
     Texture t;
     t.width = 4;
@@ -25,6 +25,18 @@ Scene textured_emitter_scene() {
     Material m = test_support::lambertian(Color(0.0f));
     m.emission = Color(3.0f);
     m.emissive_texture.texture = static_cast<int>(builder.add_texture(std::move(t)));
+    if (masked) {
+        // MASK: the quad's left half (u < 0.5) is absent, for every kind of ray.
+        Texture coverage;
+        coverage.width = 2;
+        coverage.height = 1;
+        coverage.texels = {Color(1.0f), Color(1.0f)};
+        coverage.alpha = {0.0f, 1.0f};
+        coverage.nearest = true;
+        coverage.wrap_s = coverage.wrap_t = TextureWrap::ClampToEdge;
+        m.base_color_texture.texture = static_cast<int>(builder.add_texture(std::move(coverage)));
+        m.alpha_mode = AlphaMode::Mask;
+    }
     const uint32_t emitter = builder.add_material(m);
     const MeshData quad = make_quad(Vec3(0, 0, 1), Vec3(2, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, -1));
     EXPECT_TRUE(
@@ -66,28 +78,32 @@ TEST(EmissiveTexture, PhotonFluxIsTheTexturesIntegral) {
 }
 
 TEST(EmissiveTexture, LightSamplingAgreesWithBsdfSampling) {
-    auto rs = test_support::make_render_scene(textured_emitter_scene());
-    const LightSet& lights = *rs->lights;
-    const Vec3 p(0.6f, 0.3f, 0.2f), n(0, 0, 1);
-    Rng rng(5, 6);
-    const int samples = 400000;
-    DVec3 by_light(0.0), by_bsdf(0.0);
-    const Frame frame(n);
-    for (int i = 0; i < samples; ++i) {
-        const auto ls = lights.sample_incident(p, rng.next_float(), rng.next_vec2());
-        if (ls && ls->pdf > 0.0f) by_light += DVec3(ls->radiance * (glm::dot(ls->wi, n) / ls->pdf));
-        // Cosine-weighted directions: E = pi * mean L.
-        const Vec3 d = frame.to_world(sample_cosine_hemisphere(rng.next_vec2()));
-        const Ray ray{p, d};
-        const std::optional<Hit> hit = rs->tracer->intersect(ray);
-        if (!hit) continue;
-        const SurfaceInteraction si = make_interaction(*rs->scene, *hit, d);
-        by_bsdf += DVec3(lights.emitted_radiance(si, -d) * kPi);
+    for (bool masked : {false, true}) {
+        SCOPED_TRACE(masked ? "masked" : "opaque");
+        auto rs = test_support::make_render_scene(textured_emitter_scene(masked));
+        const LightSet& lights = *rs->lights;
+        const Vec3 p(0.6f, 0.3f, 0.2f), n(0, 0, 1);
+        Rng rng(5, 6);
+        const int samples = 400000;
+        DVec3 by_light(0.0), by_bsdf(0.0);
+        const Frame frame(n);
+        for (int i = 0; i < samples; ++i) {
+            const auto ls = lights.sample_incident(p, rng.next_float(), rng.next_vec2());
+            if (ls && ls->pdf > 0.0f)
+                by_light += DVec3(ls->radiance * (glm::dot(ls->wi, n) / ls->pdf));
+            // Cosine-weighted directions: E = pi * mean L.
+            const Vec3 d = frame.to_world(sample_cosine_hemisphere(rng.next_vec2()));
+            const Ray ray{p, d};
+            const std::optional<Hit> hit = rs->tracer->intersect(ray);
+            if (!hit) continue;
+            const SurfaceInteraction si = make_interaction(*rs->scene, *hit, d);
+            by_bsdf += DVec3(lights.emitted_radiance(si, -d) * kPi);
+        }
+        by_light /= double(samples);
+        by_bsdf /= double(samples);
+        ASSERT_GT(by_bsdf.x, 0.1);
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(by_light[c], by_bsdf[c], 0.02 * by_bsdf[c]) << c;
     }
-    by_light /= double(samples);
-    by_bsdf /= double(samples);
-    ASSERT_GT(by_bsdf.x, 0.1);
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(by_light[c], by_bsdf[c], 0.02 * by_bsdf[c]) << c;
 }
 
 }  // namespace
