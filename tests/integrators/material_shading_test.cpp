@@ -4,6 +4,7 @@
 // aliasing of a distant checkerboard.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 
 #include "core/camera/camera.h"
@@ -146,6 +147,9 @@ TEST(MipMaps, ReduceTheErrorOfADistantCheckerboard) {
             error_flat += sqr(float(without_mips.radiance(centre, context).x - reference));
         }
     }
+    std::printf(
+        "distant checkerboard, 1 spp against 256: squared error %.3f with mip-maps, %.3f without\n",
+        error_mip, error_flat);
     EXPECT_LT(error_mip, 0.25 * error_flat) << error_mip << " vs " << error_flat;
 }
 

@@ -2,6 +2,8 @@
 // form exp(-sigma d), for camera paths (direct, path, photon-map) and for photons.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include "core/integrators/direct.h"
 #include "core/integrators/path.h"
 #include "core/math/rng.h"
@@ -84,6 +86,9 @@ TEST(Volume, PhotonsFollowBeerLambert) {
     const Color expected = glm::exp(-kSigma * kThickness);
     // Photons that reach the floor through the slab crossed it straight down or at a slant
     // (d / cos): the ratio lies between exp(-sigma d / cos_max) and exp(-sigma d).
+    std::printf("volume: photon irradiance ratio %.4f %.4f %.4f, exp(-sigma d) %.4f %.4f %.4f\n",
+                tinted.x / clear.x, tinted.y / clear.y, tinted.z / clear.z, expected.x, expected.y,
+                expected.z);
     for (int c = 0; c < 3; ++c) {
         const float ratio = tinted[c] / clear[c];
         EXPECT_LE(ratio, expected[c] * 1.01f) << c;

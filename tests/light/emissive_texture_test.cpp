@@ -3,6 +3,8 @@
 // with BSDF-sampled rays that read the emitted radiance where they land.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include "core/light/light_set.h"
 #include "core/math/rng.h"
 #include "core/math/sampling.h"
@@ -53,6 +55,8 @@ TEST(EmissiveTexture, PowerIsTheTexturesIntegral) {
     const LightSet lights(scene);
     for (int c = 0; c < 3; ++c)
         EXPECT_NEAR(lights.total_power()[c], kExactPower[c], 0.01f * kExactPower[c]);
+    std::printf("emissive texture: power %.4f, exact %.4f (red)\n", lights.total_power().x,
+                kExactPower.x);
 }
 
 TEST(EmissiveTexture, PhotonFluxIsTheTexturesIntegral) {
@@ -71,6 +75,8 @@ TEST(EmissiveTexture, PhotonFluxIsTheTexturesIntegral) {
     flux /= double(n);
     left /= double(n);
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(flux[c], kExactPower[c], 0.01 * kExactPower[c]);
+    std::printf("emissive texture: mean photon flux %.4f, exact %.4f (red)\n", flux.x,
+                kExactPower.x);
     // The texture decides where the flux leaves: rows 0-1 hold 28 of the 120 parts of the sum,
     // with bilinear blending across the v = 0.5 line and the repeat seam at v = 0 (exact: the
     // mean of the blended field over v in [0, 0.5]).
@@ -102,6 +108,9 @@ TEST(EmissiveTexture, LightSamplingAgreesWithBsdfSampling) {
         by_light /= double(samples);
         by_bsdf /= double(samples);
         ASSERT_GT(by_bsdf.x, 0.1);
+        std::printf(
+            "emissive texture (%s): irradiance by light sampling %.4f, by BSDF sampling %.4f\n",
+            masked ? "masked" : "opaque", by_light.x, by_bsdf.x);
         for (int c = 0; c < 3; ++c) EXPECT_NEAR(by_light[c], by_bsdf[c], 0.02 * by_bsdf[c]) << c;
     }
 }

@@ -3,6 +3,8 @@
 // passes it both ways; a rough coat's sampling, pdf and evaluation agree.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include "core/material/bsdf.h"
 #include "core/math/rng.h"
 #include "core/math/sampling.h"
@@ -80,6 +82,10 @@ TEST(Clearcoat, RoughCoatSamplingAgreesWithEvaluation) {
             sampled /= n_samples;
             quadrature /= n_samples;
             pdf_integral /= n_samples;
+            std::printf(
+                "clearcoat 1, roughness 0.3, base %.0f, mu %.1f: albedo %.4f sampled, %.4f by "
+                "quadrature, pdf integral %.4f\n",
+                colour, mu, sampled, quadrature, pdf_integral);
             EXPECT_NEAR(sampled, quadrature, 0.02 * quadrature + 1e-3);
             EXPECT_NEAR(pdf_integral, 1.0, 0.03);
             // The coat alone reflects about its Fresnel share; nothing reflects more than all.

@@ -2,6 +2,8 @@
 // camera rays, shadow rays and photons; a BLEND panel of alpha a stops a fraction a of rays.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include "core/integrators/direct.h"
 #include "core/math/rng.h"
 #include "core/photon/photon_map.h"
@@ -114,6 +116,9 @@ TEST(AlphaBlend, StopsAFractionAlphaOfRays) {
     }
     // Binomial: sigma = sqrt(a (1 - a) / n) = 0.0023; 4 sigma.
     const double sigma = std::sqrt(alpha * (1.0 - alpha) / n);
+    std::printf(
+        "BLEND alpha %.2f: %.4f of shadow rays and %.4f of camera rays stopped (sigma %.4f)\n",
+        alpha, double(occluded) / n, double(hit_panel) / n, sigma);
     EXPECT_NEAR(double(occluded) / n, alpha, 4.0 * sigma);
     EXPECT_NEAR(double(hit_panel) / n, alpha, 4.0 * sigma);
     // The same ray decides the same way every time (deterministic for any thread count).
