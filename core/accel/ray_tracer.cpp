@@ -1,9 +1,12 @@
 #include "core/accel/ray_tracer.h"
 
+#include "core/math/rng.h"
+
 #include <pmmintrin.h>
 #include <xmmintrin.h>
 
 #include <algorithm>
+#include <bit>
 #include <cfloat>
 #include <cmath>
 #include <cstring>
@@ -55,8 +58,24 @@ Expected<std::unique_ptr<RayTracer>> RayTracer::build(std::shared_ptr<EmbreeDevi
     rtcSetSceneFlags(rtc_scene, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(rtc_scene, RTC_BUILD_QUALITY_HIGH);
 
+    tracer->subset_ = only != nullptr;
     const size_t triangle_count = only ? only->size() : scene.triangles.size();
-    if (triangle_count > 0) {
+    // Triangles of alpha-tested materials go into a geometry of their own with the filter.
+    std::vector<uint32_t> lists[2];  // reported indices per geometry
+    bool any_alpha = false;
+    for (const Material& m : scene.materials) any_alpha = any_alpha || m.alpha_tested();
+    if (any_alpha) {
+        for (uint32_t i = 0; i < triangle_count; ++i) {
+            const uint32_t t = only ? (*only)[i] : i;
+            lists[scene.materials[scene.triangle_materials[t]].alpha_tested() ? 1 : 0].push_back(i);
+        }
+        any_alpha = !lists[1].empty();
+    }
+    tracer->has_alpha_geometry_ = any_alpha;
+    const auto scene_triangle = [&](uint32_t reported) { return only ? (*only)[reported] : reported; };
+    for (unsigned g = 0; g < (any_alpha ? 2u : 1u); ++g) {
+        const size_t count = any_alpha ? lists[g].size() : triangle_count;
+        if (count == 0) continue;
         RTCGeometry geometry = rtcNewGeometry(device->handle(), RTC_GEOMETRY_TYPE_TRIANGLE);
         // Embree may read 16 bytes past the last vertex's 12: pad the buffer by one float4.
         auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
@@ -64,24 +83,37 @@ Expected<std::unique_ptr<RayTracer>> RayTracer::build(std::shared_ptr<EmbreeDevi
             scene.positions.size() + 1));
         auto* indices = static_cast<uint32_t*>(
             rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                    3 * sizeof(uint32_t), triangle_count));
+                                    3 * sizeof(uint32_t), count));
         if (!vertices || !indices) {
             rtcReleaseGeometry(geometry);
             return Error{"Embree: could not allocate geometry buffers for " +
-                         std::to_string(triangle_count) +
-                         " triangles: " + device->last_error()};
+                         std::to_string(count) + " triangles: " + device->last_error()};
         }
         std::memcpy(vertices, scene.positions.data(), scene.positions.size() * sizeof(Vec3));
         std::memset(vertices + 3 * scene.positions.size(), 0, 3 * sizeof(float));
-        if (only) {
+        if (any_alpha) {
+            for (size_t i = 0; i < count; ++i)
+                std::memcpy(indices + 3 * i, &scene.triangles[scene_triangle(lists[g][i])], sizeof(glm::uvec3));
+        } else if (only) {
             for (size_t i = 0; i < only->size(); ++i)
                 std::memcpy(indices + 3 * i, &scene.triangles[(*only)[i]], sizeof(glm::uvec3));
         } else {
             std::memcpy(indices, scene.triangles.data(), scene.triangles.size() * sizeof(glm::uvec3));
         }
+        if (g == 1) {
+            tracer->alpha_triangles_.reserve(count);
+            for (uint32_t r : lists[1]) tracer->alpha_triangles_.push_back(scene_triangle(r));
+            rtcSetGeometryUserData(geometry, tracer.get());
+            rtcSetGeometryIntersectFilterFunction(geometry, &RayTracer::alpha_filter);
+            rtcSetGeometryOccludedFilterFunction(geometry, &RayTracer::alpha_filter);
+        }
         rtcCommitGeometry(geometry);
-        rtcAttachGeometryByID(rtc_scene, geometry, 0);
+        rtcAttachGeometryByID(rtc_scene, geometry, g);
         rtcReleaseGeometry(geometry);
+    }
+    if (any_alpha) {
+        tracer->reported_[0] = std::move(lists[0]);
+        tracer->reported_[1] = std::move(lists[1]);
     }
     rtcCommitScene(rtc_scene);
     if (rtcGetDeviceError(device->handle()) != RTC_ERROR_NONE) {
@@ -106,12 +138,46 @@ void RayTracer::skip_back_faces_at_viewpoint(const Ray& ray, RTCRayHit& rayhit) 
     for (int skip = 0; skip < kMaxViewpointSkips; ++skip) {
         if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
         const float t = rayhit.ray.tfar;
-        const Vec3 normal = scene_->triangle_normal(rayhit.hit.primID);
+        const uint32_t index = reported_index(rayhit.hit);
+        if (subset_) break;  // viewpoint rays are cast against whole scenes only
+        const Vec3 normal = scene_->triangle_normal(index);
         const float leaving = glm::dot(ray.direction, normal);
         if (!(leaving > 0.0f) || t * leaving > band) break;  // a front face, or clear of it
         rayhit = to_rtc_rayhit(ray);
         rayhit.ray.tnear = std::max({ray.tmin, std::nextafter(t, FLT_MAX), FLT_MIN});
         cast(rayhit);
+    }
+}
+
+void RayTracer::alpha_filter(const RTCFilterFunctionNArguments* args) {
+    const auto* tracer = static_cast<const RayTracer*>(args->geometryUserPtr);
+    const Scene& scene = *tracer->scene_;
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] != -1) continue;
+        const uint32_t prim = RTCHitN_primID(args->hit, args->N, i);
+        const uint32_t triangle = tracer->alpha_triangles_[prim];
+        const float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
+        const Material& m = scene.materials[scene.triangle_materials[triangle]];
+        const float alpha = scene.alpha_at(triangle, u, v);
+        bool covered;
+        if (m.alpha_mode == AlphaMode::Mask) {
+            covered = alpha >= m.alpha_cutoff;  // glTF 2.0 section 3.9.4: opaque at the cutoff
+        } else {
+            // Stochastic coverage: a hash of the ray and the triangle, the same for any thread
+            // count and tile order. Unbiased: a fraction alpha of rays sees the surface.
+            RTCRayN* ray = args->ray;
+            const auto bits = [&](float f) { return uint64_t(std::bit_cast<uint32_t>(f)); };
+            const uint64_t origin = bits(RTCRayN_org_x(ray, args->N, i)) |
+                                    (bits(RTCRayN_org_y(ray, args->N, i)) << 32);
+            const uint64_t direction = bits(RTCRayN_dir_x(ray, args->N, i)) |
+                                       (bits(RTCRayN_dir_y(ray, args->N, i)) << 32);
+            const uint64_t rest = bits(RTCRayN_org_z(ray, args->N, i)) |
+                                  (bits(RTCRayN_dir_z(ray, args->N, i)) << 32);
+            const uint64_t h = hash_indices(origin, direction, rest, triangle);
+            const float xi = static_cast<float>(h >> 40) * 0x1.0p-24f;
+            covered = xi < alpha;
+        }
+        if (!covered) args->valid[i] = 0;
     }
 }
 

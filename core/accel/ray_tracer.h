@@ -107,7 +107,7 @@ public:
         cast(rayhit);
         if (ray.from_viewpoint) skip_back_faces_at_viewpoint(ray, rayhit);
         if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
-        return Hit{rayhit.ray.tfar, rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v};
+        return Hit{rayhit.ray.tfar, reported_index(rayhit.hit), rayhit.hit.u, rayhit.hit.v};
     }
     /// Whether anything lies in [tmin, tmax] (from_viewpoint is not looked at).
     bool occluded(const Ray& ray) const;
@@ -152,6 +152,16 @@ private:
         rtcInitIntersectContext(&context);
         rtcIntersect1(rtc_scene_, &context, &rayhit);
     }
+    /// The index a hit reports: the primitive's, unless alpha-tested triangles sit in a second
+    /// geometry (then through the per-geometry tables).
+    uint32_t reported_index(const RTCHit& hit) const {
+        if (!has_alpha_geometry_) return hit.primID;
+        return reported_[hit.geomID][hit.primID];
+    }
+    /// Embree's intersection and occlusion filter of the alpha-tested geometry: rejects hits
+    /// where alpha says the surface is absent (MASK below the cutoff; BLEND where a hash of the
+    /// ray and the hit falls at or above alpha, so that a fraction alpha of rays is stopped).
+    static void alpha_filter(const RTCFilterFunctionNArguments* args);
     /// The viewpoint rule of intersect(): casts again past close back faces.
     void skip_back_faces_at_viewpoint(const Ray& ray, RTCRayHit& rayhit) const;
 
@@ -159,6 +169,15 @@ private:
     const Scene* scene_ = nullptr;
     RTCScene rtc_scene_ = nullptr;
     float scene_scale_ = 1.0f;
+    /// Whether triangles of MASK or BLEND materials exist: they are geometry 1, with the alpha
+    /// filter, and the opaque ones geometry 0 without any (their rays pay nothing).
+    bool has_alpha_geometry_ = false;
+    /// Per geometry: primitive -> reported index (the scene triangle, or its place in `only`).
+    std::vector<uint32_t> reported_[2];
+    /// Geometry 1's primitives -> scene triangles, for the filter's alpha lookup.
+    std::vector<uint32_t> alpha_triangles_;
+    /// Whether the tracer covers all of the scene's triangles (reported index = triangle).
+    bool subset_ = false;
 };
 
 }  // namespace photond

@@ -15,7 +15,8 @@ public:
     Color radiance(const CameraRay& ray, SampleContext& context) const override;
 
 private:
-    Color radiance_along(const Ray& ray, int depth, SampleContext& context) const;
+    Color radiance_along(const Ray& ray, int depth, SampleContext& context, float path_length = 0.0f,
+                         float spread = 0.0f) const;
 
     std::shared_ptr<const RenderScene> scene_;
     int max_specular_depth_;

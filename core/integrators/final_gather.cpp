@@ -71,7 +71,7 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
                     return along(spawn_ray(rs, si, s.wi), depth + 1, nullptr);
                 });
             }
-            return radiance;
+            return volume_transmittance(*rs.scene, si) * radiance;
         }
     };
     return Walker{*this, rs, rng, counters}.along(ray, 0, distance);

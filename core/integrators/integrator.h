@@ -106,7 +106,14 @@ inline Bsdf make_bsdf(const RenderScene& rs, const SurfaceInteraction& si, const
         ng = -ng;
         ns = -ns;
     }
-    return Bsdf(rs.bsdf_materials[si.material], rs.scene->base_color(si.material, si.uv), Frame(ns), ng);
+    if (!material.textured() && rs.scene->colors.empty())
+        return Bsdf(rs.bsdf_materials[si.material], material.base_color, Frame(ns), ng);
+    const MaterialPoint mp = rs.scene->material_point(si.material, si.tex);
+    if (!material.varying_bsdf())
+        return Bsdf(rs.bsdf_materials[si.material], mp.base_color, Frame(ns), ng);
+    // Metallic, roughness or the clearcoat vary over the surface: the constants are derived here.
+    return Bsdf(BsdfMaterial(material, mp.metallic, mp.roughness, mp.clearcoat, mp.clearcoat_roughness),
+                mp.base_color, Frame(ns), ng);
 }
 
 /// Next-event estimation: one light sample with a shadow ray, lobes in `mask` only. With

@@ -14,6 +14,11 @@ Color PathIntegrator::radiance(const CameraRay& camera_ray, SampleContext& conte
     bool previous_was_delta = true;  // the camera ray counts as specular: emission is taken whole
     float previous_bsdf_pdf = 0.0f;
     Vec3 previous_point = camera_ray.origin;
+    // The camera's ray cone picks texture levels along the camera ray and ideal specular bounces
+    // after it; after a rough bounce the path is an integral over directions, textures at level 0.
+    const float spread = pixel_spread(camera_ray);
+    float cone_length = 0.0f;
+    bool cone_alive = true;
 
     for (int depth = 0; depth < max_depth_; ++depth) {
         const std::optional<Hit> hit = trace_ray(rs, ray, context.counters);
@@ -25,8 +30,11 @@ Color PathIntegrator::radiance(const CameraRay& camera_ray, SampleContext& conte
                                                                      previous_was_delta ? 0.0f : previous_bsdf_pdf);
             break;
         }
-        const SurfaceInteraction si = make_interaction(*rs.scene, *hit, ray.direction);
+        cone_length += hit->t;
+        const SurfaceInteraction si =
+            make_interaction(*rs.scene, *hit, ray.direction, cone_alive ? cone_length * spread : 0.0f);
         const Vec3 wo = -ray.direction;
+        throughput *= volume_transmittance(*rs.scene, si);
 
         const Color emitted = rs.lights->emitted_radiance(si, wo);
         if (!is_black(emitted)) {
@@ -48,6 +56,7 @@ Color PathIntegrator::radiance(const CameraRay& camera_ray, SampleContext& conte
         if (!s || !(s->pdf > 0.0f) || is_black(s->weight)) break;
         throughput *= s->weight;
         previous_was_delta = s->kind == LobeKind::Delta;
+        cone_alive = cone_alive && previous_was_delta;
         previous_bsdf_pdf = s->pdf;
         previous_point = si.p;
         ray = spawn_ray(rs, si, s->wi);

@@ -71,11 +71,12 @@ Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_
     const std::optional<Hit> hit = trace_ray(rs, ray, context.counters);
     // A camera ray or a delta bounce that leaves the scene sees the sky whole.
     if (!hit) return rs.lights->escaped_radiance(ray.direction, 0.0f);
-    const SurfaceInteraction si = make_interaction(*rs.scene, *hit, ray.direction);
+    const float length = path_length + hit->t;
+    // The camera's ray cone, widened along ideal specular bounces, picks the texture level.
+    const SurfaceInteraction si = make_interaction(*rs.scene, *hit, ray.direction, footprint.at(length));
     const Vec3 wo = -ray.direction;
     Color radiance = rs.lights->emitted_radiance(si, wo);
     const Bsdf bsdf = make_bsdf(rs, si, wo);
-    const float length = path_length + hit->t;
     if (bsdf.has_non_delta()) {
         radiance += sample_direct_light(rs, *direct_lights_, si, bsdf, wo, context, false);
         const Vec3 normal = glm::dot(si.shading_normal, wo) >= 0.0f ? si.shading_normal : -si.shading_normal;
@@ -114,7 +115,7 @@ Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_
             return radiance_along(spawn_ray(rs, si, s.wi), depth + 1, length, footprint, context);
         });
     }
-    return radiance;
+    return volume_transmittance(*rs.scene, si) * radiance;
 }
 
 }  // namespace photond

@@ -6,6 +6,18 @@
 
 namespace photond {
 
+namespace {
+
+/// The probability that a ray meets an alpha-tested surface at barycentrics b (RayTracer's
+/// filter): MASK 1 or 0 by the cutoff, BLEND alpha.
+float emitter_coverage(const Material& m, const Scene& scene, uint32_t triangle, Vec2 b) {
+    const float alpha = scene.alpha_at(triangle, b.x, b.y);
+    if (m.alpha_mode == AlphaMode::Mask) return alpha >= m.alpha_cutoff ? 1.0f : 0.0f;
+    return std::clamp(alpha, 0.0f, 1.0f);
+}
+
+}  // namespace
+
 float LightSet::spot_falloff(const PunctualLight& light, float cos_angle) {
     return spot_falloff_from_axis(light, 1.0f - cos_angle);
 }
@@ -72,6 +84,10 @@ LightSet::LightSet(const Scene& scene, const Environment* environment) : scene_(
         light_of_triangle_[t] = static_cast<int32_t>(lights_.size());
         Entry e{LightKind::Triangle, t, sides * kPi * area * m.emission, area};
         e.double_sided = m.double_sided;
+        e.textured = m.emissive_texture.present();
+        // Power by the texture's mean over the triangle; the sampled radiance and flux take the
+        // texel at the sampled point, so estimates stay unbiased whatever the mean's accuracy.
+        if (e.textured) e.power *= mean_emissive_texel(t);
         e.front_frame = Frame(scene.triangle_normal(t));
         e.back_frame = Frame(-scene.triangle_normal(t));
         const glm::uvec3& v = scene.triangles[t];
@@ -180,7 +196,8 @@ std::optional<LightSample> LightSet::sample_incident(const Vec3& p, float u_sele
             break;
         }
         case LightKind::Triangle: {
-            const Vec3 q = e.point_at(sample_uniform_triangle(u));
+            const Vec2 b = sample_uniform_triangle(u);
+            const Vec3 q = e.point_at(b);
             const Vec3 n = scene_->triangle_normal(e.index);
             const Vec3 d = q - p;
             const float dist2 = glm::dot(d, d);
@@ -192,7 +209,10 @@ std::optional<LightSample> LightSet::sample_incident(const Vec3& p, float u_sele
             if (cos_light <= 0.0f && !m.double_sided) return std::nullopt;
             const float abs_cos = std::abs(cos_light);
             if (!(abs_cos > 0.0f)) return std::nullopt;
-            s.radiance = m.emission;
+            s.radiance = e.textured ? m.emission * emissive_texel(e, b) : m.emission;
+            // An alpha-tested emitter emits where it is present: a ray that finds it there (the
+            // BSDF-sampled estimate) passes its coverage test with this probability.
+            if (m.alpha_tested()) s.radiance *= emitter_coverage(m, *scene_, e.index, b);
             s.pdf = choice_pdf * dist2 / (abs_cos * e.area);
             if (!std::isfinite(s.pdf)) return std::nullopt;
             s.point = q;
@@ -253,7 +273,49 @@ Color LightSet::emitted_radiance(const SurfaceInteraction& si, const Vec3& wo) c
     const Material& m = scene_->materials[si.material];
     if (!m.is_emissive()) return Color(0.0f);
     if (!m.double_sided && glm::dot(wo, si.geometric_normal) <= 0.0f) return Color(0.0f);
-    return m.emission;
+    return m.emissive_texture.present() ? scene_->emission_at(si.material, si.tex) : m.emission;
+}
+
+Color LightSet::emissive_texel(const Entry& e, Vec2 b) const {
+    const Material& m = scene_->materials[scene_->triangle_materials[e.index]];
+    return Color(scene_->sample(m.emissive_texture, scene_->texture_point(e.index, b.x, b.y)));
+}
+
+Color LightSet::mean_emissive_texel(uint32_t triangle) const {
+    const Material& m = scene_->materials[scene_->triangle_materials[triangle]];
+    const Texture& texture = scene_->textures[static_cast<size_t>(m.emissive_texture.texture)];
+    const TexturePoint c0 = scene_->texture_point(triangle, 0.0f, 0.0f);
+    const TexturePoint c1 = scene_->texture_point(triangle, 1.0f, 0.0f);
+    const TexturePoint c2 = scene_->texture_point(triangle, 0.0f, 1.0f);
+    const auto uv = [&](const TexturePoint& tp) {
+        return m.emissive_texture.apply(m.emissive_texture.slot == 0 ? tp.uv : tp.uv1);
+    };
+    const Vec2 a = uv(c1) - uv(c0), b = uv(c2) - uv(c0);
+    const float texels = std::abs(a.x * b.y - a.y * b.x) * 0.5f * static_cast<float>(texture.width) *
+                         static_cast<float>(texture.height);
+    // Level L has 4^-L as many texels: the one where the triangle covers at most ~256.
+    const float lod = texels > 256.0f ? std::ceil(0.5f * std::log2(texels / 256.0f)) : 0.0f;
+    const float covered = std::isfinite(texels) ? texels / std::exp2(2.0f * lod) : 1.0f;
+    // n^2 equal sub-triangles, each read at its centroid: four or more points per covered texel.
+    const int n = std::clamp(static_cast<int>(std::ceil(std::sqrt(4.0f * covered))), 8, 32);
+    Color sum(0.0f);
+    const float inv_n = 1.0f / static_cast<float>(n);
+    for (int i = 0; i < n; ++i) {
+        for (int j = 0; i + j < n; ++j) {
+            for (int upper = 0; upper < 2; ++upper) {
+                if (upper && i + j + 1 >= n) continue;
+                const float o = upper ? 2.0f / 3.0f : 1.0f / 3.0f;
+                const float bu = (static_cast<float>(i) + o) * inv_n, bv = (static_cast<float>(j) + o) * inv_n;
+                const TexturePoint tp = scene_->texture_point(triangle, bu, bv);
+                sum += Color(texture.sample_rgba(uv(tp), lod));
+            }
+        }
+    }
+    Color mean = sum / static_cast<float>(n * n);
+    // A floor of a thousandth of the whole texture's mean (its 1x1 level), so that a triangle
+    // whose emitting texels fall between the points keeps a positive choice probability.
+    const Color whole = Color(texture.sample_rgba(Vec2(0.5f), static_cast<float>(texture.level_count())));
+    return glm::max(mean, 1e-3f * whole);
 }
 
 Vec3 LightSet::parallel_origin(const Vec3& direction, Vec2 u, const EmissionFocus& focus, float* area_ratio) const {
@@ -324,7 +386,8 @@ std::optional<EmissionSample> LightSet::sample_emission(float u_select, Vec2 u_p
             break;
         }
         case LightKind::Triangle: {
-            s.origin = e.point_at(sample_uniform_triangle(u_position));
+            const Vec2 b = sample_uniform_triangle(u_position);
+            s.origin = e.point_at(b);
             const Frame* face = &e.front_frame;
             Vec2 ud = u_direction;
             if (e.double_sided) {  // pick a face, reusing the random number
@@ -337,7 +400,9 @@ std::optional<EmissionSample> LightSet::sample_emission(float u_select, Vec2 u_p
             }
             s.normal = face->n;
             s.direction = face->to_world(sample_cosine_hemisphere(ud));
-            s.flux_weight = e.emission_weight;
+            s.flux_weight = e.textured ? e.emission_weight * emissive_texel(e, b) : e.emission_weight;
+            const Material& m = scene_->materials[scene_->triangle_materials[e.index]];
+            if (m.alpha_tested()) s.flux_weight *= emitter_coverage(m, *scene_, e.index, b);
             break;
         }
     }

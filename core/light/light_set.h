@@ -128,7 +128,15 @@ private:
         /// Triangles: the point at barycentric coordinates b of the second and third vertices.
         Vec3 point_at(Vec2 b) const { return corner + b.x * edge1 + b.y * edge2; }
         bool double_sided = false;
+        /// Triangles: the material has an emissive texture, read at each sampled point.
+        bool textured = false;
     };
+    /// The emissive texture's value (without the factor) on triangle light `e` at barycentrics b.
+    Color emissive_texel(const Entry& e, Vec2 b) const;
+    /// Mean emissive texture value over a triangle (without the factor), for its power: the
+    /// mean of a grid of points on it, read at the mip level where the triangle covers about 256
+    /// texels (levels are box means, so no emitting texel is missed between the points).
+    Color mean_emissive_texel(uint32_t triangle) const;
     const Scene* scene_;
     std::vector<Entry> lights_;
     std::vector<int32_t> light_of_triangle_;  // -1 when the triangle emits nothing

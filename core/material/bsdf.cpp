@@ -48,6 +48,11 @@ constexpr float kMinIorContrast = 1e-3f;
 constexpr int kSlotDiffuse = 0;
 constexpr int kSlotSpecular = 1;
 constexpr int kSlotGlass = 2;
+constexpr int kSlotCoat = 3;
+/// KHR_materials_clearcoat: the coat's Fresnel F0 (ior 1.5) and the cosine-weighted mean of its
+/// Schlick term, 0.04 + 0.96 / 21 (int (1 - mu)^5 2 mu dmu = 1/21).
+constexpr float kCoatF0 = 0.04f;
+constexpr float kCoatFresnelMean = kCoatF0 + (1.0f - kCoatF0) / 21.0f;
 
 /// Classifies a microfacet lobe by its perceptual roughness for the photon passes: ideal
 /// specular below kDeltaRoughness, glossy below kGlossyRoughness, otherwise diffuse (photons
@@ -260,11 +265,12 @@ SpecularAlbedo specular_albedo_terms(int cell, float w_roughness, float mu) {
 
 }  // namespace
 
-BsdfMaterial::BsdfMaterial(const Material& material) {
+BsdfMaterial::BsdfMaterial(const Material& material, float metallic_value, float roughness_value,
+                           float clearcoat_value, float clearcoat_roughness_value) {
     // Clamp to the ranges the glTF spec allows, which is what the energy guarantee needs.
-    metallic = std::clamp(material.metallic, 0.0f, 1.0f);
+    metallic = std::isfinite(metallic_value) ? std::clamp(metallic_value, 0.0f, 1.0f) : 0.0f;
     transmission = std::clamp(material.transmission, 0.0f, 1.0f);
-    roughness = std::clamp(material.roughness, 0.0f, 1.0f);
+    roughness = std::isfinite(roughness_value) ? std::clamp(roughness_value, 0.0f, 1.0f) : 1.0f;
     ior = std::isfinite(material.ior) ? std::max(material.ior, 1.0f) : 1.5f;
     const float specular = std::clamp(material.specular, 0.0f, 1.0f);
 
@@ -299,7 +305,50 @@ BsdfMaterial::BsdfMaterial(const Material& material) {
     }
     if (reflects) other_lobes |= mask_of(specular_kind);
     if (glass_weight > 0.0f) other_lobes |= mask_of(glass_kind);
-    lambertian_only = metallic <= 0.0f && glass_weight <= 0.0f && specular_f90 <= 0.0f;
+    coat = std::isfinite(clearcoat_value) ? std::clamp(clearcoat_value, 0.0f, 1.0f) : 0.0f;
+    coat_roughness = std::isfinite(clearcoat_roughness_value) ? std::clamp(clearcoat_roughness_value, 0.0f, 1.0f) : 0.0f;
+    coat_smooth = coat_roughness < kDeltaRoughness;
+    coat_alpha = std::max(sqr(coat_roughness), kMinAlpha);
+    coat_kind = microfacet_lobe_kind(coat_roughness);
+    if (coat > 0.0f) other_lobes |= mask_of(coat_kind);
+    lambertian_only = metallic <= 0.0f && glass_weight <= 0.0f && specular_f90 <= 0.0f && coat <= 0.0f;
+}
+
+LobeMask possible_lobes(const Scene& scene, const Material& m) {
+    float metallic[2] = {m.metallic, m.metallic}, roughness[2] = {m.roughness, m.roughness};
+    if (m.metallic_roughness_texture.present()) {
+        const Texture& t = scene.textures[static_cast<size_t>(m.metallic_roughness_texture.texture)];
+        float g[2] = {1.0f, 0.0f}, b[2] = {1.0f, 0.0f};
+        for (const Color& c : t.texels) {
+            g[0] = std::min(g[0], c.y), g[1] = std::max(g[1], c.y);
+            b[0] = std::min(b[0], c.z), b[1] = std::max(b[1], c.z);
+        }
+        if (t.texels.empty()) g[0] = g[1] = b[0] = b[1] = 1.0f;
+        for (int i = 0; i < 2; ++i) {
+            roughness[i] = m.roughness * g[i];
+            metallic[i] = m.metallic * b[i];
+        }
+    }
+    const Color colour = m.base_color_texture.present() ? Color(1.0f) : m.base_color;
+    // The range's ends, and a glossy roughness where the range holds one between them.
+    const float glossy = std::clamp(0.5f * (kDeltaRoughness + kGlossyRoughness), roughness[0], roughness[1]);
+    // The clearcoat's roughness likewise (its factor only switches the lobe on).
+    float coat_roughness[2] = {m.clearcoat_roughness, m.clearcoat_roughness};
+    if (m.clearcoat_roughness_texture.present()) {
+        coat_roughness[0] = 0.0f;  // conservative: the texture may hold any value
+    }
+    const float coat_glossy = std::clamp(0.5f * (kDeltaRoughness + kGlossyRoughness), coat_roughness[0], coat_roughness[1]);
+    const float coat = m.clearcoat > 0.0f ? m.clearcoat : 0.0f;
+    LobeMask lobes = 0;
+    for (float mv : metallic) {
+        for (float rv : {roughness[0], roughness[1], glossy}) {
+            for (float cr : {coat_roughness[0], coat_roughness[1], coat_glossy}) {
+                const BsdfMaterial constants(m, mv, rv, coat, cr);
+                lobes |= Bsdf(constants, colour, Frame(Vec3(0, 0, 1)), Vec3(0, 0, 1)).lobes();
+            }
+        }
+    }
+    return lobes;
 }
 
 Color Bsdf::layer_albedo(float cos_theta) const {
@@ -321,6 +370,8 @@ Color Bsdf::lambert_albedo(float cos_theta) const {
     for (int ch = 0; ch < 3; ++ch) {
         if (m_->diffuse_norm[ch] > 0.0f) rho[ch] = diffuse_weight_[ch] * remaining[ch];
     }
+    // Under a clearcoat: through it towards wo, and on average (cosine-weighted) towards wi.
+    if (m_->coat > 0.0f) rho *= coat_through(cos_theta) * (1.0f - m_->coat * kCoatFresnelMean);
     return rho;
 }
 
@@ -331,14 +382,15 @@ Color Bsdf::diffuse_reflectance(const Vec3& wo) const {
 bool Bsdf::has_non_lambertian_non_delta() const {
     const bool rough_reflection = !m_->smooth && (m_->metallic > 0.0f || (m_->layer_weight > 0.0f && m_->specular_f90 > 0.0f));
     const bool rough_glass = m_->glass_weight > 0.0f && !m_->glass_delta;
-    return rough_reflection || rough_glass;
+    const bool rough_coat = m_->coat > 0.0f && !m_->coat_smooth;
+    return rough_reflection || rough_glass || rough_coat;
 }
 
 Bsdf::SlotProbabilities Bsdf::slot_probabilities(const Vec3& wo, bool outside,
                                                  LobeMask mask) const {
     // Each slot's estimated albedo for this wo (exact for Lambert and the smooth lobes). The
     // estimates never depend on the TransportMode, so that pdf() needs none.
-    SlotProbabilities p{0.0f, 0.0f, 0.0f};
+    SlotProbabilities p{0.0f, 0.0f, 0.0f, 0.0f};
     const float mu = wo.z;
     if (in_mask(mask, LobeKind::Diffuse) && !(mask & kExcludeLambertian) &&
         max_component(diffuse_) > 0.0f) {
@@ -351,14 +403,37 @@ Bsdf::SlotProbabilities Bsdf::slot_probabilities(const Vec3& wo, bool outside,
         const float f = fresnel_dielectric(mu, relative_ior(outside));
         p[kSlotGlass] = m_->glass_weight * (f + (1.0f - f) * average(base_color_));
     }
-    const float sum = p[0] + p[1] + p[2];
-    if (!(sum > 0.0f)) return {0.0f, 0.0f, 0.0f};
+    if (m_->coat > 0.0f && outside) {
+        // The base is seen through the coat; the coat reflects its Fresnel share.
+        const float through = coat_through(mu);
+        for (int k = 0; k < 3; ++k) p[k] *= through;
+        if (in_mask(mask, m_->coat_kind)) p[kSlotCoat] = coat_fresnel(mu);
+    }
+    const float sum = p[0] + p[1] + p[2] + p[3];
+    if (!(sum > 0.0f)) return {0.0f, 0.0f, 0.0f, 0.0f};
     for (float& v : p) v /= sum;
     return p;
 }
 
 Color Bsdf::eval_local(const Vec3& wo, const Vec3& wi, bool outside, TransportMode mode,
                        LobeMask mask) const {
+    Color f = eval_base_local(wo, wi, outside, mode, mask);
+    if (!(m_->coat > 0.0f) || !outside) return f;
+    // KHR_materials_clearcoat: f = (1 - c F_c(mu_o)) (1 - c F_c(mu_i)) f_base + c F_c(h) D G / (4 mu_o mu_i),
+    // the base attenuated by the coat's directional Fresnel both ways (reciprocal; the
+    // specification's mix(base, coat, c F_c) written for both directions).
+    f *= coat_through(wo.z) * coat_through(std::abs(wi.z));
+    if (wi.z > 0.0f && !m_->coat_smooth && in_mask(mask, m_->coat_kind)) {
+        const GgxDistribution ggx(m_->coat_alpha);
+        const Vec3 h = glm::normalize(wo + wi);
+        const float fresnel = m_->coat * (kCoatF0 + (1.0f - kCoatF0) * schlick_weight(glm::dot(wo, h)));
+        f += Color(fresnel * ggx.d(h) * ggx.g2(wo, wi) / (4.0f * wo.z * wi.z));
+    }
+    return f;
+}
+
+Color Bsdf::eval_base_local(const Vec3& wo, const Vec3& wi, bool outside, TransportMode mode,
+                            LobeMask mask) const {
     Color f(0.0f);
     const GgxDistribution ggx(m_->alpha);
     if (wi.z > 0.0f) {
@@ -405,6 +480,17 @@ Color Bsdf::eval_local(const Vec3& wo, const Vec3& wi, bool outside, TransportMo
 
 float Bsdf::pdf_local(const Vec3& wo, const Vec3& wi, bool outside,
                       const SlotProbabilities& slots) const {
+    float pdf = pdf_base_local(wo, wi, outside, slots);
+    if (slots[kSlotCoat] > 0.0f && !m_->coat_smooth && wi.z > 0.0f) {
+        const GgxDistribution ggx(m_->coat_alpha);
+        const Vec3 h = glm::normalize(wo + wi);
+        pdf += slots[kSlotCoat] * ggx.visible_normal_pdf(wo, h) / (4.0f * glm::dot(wo, h));
+    }
+    return pdf;
+}
+
+float Bsdf::pdf_base_local(const Vec3& wo, const Vec3& wi, bool outside,
+                           const SlotProbabilities& slots) const {
     const GgxDistribution ggx(m_->alpha);
     const float p_specular = m_->smooth ? 0.0f : slots[kSlotSpecular];
     const float p_glass = m_->glass_delta ? 0.0f : slots[kSlotGlass];
@@ -480,7 +566,7 @@ std::optional<BsdfSample> Bsdf::sample_lobes(const Vec3& wo, float u_lobe, const
     // Choose a slot with u_lobe; reuse the remainder of u_lobe for the reflect/refract choice.
     int slot = -1;
     float lower = 0.0f, chosen_lower = 0.0f;
-    for (int s = 0; s < 3; ++s) {
+    for (int s = 0; s < 4; ++s) {
         if (slots[s] <= 0.0f) continue;
         slot = s;
         chosen_lower = lower;
@@ -493,27 +579,35 @@ std::optional<BsdfSample> Bsdf::sample_lobes(const Vec3& wo, float u_lobe, const
 
     BsdfSample s;
     Vec3 i;
-    const bool delta = (slot == kSlotSpecular && m_->smooth) || (slot == kSlotGlass && m_->glass_delta);
+    const bool delta = (slot == kSlotSpecular && m_->smooth) || (slot == kSlotGlass && m_->glass_delta) ||
+                       (slot == kSlotCoat && m_->coat_smooth);
+    // Light reaching the base through a clearcoat both ways (1 where there is none).
+    const float coat_o = m_->coat > 0.0f && outside ? coat_through(o.z) : 1.0f;
     if (delta) {
         // All delta lobes share the mirror direction: its weight is their total reflectance over
         // the total probability of choosing it.
         const float f_glass = fresnel_dielectric(o.z, eta);
-        const bool mirror = slot == kSlotSpecular || u_choice < f_glass;
+        const bool mirror = slot == kSlotSpecular || slot == kSlotCoat || u_choice < f_glass;
         Color reflectance(0.0f);
         float probability = 0.0f;
         if (mirror) {
             i = Vec3(-o.x, -o.y, o.z);
             if (m_->smooth && slots[kSlotSpecular] > 0.0f) {
-                reflectance += specular_albedo(o.z);
+                reflectance += specular_albedo(o.z) * (coat_o * coat_o);
                 probability += slots[kSlotSpecular];
             }
             if (m_->glass_delta && slots[kSlotGlass] > 0.0f) {
-                reflectance += Color(m_->glass_weight * f_glass);
+                reflectance += Color(m_->glass_weight * f_glass * coat_o * coat_o);
                 probability += slots[kSlotGlass] * f_glass;
+            }
+            if (m_->coat_smooth && slots[kSlotCoat] > 0.0f) {
+                reflectance += Color(coat_fresnel(o.z));
+                probability += slots[kSlotCoat];
             }
         } else {
             if (!refract(o, Vec3(0, 0, 1), eta, &i)) return std::nullopt;
             reflectance = m_->glass_weight * (1.0f - f_glass) * base_color_;
+            if (m_->coat > 0.0f && outside) reflectance *= coat_o * coat_through(std::abs(i.z));
             if (mode == TransportMode::Radiance) reflectance /= eta * eta;
             probability = slots[kSlotGlass] * (1.0f - f_glass);
             s.is_transmission = true;
@@ -528,6 +622,8 @@ std::optional<BsdfSample> Bsdf::sample_lobes(const Vec3& wo, float u_lobe, const
         bool reflection = true;
         if (slot == kSlotDiffuse) {
             i = sample_cosine_hemisphere(u);
+        } else if (slot == kSlotCoat) {
+            i = reflect(o, GgxDistribution(m_->coat_alpha).sample_visible_normal(o, u));
         } else {
             const Vec3 h = ggx.sample_visible_normal(o, u);
             reflection =
@@ -545,8 +641,10 @@ std::optional<BsdfSample> Bsdf::sample_lobes(const Vec3& wo, float u_lobe, const
         if (!(pdf > 0.0f) || is_black(f) || !is_finite(f)) return std::nullopt;
         s.weight = f * std::abs(i.z) / pdf;
         s.pdf = pdf;
-        s.kind = slot == kSlotDiffuse ? LobeKind::Diffuse
-                                      : (slot == kSlotSpecular ? m_->specular_kind : m_->glass_kind);
+        s.kind = slot == kSlotDiffuse    ? LobeKind::Diffuse
+                 : slot == kSlotSpecular ? m_->specular_kind
+                 : slot == kSlotCoat     ? m_->coat_kind
+                                         : m_->glass_kind;
         s.is_transmission = i.z < 0.0f;
         s.eta = s.is_transmission ? eta : 1.0f;
     }
@@ -571,8 +669,11 @@ int Bsdf::delta_lobes(const Vec3& wo, std::array<BsdfSample, 2>& out, TransportM
     };
     int count = 0;
     Color mirror(0.0f);
+    const float coat_o = m_->coat > 0.0f && outside ? coat_through(o.z) : 1.0f;
     if (m_->smooth) mirror += specular_albedo(o.z);
     mirror += Color(m_->glass_weight * f_glass);
+    mirror *= coat_o * coat_o;
+    if (m_->coat > 0.0f && m_->coat_smooth && outside) mirror += Color(coat_fresnel(o.z));
     if (!is_black(mirror)) {
         BsdfSample s;
         s.wi = to_world(Vec3(-o.x, -o.y, o.z));
@@ -587,6 +688,7 @@ int Bsdf::delta_lobes(const Vec3& wo, std::array<BsdfSample, 2>& out, TransportM
         BsdfSample s;
         s.wi = to_world(i);
         s.weight = m_->glass_weight * (1.0f - f_glass) * base_color_;
+        if (m_->coat > 0.0f && outside) s.weight *= coat_o * coat_through(std::abs(i.z));
         if (mode == TransportMode::Radiance) s.weight /= eta * eta;
         s.pdf = 1.0f;
         s.kind = LobeKind::Delta;

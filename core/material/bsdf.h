@@ -57,7 +57,13 @@ struct BsdfSample {
 /// per material (RenderScene::bsdf_materials), so that a Bsdf at a hit only adds the base colour
 /// and the frames: deriving it at every hit was a tenth of a photon bounce.
 struct BsdfMaterial {
-    explicit BsdfMaterial(const Material& material);
+    explicit BsdfMaterial(const Material& material)
+        : BsdfMaterial(material, material.metallic, material.roughness, material.clearcoat,
+                       material.clearcoat_roughness) {}
+    /// With metallic, roughness and the clearcoat's factor and roughness read from the
+    /// material's textures at one point.
+    BsdfMaterial(const Material& material, float metallic, float roughness, float clearcoat,
+                 float clearcoat_roughness);
 
     Color specular_f0;       // dielectric layer F0 (from ior and KHR_materials_specular)
     float specular_f90;      // dielectric layer F90 (the specular factor)
@@ -79,7 +85,19 @@ struct BsdfMaterial {
     Color diffuse_norm;       // 1 / (1 - E_s_avg) per channel; 0 where the layer reflects all
     int albedo_cell = -1;            // roughness cell of the layer albedo table; -1: mirror
     float albedo_cell_weight = 0.0f;  // interpolation weight within that cell
+    /// KHR_materials_clearcoat: factor, perceptual roughness, GGX alpha, whether it is delta,
+    /// its lobe kind, and the cosine-weighted mean of its Fresnel term (for rho_d).
+    float coat = 0.0f;
+    float coat_roughness = 0.0f;
+    float coat_alpha = 0.0f;
+    bool coat_smooth = true;
+    LobeKind coat_kind = LobeKind::Delta;
 };
+
+/// The lobe kinds a material can have anywhere on its surface: with a metallicRoughnessTexture,
+/// the union over its texels' extremes of metallic and roughness (the base colour taken as
+/// white, so a texture can only remove lobes). For the render plan and the caustic casters.
+LobeMask possible_lobes(const Scene& scene, const Material& material);
 
 class Bsdf {
 public:
@@ -92,15 +110,30 @@ public:
     Bsdf(const BsdfMaterial& material, const Color& base_color, const Frame& shading,
          const Vec3& geometric_normal)
         : m_(&material), frame_(shading), geometric_normal_(geometric_normal) {
-        base_color_ = glm::clamp(base_color, Color(0.0f), Color(1.0f));
-        diffuse_weight_ = m_->layer_weight * base_color_;
-        diffuse_ = diffuse_weight_ * m_->diffuse_remaining;
-        lobes_ = m_->other_lobes;
-        if (max_component(diffuse_) > 0.0f) lobes_ |= mask_of(LobeKind::Diffuse);
-        pure_lambertian_ = lobes_ == mask_of(LobeKind::Diffuse) && m_->lambertian_only;
+        init(base_color);
     }
-    /// Not from a temporary: the Bsdf would point to it after it is gone.
-    Bsdf(BsdfMaterial&&, const Color&, const Frame&, const Vec3&) = delete;
+    /// A Bsdf that keeps its own material constants: for materials whose metallic and roughness
+    /// vary over the surface (metallicRoughnessTexture), derived at the hit.
+    Bsdf(BsdfMaterial&& material, const Color& base_color, const Frame& shading,
+         const Vec3& geometric_normal)
+        : m_(nullptr), own_(std::move(material)), frame_(shading), geometric_normal_(geometric_normal) {
+        m_ = &*own_;
+        init(base_color);
+    }
+    Bsdf(const Bsdf& other) { *this = other; }
+    Bsdf& operator=(const Bsdf& other) {
+        if (this == &other) return *this;
+        own_ = other.own_;
+        m_ = own_ ? &*own_ : other.m_;
+        frame_ = other.frame_;
+        geometric_normal_ = other.geometric_normal_;
+        base_color_ = other.base_color_;
+        diffuse_ = other.diffuse_;
+        diffuse_weight_ = other.diffuse_weight_;
+        lobes_ = other.lobes_;
+        pure_lambertian_ = other.pure_lambertian_;
+        return *this;
+    }
 
     /// Sum of the non-delta lobes in `mask` (no cosine). Zero for delta-only materials.
     /// Reflection vs transmission is decided by the geometric normal (reflection iff wo and wi
@@ -158,16 +191,28 @@ public:
 
 private:
     // Sampling slots: the Lambertian lobe, the specular reflection (metal + dielectric layer,
-    // sharing one GGX distribution) and the solid dielectric (reflection + transmission).
-    using SlotProbabilities = std::array<float, 3>;
+    // sharing one GGX distribution), the solid dielectric (reflection + transmission) and the
+    // clearcoat (which applies on the normals' side only: light from inside a coated solid
+    // meets no coat).
+    using SlotProbabilities = std::array<float, 4>;
 
     // The helpers work in the shading frame flipped so that wo.z > 0; `outside` tells whether
     // wo was on the normals' side (which matters for the dielectric's relative index only).
     SlotProbabilities slot_probabilities(const Vec3& wo, bool outside, LobeMask mask) const;
     Color eval_local(const Vec3& wo, const Vec3& wi, bool outside, TransportMode mode,
                      LobeMask mask) const;
+    Color eval_base_local(const Vec3& wo, const Vec3& wi, bool outside, TransportMode mode,
+                          LobeMask mask) const;  // eval_local without the clearcoat
     float pdf_local(const Vec3& wo, const Vec3& wi, bool outside,
                     const SlotProbabilities& slots) const;
+    float pdf_base_local(const Vec3& wo, const Vec3& wi, bool outside,
+                         const SlotProbabilities& slots) const;
+    /// KHR_materials_clearcoat's Fresnel share c (0.04 + 0.96 (1 - mu)^5), and what passes it.
+    float coat_fresnel(float mu) const {
+        const float x = 1.0f - std::clamp(mu, 0.0f, 1.0f), x2 = x * x;
+        return m_->coat * (0.04f + 0.96f * x2 * x2 * x);
+    }
+    float coat_through(float mu) const { return 1.0f - coat_fresnel(mu); }
     Color layer_albedo(float cos_theta) const;
     Color lambert_albedo(float cos_theta) const;
     Color specular_albedo(float cos_theta) const;
@@ -200,7 +245,19 @@ private:
         return s;
     }
 
+    void init(const Color& base_color) {
+        base_color_ = glm::clamp(base_color, Color(0.0f), Color(1.0f));
+        diffuse_weight_ = m_->layer_weight * base_color_;
+        diffuse_ = diffuse_weight_ * m_->diffuse_remaining;
+        // Under a clearcoat, on average through it both ways (0.04 + 0.96 / 21: its mean Fresnel).
+        if (m_->coat > 0.0f) diffuse_ *= sqr(1.0f - m_->coat * (0.04f + 0.96f / 21.0f));
+        lobes_ = m_->other_lobes;
+        if (max_component(diffuse_) > 0.0f) lobes_ |= mask_of(LobeKind::Diffuse);
+        pure_lambertian_ = lobes_ == mask_of(LobeKind::Diffuse) && m_->lambertian_only;
+    }
+
     const BsdfMaterial* m_;
+    std::optional<BsdfMaterial> own_;  // set when the constants vary over the surface
     Frame frame_;
     Vec3 geometric_normal_;
     Color base_color_;

@@ -114,6 +114,10 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
         if (!hit) return;
         const SurfaceInteraction si = make_interaction(*rs.scene, *hit, ray.direction);
         const Vec3 wo = -ray.direction;  // towards where the photon came from
+        if (rs.scene->materials[si.material].has_volume()) {
+            flux *= volume_transmittance(*rs.scene, si);
+            if (is_black(flux)) return;
+        }
         const Bsdf bsdf = make_bsdf(rs, si, wo);
         if (bsdf.has_non_delta()) {
             const bool caustic_path = specular_bounces > 0 && !diffuse_seen;

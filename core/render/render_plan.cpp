@@ -21,11 +21,9 @@ SceneLightPaths analyse_light_paths(const Scene& scene, const LightSet& lights) 
     for (size_t i = 0; i < scene.materials.size(); ++i) {
         if (!used[i]) continue;
         const Material& m = scene.materials[i];
-        // Lobes from a representative BSDF of the material (its texture can only scale colours).
-        const Color colour = m.base_color_texture >= 0 ? Color(1.0f) : m.base_color;
-        const BsdfMaterial constants(m);
-        const Bsdf bsdf(constants, colour, Frame(Vec3(0, 0, 1)), Vec3(0, 0, 1));
-        const LobeMask lobes = bsdf.lobes();
+        // Every lobe the material can have anywhere (its textures can only scale colours and
+        // move metallic and roughness within their texels' range).
+        const LobeMask lobes = possible_lobes(scene, m);
         if (lobes & (mask_of(LobeKind::Delta) | mask_of(LobeKind::Glossy))) paths.has_specular = true;
         if (lobes & kNonDeltaLobes) paths.has_receiver = true;
         // Diffuse-class lobes: the Lambertian one and microfacet lobes too rough to count as glossy.

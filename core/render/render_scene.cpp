@@ -23,8 +23,13 @@ Expected<std::shared_ptr<const RenderScene>> RenderScene::create(std::shared_ptr
     for (const Material& material : scene->materials) render_scene->bsdf_materials.emplace_back(material);
     std::vector<uint32_t> specular;
     constexpr LobeMask kCausticLobes = mask_of(LobeKind::Delta) | mask_of(LobeKind::Glossy);
+    std::vector<LobeMask> lobes(scene->materials.size());
+    for (size_t i = 0; i < lobes.size(); ++i) {
+        const Material& m = scene->materials[i];
+        lobes[i] = m.varying_bsdf() ? possible_lobes(*scene, m) : render_scene->bsdf_materials[i].other_lobes;
+    }
     for (uint32_t t = 0; t < scene->triangles.size(); ++t) {
-        if (render_scene->bsdf_materials[scene->triangle_materials[t]].other_lobes & kCausticLobes) specular.push_back(t);
+        if (lobes[scene->triangle_materials[t]] & kCausticLobes) specular.push_back(t);
     }
     if (!specular.empty()) {
         auto casters = RayTracer::build(device, *scene, &specular);

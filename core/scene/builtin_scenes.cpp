@@ -442,7 +442,7 @@ Expected<Scene> make_sunlit_room() {
     SceneBuilder builder("sunlit-room");
     const uint32_t checker = builder.add_texture(checker_texture(8, Color(0.75f, 0.7f, 0.6f), Color(0.35f, 0.25f, 0.2f)));
     Material floor = lambertian("floor", Color(1.0f));
-    floor.base_color_texture = static_cast<int>(checker);
+    floor.base_color_texture.texture = static_cast<int>(checker);
     const uint32_t floor_material = builder.add_material(floor);
     const uint32_t white = builder.add_material(lambertian("white", Color(0.8f)));
     const uint32_t blue = builder.add_material(lambertian("blue", Color(0.25f, 0.35f, 0.65f)));

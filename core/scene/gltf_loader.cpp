@@ -1,6 +1,7 @@
 #include "core/scene/gltf_loader.h"
 
 #include "core/scene/gltf_compression.h"
+#include "core/math/frame.h"
 
 #include <tiny_gltf.h>
 
@@ -12,6 +13,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <tuple>
 #include <optional>
 #include <set>
 #include <string_view>
@@ -36,7 +38,8 @@ constexpr uint64_t kMaxImagePixels = uint64_t(1) << 26;
 
 const std::set<std::string, std::less<>> kSupportedRequiredExtensions = {
     "KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_transmission",
-    "KHR_materials_ior", "KHR_materials_specular"};
+    "KHR_materials_ior", "KHR_materials_specular", "KHR_texture_transform",
+    "KHR_materials_clearcoat", "KHR_materials_volume"};
 
 // Geometry and file extensions (kept apart from the material ones above): decoded by the loader,
 // so a file may require them.
@@ -278,7 +281,9 @@ float srgb_to_linear(float c) {
     return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
 }
 
-Expected<Texture> decode_base_color_image(const tinygltf::Image& image, int image_index) {
+// Decodes a PNG or JPEG into linear RGB (through the sRGB curve for colour textures: base colour
+// and emission; as stored for data: metallic-roughness and normals) and linear alpha.
+Expected<Texture> decode_image(const tinygltf::Image& image, int image_index, bool srgb) {
     const std::string what = "image " + std::to_string(image_index) + quoted(image.name) +
                              (image.uri.empty() ? "" : " (uri '" + image.uri + "')");
     if (!image.as_is || image.image.empty()) return Error{what + " could not be read"};
@@ -310,22 +315,30 @@ Expected<Texture> decode_base_color_image(const tinygltf::Image& image, int imag
     texture.width = decoded.width;
     texture.height = decoded.height;
     texture.texels.resize(texel_count);
+    const auto curve = [srgb](float c) { return srgb ? srgb_to_linear(c) : c; };
+    std::vector<float> alpha(texel_count);
+    bool opaque = true;
     if (decoded.bits == 8) {
         float table[256];
-        for (int i = 0; i < 256; ++i) table[i] = srgb_to_linear(float(i) / 255.0f);
+        for (int i = 0; i < 256; ++i) table[i] = curve(float(i) / 255.0f);
         const uint8_t* p = decoded.image.data();
-        for (size_t i = 0; i < texel_count; ++i, p += 4)
+        for (size_t i = 0; i < texel_count; ++i, p += 4) {
             texture.texels[i] = Color(table[p[0]], table[p[1]], table[p[2]]);
+            alpha[i] = p[3] / 255.0f;
+            opaque = opaque && p[3] == 255;
+        }
     } else {
         const uint8_t* p = decoded.image.data();
         for (size_t i = 0; i < texel_count; ++i, p += 8) {
-            uint16_t rgb[3];
-            std::memcpy(rgb, p, sizeof(rgb));  // stb returns native-endian 16-bit samples
-            texture.texels[i] =
-                Color(srgb_to_linear(rgb[0] / 65535.0f), srgb_to_linear(rgb[1] / 65535.0f),
-                      srgb_to_linear(rgb[2] / 65535.0f));
+            uint16_t rgba[4];
+            std::memcpy(rgba, p, sizeof(rgba));  // stb returns native-endian 16-bit samples
+            texture.texels[i] = Color(curve(rgba[0] / 65535.0f), curve(rgba[1] / 65535.0f),
+                                      curve(rgba[2] / 65535.0f));
+            alpha[i] = rgba[3] / 65535.0f;
+            opaque = opaque && rgba[3] == 65535;
         }
     }
+    if (!opaque) texture.alpha = std::move(alpha);
     return texture;
 }
 
@@ -498,7 +511,13 @@ private:
 
     Status load_mesh(int mesh_index);
     Expected<uint32_t> scene_material(int material_index);
-    Expected<int> scene_texture(int texture_index, const std::string& context);
+    Expected<int> scene_texture(int texture_index, const std::string& context, const std::string& role,
+                                bool srgb);
+    /// A textureInfo (index, texCoord, KHR_texture_transform) as a TextureRef; `sets` collects
+    /// the material's TEXCOORD sets, whose position there is the ref's slot.
+    Expected<TextureRef> texture_ref(int index, int tex_coord, const tinygltf::ExtensionMap& extensions,
+                                     const std::string& context, const std::string& role, bool srgb,
+                                     std::vector<int>& sets);
     Status visit_node(int node_index, const Mat4& parent, int depth);
     Status add_camera(const tinygltf::Node& node, int node_index, const Mat4& world);
     void add_cameras();
@@ -513,9 +532,16 @@ private:
         std::vector<Vec3> positions;
         std::vector<Vec3> normals;
         std::vector<Vec2> uvs;
+        std::vector<Vec2> uvs1;
+        std::vector<Vec4> colors;
+        std::vector<Vec4> tangents;
         std::vector<glm::uvec3> triangles;
         uint32_t material = 0;
     };
+
+    /// Per-vertex tangents for a normal-mapped primitive without TANGENT (glTF 2.0 section
+    /// 3.7.2.1: MikkTSpace). See the definition.
+    static void generate_tangents(DecodedPrimitive& prim, int slot);
 
     const tinygltf::Model& model_;
     std::string file_;
@@ -524,7 +550,10 @@ private:
     bool quantized_ = false;  // KHR_mesh_quantization declared: integer attributes allowed
     std::vector<std::optional<std::vector<DecodedPrimitive>>> meshes_;
     std::map<int, uint32_t> materials_;  // glTF material (-1: default) -> scene material
-    std::map<int, int> textures_;        // glTF image -> scene texture
+    /// (glTF image, sampler, sRGB) -> scene texture
+    std::map<std::tuple<int, int, bool>, int> textures_;
+    std::map<int, std::vector<int>> texcoord_sets_;  // glTF material -> TEXCOORD sets by slot
+    std::map<int, int> normal_slots_;  // glTF material with a normal texture -> its slot
     std::vector<uint8_t> on_path_;       // cycle detection during the node walk
     std::vector<std::optional<CameraDesc>> cameras_;  // per glTF camera, from the first node
     std::vector<std::vector<int>> camera_nodes_;      // per glTF camera, the nodes placing it
@@ -728,6 +757,16 @@ const AccessorRule& effective_rule(const AccessorRule& rule, bool quantized) {
     if (&rule == &kTexcoordRule) return kQuantizedTexcoordRule;
     return rule;
 }
+const AccessorRule kColorRule{
+    {TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4},
+    {TINYGLTF_COMPONENT_TYPE_FLOAT},
+    {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
+    {}};
+const AccessorRule kTangentRule{
+    {TINYGLTF_TYPE_VEC4},
+    {TINYGLTF_COMPONENT_TYPE_FLOAT},
+    {TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT},  // KHR_mesh_quantization
+    {}};
 const AccessorRule kIndexRule{
     {TINYGLTF_TYPE_SCALAR},
     {},
@@ -764,22 +803,96 @@ Expected<Color> extension_color(const tinygltf::ExtensionMap& extensions, const 
     return c;
 }
 
-Expected<int> GltfSceneReader::scene_texture(int texture_index, const std::string& context) {
+Expected<int> GltfSceneReader::scene_texture(int texture_index, const std::string& context,
+                                             const std::string& role, bool srgb) {
     if (texture_index < 0 || static_cast<size_t>(texture_index) >= model_.textures.size())
-        return fail(context + "baseColorTexture uses texture " + std::to_string(texture_index) +
+        return fail(context + role + " uses texture " + std::to_string(texture_index) +
                     ", which does not exist");
     const tinygltf::Texture& texture = model_.textures[static_cast<size_t>(texture_index)];
     const int source = texture.source;
     if (source < 0 || static_cast<size_t>(source) >= model_.images.size())
         return fail(context + "texture " + std::to_string(texture_index) + quoted(texture.name) +
                     " has no usable image source (" + std::to_string(source) + ")");
-    if (const auto it = textures_.find(source); it != textures_.end()) return it->second;
-    Expected<Texture> decoded =
-        decode_base_color_image(model_.images[static_cast<size_t>(source)], source);
+    if (texture.sampler >= 0 && static_cast<size_t>(texture.sampler) >= model_.samplers.size())
+        return fail(context + "texture " + std::to_string(texture_index) + quoted(texture.name) +
+                    " uses sampler " + std::to_string(texture.sampler) + ", which does not exist");
+    const auto key = std::make_tuple(source, texture.sampler, srgb);
+    if (const auto it = textures_.find(key); it != textures_.end()) return it->second;
+    Expected<Texture> decoded = decode_image(model_.images[static_cast<size_t>(source)], source, srgb);
     if (!decoded) return fail(context + decoded.error().message);
+    if (texture.sampler >= 0) {
+        // glTF 2.0 section 5.26: wrapS/wrapT 33071 CLAMP_TO_EDGE, 33648 MIRRORED_REPEAT, else
+        // 10497 REPEAT; magFilter 9728 NEAREST.
+        const tinygltf::Sampler& sampler = model_.samplers[static_cast<size_t>(texture.sampler)];
+        const auto wrap = [](int mode) {
+            return mode == 33071 ? TextureWrap::ClampToEdge
+                                 : mode == 33648 ? TextureWrap::MirroredRepeat : TextureWrap::Repeat;
+        };
+        decoded->wrap_s = wrap(sampler.wrapS);
+        decoded->wrap_t = wrap(sampler.wrapT);
+        decoded->nearest = sampler.magFilter == 9728;
+    }
     const int scene_index = static_cast<int>(builder_.add_texture(std::move(decoded).value()));
-    textures_.emplace(source, scene_index);
+    textures_.emplace(key, scene_index);
     return scene_index;
+}
+
+Expected<TextureRef> GltfSceneReader::texture_ref(int index, int tex_coord,
+                                                  const tinygltf::ExtensionMap& extensions,
+                                                  const std::string& context, const std::string& role,
+                                                  bool srgb, std::vector<int>& sets) {
+    TextureRef ref;
+    Expected<int> texture = scene_texture(index, context, role, srgb);
+    if (!texture) return texture.error();
+    ref.texture = *texture;
+    int set = std::max(tex_coord, 0);
+    if (const auto it = extensions.find("KHR_texture_transform"); it != extensions.end()) {
+        // KHR_texture_transform: uv' = T(offset) R(rotation) S(scale) uv, with
+        // R = [cos sin; -sin cos] (rows), and an optional texCoord that overrides the set.
+        const std::string what = context + role + " KHR_texture_transform";
+        const tinygltf::Value& t = it->second;
+        if (!t.IsObject()) return fail(what + " is not an object");
+        const auto vec2 = [&](const char* key, Vec2 fallback) -> Expected<Vec2> {
+            if (!t.Has(key)) return fallback;
+            const tinygltf::Value& v = t.Get(key);
+            if (!v.IsArray() || v.ArrayLen() != 2 || !v.Get(0).IsNumber() || !v.Get(1).IsNumber())
+                return fail(what + "." + key + " is not an array of 2 numbers");
+            return Vec2(float(v.Get(0).GetNumberAsDouble()), float(v.Get(1).GetNumberAsDouble()));
+        };
+        Expected<Vec2> offset = vec2("offset", Vec2(0.0f));
+        if (!offset) return offset.error();
+        Expected<Vec2> scale = vec2("scale", Vec2(1.0f));
+        if (!scale) return scale.error();
+        float rotation = 0.0f;
+        if (t.Has("rotation")) {
+            if (!t.Get("rotation").IsNumber()) return fail(what + ".rotation is not a number");
+            rotation = float(t.Get("rotation").GetNumberAsDouble());
+        }
+        if (t.Has("texCoord")) {
+            if (!t.Get("texCoord").IsNumber()) return fail(what + ".texCoord is not a number");
+            set = static_cast<int>(t.Get("texCoord").GetNumberAsDouble());
+        }
+        const float c = std::cos(rotation), sn = std::sin(rotation);
+        ref.transformed = true;
+        ref.m0 = Vec2(c * scale->x, -sn * scale->x);
+        ref.m1 = Vec2(sn * scale->y, c * scale->y);
+        ref.offset = *offset;
+        if (!std::isfinite(ref.m0.x) || !std::isfinite(ref.m0.y) || !std::isfinite(ref.m1.x) ||
+            !std::isfinite(ref.m1.y) || !std::isfinite(ref.offset.x) || !std::isfinite(ref.offset.y))
+            return fail(what + " has a non-finite value");
+    }
+    if (set < 0 || set > 31) return fail(context + role + " uses TEXCOORD_" + std::to_string(set));
+    auto it = std::find(sets.begin(), sets.end(), set);
+    if (it == sets.end()) {
+        if (sets.size() >= 2)
+            return fail(context + "uses more than two TEXCOORD sets (" + std::to_string(sets[0]) +
+                        ", " + std::to_string(sets[1]) + ", " + std::to_string(set) +
+                        "); at most two per material are supported");
+        sets.push_back(set);
+        it = sets.end() - 1;
+    }
+    ref.slot = static_cast<uint8_t>(it - sets.begin());
+    return ref;
 }
 
 Expected<uint32_t> GltfSceneReader::scene_material(int material_index) {
@@ -837,11 +950,88 @@ Expected<uint32_t> GltfSceneReader::scene_material(int material_index) {
             !std::isfinite(m.transmission) || !std::isfinite(m.specular))
             return fail(context + "has a non-finite factor");
 
-        if (pbr.baseColorTexture.index >= 0) {
-            Expected<int> texture = scene_texture(pbr.baseColorTexture.index, context);
-            if (!texture) return texture.error();
-            m.base_color_texture = *texture;
+        m.base_alpha = std::clamp(float(pbr.baseColorFactor[3]), 0.0f, 1.0f);
+        if (g.alphaMode == "MASK") {
+            m.alpha_mode = AlphaMode::Mask;
+            m.alpha_cutoff = std::isfinite(g.alphaCutoff) ? std::max(float(g.alphaCutoff), 0.0f) : 0.5f;
+        } else if (g.alphaMode == "BLEND") {
+            m.alpha_mode = AlphaMode::Blend;
+        } else if (!g.alphaMode.empty() && g.alphaMode != "OPAQUE") {
+            return fail(context + "has unknown alphaMode '" + g.alphaMode + "'");
         }
+        // glTF 2.0 section 3.9.7: "OPAQUE": alpha is ignored.
+        std::vector<int>& sets = texcoord_sets_[material_index];
+        const auto read_ref = [&](const auto& info, const std::string& role, bool srgb,
+                                  TextureRef& out) -> Status {
+            if (info.index < 0) return Status::ok();
+            Expected<TextureRef> ref = texture_ref(info.index, info.texCoord, info.extensions,
+                                                   context, role, srgb, sets);
+            if (!ref) return ref.error();
+            out = *ref;
+            return Status::ok();
+        };
+        if (Status st = read_ref(pbr.baseColorTexture, "baseColorTexture", true, m.base_color_texture); !st)
+            return st.error();
+        if (Status st = read_ref(pbr.metallicRoughnessTexture, "metallicRoughnessTexture", false,
+                                 m.metallic_roughness_texture);
+            !st)
+            return st.error();
+        if (Status st = read_ref(g.normalTexture, "normalTexture", false, m.normal_texture); !st)
+            return st.error();
+        if (m.normal_texture.present()) normal_slots_[material_index] = m.normal_texture.slot;
+        if (Status st = read_ref(g.emissiveTexture, "emissiveTexture", true, m.emissive_texture); !st)
+            return st.error();
+        // occlusionTexture is ignored by design: ambient occlusion is for rasterisers; a global
+        // illumination renderer computes occlusion itself.
+        m.normal_scale = std::isfinite(g.normalTexture.scale) ? float(g.normalTexture.scale) : 1.0f;
+
+        // KHR_materials_clearcoat (clearcoatNormalTexture is not applied: the coat shares the
+        // base's shading normal) and KHR_materials_volume (attenuation inside the solid;
+        // thicknessFactor is for rasterisers that do not trace the solid).
+        Expected<double> coat = extension_number(ext, "KHR_materials_clearcoat", "clearcoatFactor", 0.0);
+        Expected<double> coat_roughness =
+            extension_number(ext, "KHR_materials_clearcoat", "clearcoatRoughnessFactor", 0.0);
+        Expected<double> attenuation_distance = extension_number(
+            ext, "KHR_materials_volume", "attenuationDistance", std::numeric_limits<double>::infinity());
+        Expected<Color> attenuation_color =
+            extension_color(ext, "KHR_materials_volume", "attenuationColor", Color(1.0f));
+        for (const Error* e : {coat ? nullptr : &coat.error(), coat_roughness ? nullptr : &coat_roughness.error(),
+                               attenuation_distance ? nullptr : &attenuation_distance.error(),
+                               attenuation_color ? nullptr : &attenuation_color.error()}) {
+            if (e) return fail(context + e->message);
+        }
+        m.clearcoat = std::isfinite(*coat) ? std::clamp(float(*coat), 0.0f, 1.0f) : 0.0f;
+        m.clearcoat_roughness = std::isfinite(*coat_roughness) ? std::clamp(float(*coat_roughness), 0.0f, 1.0f) : 0.0f;
+        if (const auto it = ext.find("KHR_materials_clearcoat"); it != ext.end() && it->second.IsObject()) {
+            for (const auto& [key, target] : {std::pair<const char*, TextureRef*>{"clearcoatTexture", &m.clearcoat_texture},
+                                              {"clearcoatRoughnessTexture", &m.clearcoat_roughness_texture}}) {
+                if (!it->second.Has(key)) continue;
+                const tinygltf::Value& info = it->second.Get(key);
+                if (!info.IsObject() || !info.Has("index") || !info.Get("index").IsNumber())
+                    return fail(context + "KHR_materials_clearcoat." + key + " has no texture index");
+                const int tex_coord = info.Has("texCoord") && info.Get("texCoord").IsNumber()
+                                          ? info.Get("texCoord").GetNumberAsInt() : 0;
+                tinygltf::ExtensionMap info_extensions;
+                if (info.Has("extensions") && info.Get("extensions").IsObject()) {
+                    const tinygltf::Value& e = info.Get("extensions");
+                    for (const std::string& name : e.Keys()) info_extensions[name] = e.Get(name);
+                }
+                Expected<TextureRef> ref = texture_ref(info.Get("index").GetNumberAsInt(), tex_coord, info_extensions,
+                                                       context, key, false, sets);
+                if (!ref) return ref.error();
+                *target = *ref;
+            }
+        }
+        // sigma = -ln(attenuationColor) / attenuationDistance (KHR_materials_volume), only in
+        // transmissive solids (an opaque surface has no inside that light crosses).
+        const double distance = *attenuation_distance;
+        if (m.transmission > 0.0f && distance > 0.0 && std::isfinite(distance)) {
+            for (int c = 0; c < 3; ++c) {
+                const float colour = std::clamp((*attenuation_color)[c], 1e-6f, 1.0f);
+                m.attenuation[c] = float(-std::log(double(colour)) / distance);
+            }
+        }
+        if (m.alpha_mode == AlphaMode::Opaque && !m.base_color_texture.present()) m.base_alpha = 1.0f;
     }
     const uint32_t index = builder_.add_material(std::move(m));
     materials_.emplace(material_index, index);
@@ -899,6 +1089,15 @@ Status GltfSceneReader::load_mesh(int mesh_index) {
                 return fail(what + " has " + std::to_string(packed->count) +
                             " elements but POSITION has " + std::to_string(vertex_count));
             using VecT = typename std::remove_pointer_t<decltype(target)>::value_type;
+            if constexpr (std::is_same_v<VecT, Vec4>) {
+                if (packed->components == 3) {  // COLOR_0 as RGB: alpha 1
+                    auto rgb = unpack_vectors<Vec3>(*packed, "");
+                    if (!rgb) return fail(what + rgb.error().message);
+                    target->resize(rgb->size());
+                    for (size_t i = 0; i < rgb->size(); ++i) (*target)[i] = Vec4((*rgb)[i], 1.0f);
+                    return Status::ok();
+                }
+            }
             auto values = unpack_vectors<VecT>(*packed, "");
             if (!values) return fail(what + values.error().message);
             *target = std::move(values).value();
@@ -914,16 +1113,22 @@ Status GltfSceneReader::load_mesh(int mesh_index) {
             return material.error();
         }
         out.material = *material;
-        int texcoord_set = 0;
-        if (prim.material >= 0) {
-            const auto& info = model_.materials[static_cast<size_t>(prim.material)]
-                                   .pbrMetallicRoughness.baseColorTexture;
-            if (info.index >= 0) texcoord_set = std::max(info.texCoord, 0);
+        // The TEXCOORD sets the material reads, in slot order; TEXCOORD_0 where it reads none.
+        std::vector<int> sets{0};
+        if (const auto it = texcoord_sets_.find(prim.material); it != texcoord_sets_.end() && !it->second.empty())
+            sets = it->second;
+        for (size_t slot = 0; slot < sets.size(); ++slot) {
+            const std::string name = "TEXCOORD_" + std::to_string(sets[slot]);
+            if (Status st = read_attribute(name, kTexcoordRule, slot == 0 ? &out.uvs : &out.uvs1); !st)
+                return st;
         }
-        if (Status st =
-                read_attribute("TEXCOORD_" + std::to_string(texcoord_set), kTexcoordRule, &out.uvs);
-            !st)
-            return st;
+        if (Status st = read_attribute("COLOR_0", kColorRule, &out.colors); !st) return st;
+        int normal_slot = -1;
+        if (const auto it = normal_slots_.find(prim.material); it != normal_slots_.end())
+            normal_slot = it->second;
+        if (normal_slot >= 0) {
+            if (Status st = read_attribute("TANGENT", kTangentRule, &out.tangents); !st) return st;
+        }
 
         std::vector<uint32_t> indices;
         if (prim.indices >= 0) {
@@ -968,10 +1173,109 @@ Status GltfSceneReader::load_mesh(int mesh_index) {
                 out.triangles.emplace_back(indices[0], indices[i], indices[i + 1]);
         }
         note_dropped_primitive_features(prim, out.positions, out.triangles);
+        if (normal_slot >= 0 && out.tangents.empty()) generate_tangents(out, normal_slot);
         decoded.push_back(std::move(out));
     }
     meshes_[static_cast<size_t>(mesh_index)] = std::move(decoded);
     return Status::ok();
+}
+
+void GltfSceneReader::generate_tangents(DecodedPrimitive& prim, int slot) {
+    if (prim.normals.empty()) {
+        // Flat shading: unweld first, so that each corner has its face's normal (SceneBuilder
+        // would do the same later, after tangents could no longer be made).
+        DecodedPrimitive flat;
+        flat.material = prim.material;
+        for (const glm::uvec3& t : prim.triangles) {
+            const uint32_t base = static_cast<uint32_t>(flat.positions.size());
+            const Vec3 c = glm::cross(prim.positions[t.y] - prim.positions[t.x],
+                                      prim.positions[t.z] - prim.positions[t.x]);
+            const float len = glm::length(c);
+            const Vec3 n = len > 0.0f && std::isfinite(len) ? c / len : Vec3(0.0f, 0.0f, 1.0f);
+            for (uint32_t v : {t.x, t.y, t.z}) {
+                flat.positions.push_back(prim.positions[v]);
+                flat.normals.push_back(n);
+                if (!prim.uvs.empty()) flat.uvs.push_back(prim.uvs[v]);
+                if (!prim.uvs1.empty()) flat.uvs1.push_back(prim.uvs1[v]);
+                if (!prim.colors.empty()) flat.colors.push_back(prim.colors[v]);
+            }
+            flat.triangles.emplace_back(base, base + 1, base + 2);
+        }
+        prim = std::move(flat);
+    }
+    const std::vector<Vec2>& uvs = slot == 0 ? prim.uvs : prim.uvs1;
+    if (uvs.empty()) return;  // no texture coordinates: the normal map cannot be placed
+    // MikkTSpace's essentials (Mikkelsen 2008, "Simulation of wrinkled surfaces revisited"):
+    // per face T = dp/du and the sign of the bitangent, accumulated per vertex weighted by the
+    // corner angle, and never across faces of opposite sign (a mirrored UV seam): such vertices
+    // are split, one copy per sign. glTF's v runs down the image, so the bitangent that the
+    // normal map's +y means is -dp/dv (as Blender's exporter writes it).
+    const size_t vertex_count = prim.positions.size();
+    std::vector<Vec3> sums(2 * vertex_count, Vec3(0.0f));  // [vertex][sign < 0]
+    std::vector<uint8_t> face_negative(prim.triangles.size(), 0);
+    for (size_t f = 0; f < prim.triangles.size(); ++f) {
+        const glm::uvec3& t = prim.triangles[f];
+        const uint32_t v[3] = {t.x, t.y, t.z};
+        const Vec3 e1 = prim.positions[t.y] - prim.positions[t.x];
+        const Vec3 e2 = prim.positions[t.z] - prim.positions[t.x];
+        const Vec2 d1 = uvs[t.y] - uvs[t.x], d2 = uvs[t.z] - uvs[t.x];
+        const float r = d1.x * d2.y - d2.x * d1.y;
+        const Vec3 face_normal = glm::cross(e1, e2);
+        if (!(std::abs(r) > 0.0f) || !(glm::dot(face_normal, face_normal) > 0.0f)) continue;
+        const Vec3 dpdu = (e1 * d2.y - e2 * d1.y) / r;
+        const Vec3 dpdv = (e2 * d1.x - e1 * d2.x) / r;
+        const bool negative = glm::dot(glm::cross(face_normal, dpdu), -dpdv) < 0.0f;
+        face_negative[f] = negative;
+        for (int k = 0; k < 3; ++k) {
+            const Vec3 a = prim.positions[v[(k + 1) % 3]] - prim.positions[v[k]];
+            const Vec3 b = prim.positions[v[(k + 2) % 3]] - prim.positions[v[k]];
+            const float la = glm::length(a), lb = glm::length(b);
+            if (!(la > 0.0f && lb > 0.0f)) continue;
+            const float angle = std::acos(std::clamp(glm::dot(a, b) / (la * lb), -1.0f, 1.0f));
+            const Vec3 n = prim.normals[v[k]];
+            const Vec3 tangent = dpdu - glm::dot(dpdu, n) * n;
+            const float len = glm::length(tangent);
+            if (len > 0.0f && std::isfinite(len)) sums[2 * v[k] + negative] += angle * tangent / len;
+        }
+    }
+    // Vertex v keeps its index for the sign of its first face; the other sign gets a copy.
+    std::vector<int64_t> copy_of(vertex_count, -1);
+    std::vector<int8_t> first_sign(vertex_count, -1);
+    prim.tangents.assign(vertex_count, Vec4(0.0f));
+    const auto finish = [&](uint32_t v, bool negative) {
+        const Vec3 n = prim.normals[v];
+        Vec3 t = sums[2 * v + negative];
+        t -= glm::dot(t, n) * n;
+        const float len = glm::length(t);
+        if (len > 0.0f && std::isfinite(len)) {
+            t /= len;
+        } else {
+            t = Frame(glm::length(n) > 0.0f ? n : Vec3(0.0f, 0.0f, 1.0f)).s;  // any: no UV gradient
+        }
+        return Vec4(t, negative ? -1.0f : 1.0f);
+    };
+    for (size_t f = 0; f < prim.triangles.size(); ++f) {
+        glm::uvec3& t = prim.triangles[f];
+        const bool negative = face_negative[f];
+        for (int k = 0; k < 3; ++k) {
+            uint32_t& v = t[k];
+            if (first_sign[v] < 0) {
+                first_sign[v] = negative;
+                prim.tangents[v] = finish(v, negative);
+            } else if (first_sign[v] != negative) {
+                if (copy_of[v] < 0) {
+                    copy_of[v] = static_cast<int64_t>(prim.positions.size());
+                    prim.positions.push_back(prim.positions[v]);
+                    prim.normals.push_back(prim.normals[v]);
+                    if (!prim.uvs.empty()) prim.uvs.push_back(prim.uvs[v]);
+                    if (!prim.uvs1.empty()) prim.uvs1.push_back(prim.uvs1[v]);
+                    if (!prim.colors.empty()) prim.colors.push_back(prim.colors[v]);
+                    prim.tangents.push_back(finish(v, negative));
+                }
+                v = static_cast<uint32_t>(copy_of[v]);
+            }
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1012,7 +1316,8 @@ void GltfSceneReader::note_dropped_primitive_features(const tinygltf::Primitive&
                                                       const std::vector<Vec3>& positions,
                                                       const std::vector<glm::uvec3>& triangles) {
     for (const auto& [name, accessor] : prim.attributes) {
-        if (name.rfind("COLOR_", 0) == 0 || name.rfind("JOINTS_", 0) == 0 ||
+        // COLOR_0 multiplies the base colour; further colour sets are read by nothing.
+        if ((name.rfind("COLOR_", 0) == 0 && name != "COLOR_0") || name.rfind("JOINTS_", 0) == 0 ||
             name.rfind("WEIGHTS_", 0) == 0)
             ignored_attributes_.insert(name.substr(0, name.find('_')));
     }
@@ -1036,7 +1341,7 @@ void GltfSceneReader::add_feature_warnings() {
                              " point or line primitive(s) are not rendered (they have no area)");
     for (const std::string& what : ignored_attributes_) {
         if (what == "COLOR")
-            builder_.add_warning("vertex colours (COLOR_n) are ignored");
+            builder_.add_warning("vertex colour sets after COLOR_0 (COLOR_1, ...) are ignored");
         else if (what == "morph targets")
             builder_.add_warning("morph targets are ignored: meshes are rendered in their base shape");
         else
@@ -1050,57 +1355,12 @@ void GltfSceneReader::add_feature_warnings() {
         builder_.add_warning("the file has " + std::to_string(model_.scenes.size()) +
                              " scenes; only the default scene is rendered");
 
-    // Material features the reader does not take (it reads the factors, baseColorTexture and
-    // the extensions of kSupportedRequiredExtensions). occlusionTexture is ignored by design: it
-    // approximates for rasterizers what global illumination computes.
-    struct MaterialFeature {
-        const char* what;
-        bool (*present)(const tinygltf::Material&, const tinygltf::Model&);
-    };
-    static const MaterialFeature kDropped[] = {
-        {"normalTexture is ignored (no normal mapping)",
-         [](const tinygltf::Material& m, const tinygltf::Model&) {
-             return m.normalTexture.index >= 0;
-         }},
-        {"emissiveTexture is ignored (emission is emissiveFactor alone)",
-         [](const tinygltf::Material& m, const tinygltf::Model&) {
-             return m.emissiveTexture.index >= 0;
-         }},
-        {"metallicRoughnessTexture is ignored (metallic and roughness are the factors alone)",
-         [](const tinygltf::Material& m, const tinygltf::Model&) {
-             return m.pbrMetallicRoughness.metallicRoughnessTexture.index >= 0;
-         }},
-        {"alphaMode MASK or BLEND is ignored (surfaces are opaque)",
-         [](const tinygltf::Material& m, const tinygltf::Model&) {
-             return m.alphaMode == "MASK" || m.alphaMode == "BLEND";
-         }},
-        {"the base-colour texture's sampler (wrap mode or filter) is ignored: textures repeat and "
-         "are filtered bilinearly",
-         [](const tinygltf::Material& m, const tinygltf::Model& model) {
-             const int t = m.pbrMetallicRoughness.baseColorTexture.index;
-             if (t < 0 || static_cast<size_t>(t) >= model.textures.size()) return false;
-             const int s = model.textures[static_cast<size_t>(t)].sampler;
-             if (s < 0 || static_cast<size_t>(s) >= model.samplers.size()) return false;
-             const tinygltf::Sampler& sampler = model.samplers[static_cast<size_t>(s)];
-             return sampler.wrapS != TINYGLTF_TEXTURE_WRAP_REPEAT ||
-                    sampler.wrapT != TINYGLTF_TEXTURE_WRAP_REPEAT ||
-                    sampler.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST;
-         }},
-    };
+    // occlusionTexture is ignored by design and gets no warning: it approximates for rasterizers
+    // what global illumination computes.
     const auto material_name = [&](int index) {
         const std::string& name = model_.materials[static_cast<size_t>(index)].name;
         return name.empty() ? "material " + std::to_string(index) : name;
     };
-    for (const MaterialFeature& feature : kDropped) {
-        std::vector<std::string> names;
-        for (const auto& [index, unused] : materials_) {
-            if (index >= 0 && feature.present(model_.materials[static_cast<size_t>(index)], model_))
-                names.push_back(material_name(index));
-        }
-        if (!names.empty())
-            builder_.add_warning(std::string(feature.what) + ": material" +
-                                 (names.size() > 1 ? "s " : " ") + name_list(names));
-    }
     if (!solid_transmission_materials_.empty()) {
         std::vector<std::string> names;
         for (int index : solid_transmission_materials_) names.push_back(material_name(index));
@@ -1338,8 +1598,12 @@ Status GltfSceneReader::visit_node(int node_index, const Mat4& parent, int depth
             if (triangle_count_ > kMaxSceneTriangles || vertex_count_ > kMaxSceneVertices)
                 return fail("the scene has more than " + std::to_string(kMaxSceneTriangles) +
                             " triangles or " + std::to_string(kMaxSceneVertices) + " vertices");
+            SceneBuilder::MeshExtras extras;
+            extras.uvs1 = prim.uvs1;
+            extras.colors = prim.colors;
+            extras.tangents = prim.tangents;
             if (Status st = builder_.add_mesh(prim.positions, prim.normals, prim.uvs,
-                                              prim.triangles, prim.material, world);
+                                              prim.triangles, prim.material, world, extras);
                 !st) {
                 const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(node.mesh)];
                 return fail(context + "mesh " + std::to_string(node.mesh) + quoted(mesh.name) +

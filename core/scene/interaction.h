@@ -11,7 +11,9 @@ struct SurfaceInteraction {
     Vec3 p{0.0f};
     Vec3 geometric_normal{0.0f, 0.0f, 1.0f};  // the triangle's front-face normal (winding)
     Vec3 shading_normal{0.0f, 0.0f, 1.0f};    // interpolated, on the geometric normal's side
-    Vec2 uv{0.0f};  // interpolated texture coordinates; zero when the material has no texture
+    /// Interpolated texture coordinates, vertex colour and footprint; defaults (uv 0, colour 1)
+    /// when the material reads no texture and the scene has no vertex colours.
+    TexturePoint tex;
     uint32_t triangle = 0;
     uint32_t material = 0;
     /// True when the incoming ray arrived from the front side (the side the normal points to).
@@ -26,9 +28,34 @@ inline Vec3 oriented_shading_normal(const Vec3& shading, const Vec3& geometric) 
     return glm::dot(shading, geometric) < 0.0f ? -shading : shading;
 }
 
+/// Beer-Lambert transmittance of the ray segment that ends at si (KHR_materials_volume): a ray
+/// that reaches a volume material's surface from inside (its back face: the solid's normals
+/// point out) crossed t of its medium, exp(-sigma t). Closed, non-nested solids; a segment that
+/// ends on another surface inside the solid is not attenuated.
+inline Color volume_transmittance(const Scene& scene, const SurfaceInteraction& si) {
+    const Material& m = scene.materials[si.material];
+    if (si.front_face || !m.has_volume()) return Color(1.0f);
+    return glm::exp(-m.attenuation * si.distance);
+}
+
+/// The shading normal bent by a material's normal texture (glTF 2.0 section 3.9.3): the texel
+/// (2 rgb - 1) * (scale, scale, 1) in the frame (T, B = w cross(N, T), N), T the interpolated
+/// tangent made orthogonal to N. Unchanged where the triangle has no tangent.
+Vec3 apply_normal_texture(const Scene& scene, const Material& material, const glm::uvec3& tri,
+                          float u, float v, const TexturePoint& tp, const Vec3& normal);
+
+/// The ray cone's footprint (width `footprint_width` in world units at the hit) in texture
+/// coordinates of both slots: width / |cos| scaled by sqrt(uv area / world area) of the triangle
+/// (Akenine-Moeller et al. 2019, "Texture Level of Detail Strategies for Real-Time Ray Tracing",
+/// Ray Tracing Gems ch. 20, eq. 34 and 36).
+void set_texture_footprint(const Scene& scene, const glm::uvec3& tri, const Vec3& ray_direction,
+                           const Vec3& geometric_normal, float footprint_width, TexturePoint& tp);
+
 /// Computes the interaction at `hit` of a ray with direction `ray_direction`. Inline: it runs at
 /// every hit of every integrator and photon, whose callers use only some of its fields.
-inline SurfaceInteraction make_interaction(const Scene& scene, const Hit& hit, const Vec3& ray_direction) {
+/// `footprint_width` is the ray cone's width at the hit (0: textures at their finest level).
+inline SurfaceInteraction make_interaction(const Scene& scene, const Hit& hit, const Vec3& ray_direction,
+                                           float footprint_width = 0.0f) {
     const glm::uvec3& tri = scene.triangles[hit.triangle];
     const float w = 1.0f - hit.u - hit.v;
     SurfaceInteraction si;
@@ -46,12 +73,18 @@ inline SurfaceInteraction make_interaction(const Scene& scene, const Hit& hit, c
         const float len = glm::length(n);
         shading = len > 1e-12f && std::isfinite(len) ? n * (1.0f / len) : Vec3(0.0f);
     }
-    si.shading_normal = oriented_shading_normal(shading, si.geometric_normal);
     si.triangle = hit.triangle;
     si.material = scene.triangle_materials[hit.triangle];
-    // Texture coordinates serve texture lookups only: untextured materials skip their three loads.
-    if (scene.materials[si.material].base_color_texture >= 0)
-        si.uv = w * scene.uvs[tri.x] + hit.u * scene.uvs[tri.y] + hit.v * scene.uvs[tri.z];
+    // Texture coordinates serve textures and vertex colours only: plain materials skip them.
+    const Material& material = scene.materials[si.material];
+    if (material.textured() || !scene.colors.empty()) {
+        si.tex = scene.texture_point(hit.triangle, hit.u, hit.v);
+        if (footprint_width > 0.0f && material.textured())
+            set_texture_footprint(scene, tri, ray_direction, si.geometric_normal, footprint_width, si.tex);
+        if (material.normal_texture.present() && !scene.tangents.empty())
+            shading = apply_normal_texture(scene, material, tri, hit.u, hit.v, si.tex, shading);
+    }
+    si.shading_normal = oriented_shading_normal(shading, si.geometric_normal);
     si.front_face = glm::dot(ray_direction, si.geometric_normal) < 0.0f;
     si.distance = hit.t;
     return si;

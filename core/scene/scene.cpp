@@ -6,24 +6,166 @@
 
 namespace photond {
 
-Color Texture::sample(const Vec2& uv) const {
-    if (width <= 0 || height <= 0 || texels.empty()) return Color(1.0f);
-    // Texel centres at half-integers; repeat wrapping as glTF's default sampler.
+namespace {
+
+int wrap_index(long long i, int n, TextureWrap mode) {
+    switch (mode) {
+        case TextureWrap::ClampToEdge:
+            return static_cast<int>(std::clamp<long long>(i, 0, n - 1));
+        case TextureWrap::MirroredRepeat: {
+            const long long period = 2LL * n;
+            const long long m = ((i % period) + period) % period;
+            return static_cast<int>(m < n ? m : period - 1 - m);
+        }
+        case TextureWrap::Repeat:
+        default:
+            return static_cast<int>(((i % n) + n) % n);
+    }
+}
+
+// Bilinear (or nearest) RGBA lookup in one level; texel centres at half-integers.
+Vec4 sample_level(int width, int height, const std::vector<Color>& texels, const std::vector<float>& alpha,
+                  TextureWrap wrap_s, TextureWrap wrap_t, bool nearest, const Vec2& uv) {
+    const auto at = [&](int xi, int yi) {
+        const size_t i = static_cast<size_t>(yi) * static_cast<size_t>(width) + static_cast<size_t>(xi);
+        return Vec4(texels[i], alpha.empty() ? 1.0f : alpha[i]);
+    };
     const float x = uv.x * static_cast<float>(width) - 0.5f;
     const float y = uv.y * static_cast<float>(height) - 0.5f;
-    if (!std::isfinite(x) || !std::isfinite(y)) return texels[0];
+    // Far beyond float's integer range the texel is undefined anyway: take the first one.
+    if (!(std::abs(x) < 1e15f) || !(std::abs(y) < 1e15f)) return at(0, 0);
+    if (nearest) {
+        const auto xi = static_cast<long long>(std::floor(x + 0.5f));
+        const auto yi = static_cast<long long>(std::floor(y + 0.5f));
+        return at(wrap_index(xi, width, wrap_s), wrap_index(yi, height, wrap_t));
+    }
     const float fx = std::floor(x), fy = std::floor(y);
     const float tx = x - fx, ty = y - fy;
-    auto wrap = [](long long i, int n) { return static_cast<int>(((i % n) + n) % n); };
-    const int x0 = wrap(static_cast<long long>(fx), width), x1 = wrap(static_cast<long long>(fx) + 1, width);
-    const int y0 = wrap(static_cast<long long>(fy), height), y1 = wrap(static_cast<long long>(fy) + 1, height);
-    const auto at = [&](int xi, int yi) { return texels[static_cast<size_t>(yi) * width + xi]; };
+    const auto ix = static_cast<long long>(fx), iy = static_cast<long long>(fy);
+    const int x0 = wrap_index(ix, width, wrap_s), x1 = wrap_index(ix + 1, width, wrap_s);
+    const int y0 = wrap_index(iy, height, wrap_t), y1 = wrap_index(iy + 1, height, wrap_t);
     return (1.0f - ty) * ((1.0f - tx) * at(x0, y0) + tx * at(x1, y0)) +
            ty * ((1.0f - tx) * at(x0, y1) + tx * at(x1, y1));
 }
 
-Color Scene::textured_base_color(const Material& m, Vec2 uv) const {
-    return m.base_color * textures[static_cast<size_t>(m.base_color_texture)].sample(uv);
+}  // namespace
+
+Vec4 Texture::sample_rgba(const Vec2& uv, float lod) const {
+    if (width <= 0 || height <= 0 || texels.empty()) return Vec4(1.0f);
+    if (!(lod > 0.0f) || mip_levels.empty())
+        return sample_level(width, height, texels, alpha, wrap_s, wrap_t, nearest, uv);
+    // Trilinear between the two levels around lod (Williams 1983, "Pyramidal parametrics").
+    const float max_lod = static_cast<float>(mip_levels.size());
+    const float l = std::min(lod, max_lod);
+    const int l0 = std::min(static_cast<int>(l), static_cast<int>(mip_levels.size()));
+    const float t = l - static_cast<float>(l0);
+    const auto level = [&](int k) {
+        if (k == 0) return sample_level(width, height, texels, alpha, wrap_s, wrap_t, false, uv);
+        const TextureLevel& m = mip_levels[static_cast<size_t>(k - 1)];
+        return sample_level(m.width, m.height, m.texels, m.alpha, wrap_s, wrap_t, false, uv);
+    };
+    const Vec4 a = level(l0);
+    if (t <= 0.0f || l0 >= static_cast<int>(mip_levels.size())) return a;
+    return (1.0f - t) * a + t * level(l0 + 1);
+}
+
+void Texture::build_mip_levels() {
+    mip_levels.clear();
+    int w = width, h = height;
+    const std::vector<Color>* src = &texels;
+    const std::vector<float>* src_alpha = &alpha;
+    while (w > 1 || h > 1) {
+        TextureLevel next;
+        next.width = std::max(1, w / 2);
+        next.height = std::max(1, h / 2);
+        next.texels.resize(static_cast<size_t>(next.width) * next.height);
+        if (!src_alpha->empty()) next.alpha.resize(next.texels.size());
+        // A box filter over the source texels each destination texel covers (two or three per
+        // axis where a size is odd).
+        for (int y = 0; y < next.height; ++y) {
+            const int y_begin = y * h / next.height, y_end = std::max(y_begin + 1, (y + 1) * h / next.height);
+            for (int x = 0; x < next.width; ++x) {
+                const int x_begin = x * w / next.width, x_end = std::max(x_begin + 1, (x + 1) * w / next.width);
+                Color sum(0.0f);
+                float sum_alpha = 0.0f;
+                for (int yy = y_begin; yy < y_end; ++yy) {
+                    for (int xx = x_begin; xx < x_end; ++xx) {
+                        const size_t i = static_cast<size_t>(yy) * w + xx;
+                        sum += (*src)[i];
+                        if (!src_alpha->empty()) sum_alpha += (*src_alpha)[i];
+                    }
+                }
+                const float inv = 1.0f / static_cast<float>((y_end - y_begin) * (x_end - x_begin));
+                const size_t o = static_cast<size_t>(y) * next.width + x;
+                next.texels[o] = sum * inv;
+                if (!next.alpha.empty()) next.alpha[o] = sum_alpha * inv;
+            }
+        }
+        w = next.width;
+        h = next.height;
+        mip_levels.push_back(std::move(next));
+        src = &mip_levels.back().texels;
+        src_alpha = &mip_levels.back().alpha;
+    }
+}
+
+Vec4 Scene::sample(const TextureRef& ref, const TexturePoint& tp) const {
+    const Texture& t = textures[static_cast<size_t>(ref.texture)];
+    const float footprint = ref.slot == 0 ? tp.footprint : tp.footprint1;
+    float lod = 0.0f;
+    if (footprint > 0.0f) {
+        // The footprint's width in level-0 texels (isotropic: the geometric mean of the sides).
+        const float texels = footprint * ref.scale() * std::sqrt(static_cast<float>(t.width) * t.height);
+        lod = texels > 1.0f ? std::log2(texels) : 0.0f;
+    }
+    return t.sample_rgba(ref.apply(ref.slot == 0 ? tp.uv : tp.uv1), lod);
+}
+
+MaterialPoint Scene::material_point(uint32_t material, const TexturePoint& tp) const {
+    const Material& m = materials[material];
+    MaterialPoint mp{m.base_color, m.base_alpha, m.metallic, m.roughness, m.clearcoat, m.clearcoat_roughness};
+    // KHR_materials_clearcoat: R of clearcoatTexture, G of clearcoatRoughnessTexture.
+    if (m.clearcoat_texture.present()) mp.clearcoat *= sample(m.clearcoat_texture, tp).x;
+    if (m.clearcoat_roughness_texture.present())
+        mp.clearcoat_roughness *= sample(m.clearcoat_roughness_texture, tp).y;
+    if (m.base_color_texture.present()) {
+        const Vec4 c = sample(m.base_color_texture, tp);
+        mp.base_color *= Color(c);
+        mp.alpha *= c.w;
+    }
+    mp.base_color *= Color(tp.color);
+    mp.alpha *= tp.color.w;
+    if (m.metallic_roughness_texture.present()) {
+        const Vec4 mr = sample(m.metallic_roughness_texture, tp);
+        mp.roughness *= mr.y;
+        mp.metallic *= mr.z;
+    }
+    return mp;
+}
+
+Color Scene::emission_at(uint32_t material, const TexturePoint& tp) const {
+    const Material& m = materials[material];
+    if (!m.emissive_texture.present()) return m.emission;
+    return m.emission * Color(sample(m.emissive_texture, tp));
+}
+
+TexturePoint Scene::texture_point(uint32_t triangle, float u, float v) const {
+    const glm::uvec3& tri = triangles[triangle];
+    const float w = 1.0f - u - v;
+    TexturePoint tp;
+    tp.uv = w * uvs[tri.x] + u * uvs[tri.y] + v * uvs[tri.z];
+    if (!uvs1.empty()) tp.uv1 = w * uvs1[tri.x] + u * uvs1[tri.y] + v * uvs1[tri.z];
+    if (!colors.empty()) tp.color = w * colors[tri.x] + u * colors[tri.y] + v * colors[tri.z];
+    return tp;
+}
+
+float Scene::alpha_at(uint32_t triangle, float u, float v) const {
+    const Material& m = materials[triangle_materials[triangle]];
+    float alpha = m.base_alpha;
+    if (!m.base_color_texture.present() && colors.empty()) return alpha;
+    const TexturePoint tp = texture_point(triangle, u, v);
+    if (m.base_color_texture.present()) alpha *= sample(m.base_color_texture, tp).w;
+    return alpha * tp.color.w;
 }
 
 float Scene::triangle_area(uint32_t triangle) const {
@@ -45,7 +187,10 @@ void Scene::derive_triangle_data() {
 }
 
 Status Scene::validate() const {
-    if (normals.size() != positions.size() || uvs.size() != positions.size())
+    const auto optional_size_ok = [&](size_t n) { return n == 0 || n == positions.size(); };
+    if (normals.size() != positions.size() || uvs.size() != positions.size() ||
+        !optional_size_ok(uvs1.size()) || !optional_size_ok(colors.size()) ||
+        !optional_size_ok(tangents.size()))
         return Error{"scene '" + name + "': per-vertex arrays differ in size"};
     if (triangle_materials.size() != triangles.size() || triangle_normals.size() != triangles.size() ||
         flat_shaded.size() != triangles.size())
@@ -65,9 +210,12 @@ Status Scene::validate() const {
                          " uses a material out of range"};
     }
     for (const Material& m : materials) {
-        if (m.base_color_texture >= static_cast<int>(textures.size()))
-            return Error{"scene '" + name + "': material '" + m.name +
-                         "' uses a texture out of range"};
+        for (const TextureRef* ref : {&m.base_color_texture, &m.metallic_roughness_texture,
+                                      &m.normal_texture, &m.emissive_texture}) {
+            if (ref->texture >= static_cast<int>(textures.size()) || ref->slot > 1)
+                return Error{"scene '" + name + "': material '" + m.name +
+                             "' uses a texture out of range"};
+        }
         if (!is_finite(m.base_color) || !is_finite(m.emission) || !std::isfinite(m.ior) ||
             !std::isfinite(m.roughness) || !std::isfinite(m.metallic))
             return Error{"scene '" + name + "': material '" + m.name + "' has a non-finite factor"};
@@ -122,7 +270,7 @@ void SceneBuilder::add_warning(std::string warning) {
 
 Status SceneBuilder::add_mesh(std::span<const Vec3> positions, std::span<const Vec3> normals,
                               std::span<const Vec2> uvs, std::span<const glm::uvec3> triangles,
-                              uint32_t material, const Mat4& transform) {
+                              uint32_t material, const Mat4& transform, const MeshExtras& extras) {
     if (!normals.empty() && normals.size() != positions.size())
         return Error{"mesh normals count differs from positions count"};
     if (!uvs.empty() && uvs.size() != positions.size())
@@ -134,6 +282,16 @@ Status SceneBuilder::add_mesh(std::span<const Vec3> positions, std::span<const V
             return Error{"vertex " + std::to_string(i) + " has a non-finite normal"};
         if (!uvs.empty() && !(std::isfinite(uvs[i].x) && std::isfinite(uvs[i].y)))
             return Error{"vertex " + std::to_string(i) + " has a non-finite texture coordinate"};
+    }
+    if ((!extras.uvs1.empty() && extras.uvs1.size() != positions.size()) ||
+        (!extras.colors.empty() && extras.colors.size() != positions.size()) ||
+        (!extras.tangents.empty() && extras.tangents.size() != positions.size()))
+        return Error{"mesh texture-coordinate, colour or tangent count differs from positions count"};
+    for (size_t i = 0; i < positions.size(); ++i) {
+        if ((!extras.uvs1.empty() && !(std::isfinite(extras.uvs1[i].x) && std::isfinite(extras.uvs1[i].y))) ||
+            (!extras.colors.empty() && !(is_finite(Vec3(extras.colors[i])) && std::isfinite(extras.colors[i].w))) ||
+            (!extras.tangents.empty() && !(is_finite(Vec3(extras.tangents[i])) && std::isfinite(extras.tangents[i].w))))
+            return Error{"vertex " + std::to_string(i) + " has a non-finite texture coordinate, colour or tangent"};
     }
     for (size_t i = 0; i < triangles.size(); ++i) {
         const glm::uvec3& t = triangles[i];
@@ -147,6 +305,30 @@ Status SceneBuilder::add_mesh(std::span<const Vec3> positions, std::span<const V
     const auto world = [&](const Vec3& p) { return Vec3(transform * Vec4(p, 1.0f)); };
 
     auto& s = scene_;
+    // The optional arrays exist scene-wide once any mesh has them: earlier vertices get defaults.
+    const size_t existing = s.positions.size();
+    const bool has_uvs1 = !extras.uvs1.empty() || !s.uvs1.empty();
+    const bool has_colors = !extras.colors.empty() || !s.colors.empty();
+    const bool has_tangents = !extras.tangents.empty() || !s.tangents.empty();
+    if (has_uvs1) s.uvs1.resize(existing, Vec2(0.0f));
+    if (has_colors) s.colors.resize(existing, Vec4(1.0f));
+    if (has_tangents) s.tangents.resize(existing, Vec4(0.0f));
+    // Appends the optional attributes of source vertex i (defaults where this mesh has none).
+    const auto push_extras = [&](size_t i) {
+        if (has_uvs1) s.uvs1.push_back(extras.uvs1.empty() ? Vec2(0.0f) : extras.uvs1[i]);
+        if (has_colors) s.colors.push_back(extras.colors.empty() ? Vec4(1.0f) : glm::max(extras.colors[i], Vec4(0.0f)));
+        if (has_tangents) {
+            Vec4 t(0.0f);  // zero: no tangent (the normal map is not applied)
+            if (!extras.tangents.empty()) {
+                const Vec3 d = linear * Vec3(extras.tangents[i]);
+                const float len = glm::length(d);
+                // A mirroring transform flips the bitangent cross(N, T) relative to T and N.
+                const float w = (extras.tangents[i].w < 0.0f ? -1.0f : 1.0f) * (mirrored ? -1.0f : 1.0f);
+                if (len > 0.0f && std::isfinite(len)) t = Vec4(d / len, w);
+            }
+            s.tangents.push_back(t);
+        }
+    };
     if (normals.empty()) {
         // glTF 2.0: meshes without normals are shaded flat; unweld so each triangle has its own.
         for (const glm::uvec3& t : triangles) {
@@ -161,6 +343,7 @@ Status SceneBuilder::add_mesh(std::span<const Vec3> positions, std::span<const V
                 s.positions.push_back(p[k]);
                 s.normals.push_back(n);
                 s.uvs.push_back(uvs.empty() ? Vec2(0.0f) : uvs[idx[k]]);
+                push_extras(idx[k]);
                 s.bounds.extend(p[k]);
             }
             s.triangles.emplace_back(base, base + 1, base + 2);
@@ -177,6 +360,7 @@ Status SceneBuilder::add_mesh(std::span<const Vec3> positions, std::span<const V
         s.positions.push_back(p);
         s.normals.push_back(n);
         s.uvs.push_back(uvs.empty() ? Vec2(0.0f) : uvs[i]);
+        push_extras(i);
         s.bounds.extend(p);
     }
     for (const glm::uvec3& t : triangles) {
@@ -189,6 +373,9 @@ Status SceneBuilder::add_mesh(std::span<const Vec3> positions, std::span<const V
 Expected<Scene> SceneBuilder::build() {
     for (const PunctualLight& l : scene_.lights) {
         if (l.type != PunctualLightType::Directional) scene_.bounds.extend(l.position);
+    }
+    for (Texture& t : scene_.textures) {
+        if (t.mip_levels.empty()) t.build_mip_levels();
     }
     scene_.triangle_normals.clear();
     scene_.flat_shaded.clear();

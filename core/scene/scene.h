@@ -15,31 +15,126 @@
 
 namespace photond {
 
-/// An RGB texture in linear space, sampled bilinearly with repeat wrapping.
-struct Texture {
+/// glTF sampler wrap modes (glTF 2.0 section 3.8.4.4, "Samplers").
+enum class TextureWrap : uint8_t { Repeat, ClampToEdge, MirroredRepeat };
+
+/// One level of a texture's mip-map pyramid: linear RGB and, where the image has any, alpha.
+struct TextureLevel {
     int width = 0;
     int height = 0;
     std::vector<Color> texels;  // row-major, row 0 at v = 0 (glTF: top of the image)
-
-    Color sample(const Vec2& uv) const;
+    std::vector<float> alpha;   // same layout; empty when the image is opaque
 };
+
+/// A texture in linear space (sRGB images decoded when loaded), with the wrap modes and the
+/// magnification filter of its glTF sampler. Minification always filters trilinearly over
+/// box-filtered mip levels chosen from the ray footprint (glTF's filters are hints; point
+/// sampling a distant texture aliases).
+struct Texture {
+    int width = 0;
+    int height = 0;
+    std::vector<Color> texels;  // level 0, row-major, row 0 at v = 0 (glTF: top of the image)
+    std::vector<float> alpha;   // level 0 alpha; empty when every texel is opaque
+    TextureWrap wrap_s = TextureWrap::Repeat;
+    TextureWrap wrap_t = TextureWrap::Repeat;
+    bool nearest = false;  // magFilter NEAREST: no bilinear interpolation at level 0
+    /// Levels 1.. of the mip-map pyramid, derived from level 0 by build_mip_levels() (the scene
+    /// builder calls it); not hashed.
+    std::vector<TextureLevel> mip_levels;
+
+    /// RGB and alpha at uv, bilinear (or nearest) at level 0: sample(uv, 0).
+    Color sample(const Vec2& uv) const { return Color(sample_rgba(uv, 0.0f)); }
+    /// RGBA at uv, filtered trilinearly at the mip level `lod` (0 = the image itself; the level
+    /// is log2 of the footprint's width in texels of level 0).
+    Vec4 sample_rgba(const Vec2& uv, float lod) const;
+    void build_mip_levels();
+    int level_count() const { return 1 + static_cast<int>(mip_levels.size()); }
+};
+
+/// glTF textureInfo: which texture, which TEXCOORD slot, and KHR_texture_transform as the affine
+/// map uv' = M uv + offset (M = rotation * scale, KHR_texture_transform's matrix order).
+struct TextureRef {
+    int texture = -1;  // index into Scene::textures; -1: none
+    uint8_t slot = 0;  // 0: Scene::uvs, 1: Scene::uvs1 (the loader maps glTF sets onto these)
+    bool transformed = false;
+    Vec2 m0{1.0f, 0.0f};  // first column of M
+    Vec2 m1{0.0f, 1.0f};  // second column of M
+    Vec2 offset{0.0f};
+
+    bool present() const { return texture >= 0; }
+    Vec2 apply(Vec2 uv) const { return transformed ? m0 * uv.x + m1 * uv.y + offset : uv; }
+    /// How much the transform scales lengths (sqrt |det M|), for the mip level.
+    float scale() const { return transformed ? std::sqrt(std::abs(m0.x * m1.y - m0.y * m1.x)) : 1.0f; }
+};
+
+enum class AlphaMode : uint8_t { Opaque, Mask, Blend };
 
 /// The glTF 2.0 metallic-roughness material with the extensions we read
 /// (KHR_materials_transmission, _ior, _specular, _emissive_strength).
 struct Material {
     std::string name;
     Color base_color{0.8f};
-    int base_color_texture = -1;  // index into Scene::textures, multiplied with base_color
+    float base_alpha = 1.0f;     // baseColorFactor's alpha
+    TextureRef base_color_texture;  // RGB multiplies base_color, A multiplies base_alpha
     float metallic = 0.0f;
     float roughness = 1.0f;      // perceptual roughness; GGX alpha = roughness^2
+    /// G = roughness, B = metallic, multiplying the factors (glTF 2.0 section 3.9.2).
+    TextureRef metallic_roughness_texture;
+    TextureRef normal_texture;   // tangent-space normals, (2 rgb - 1) * (scale, scale, 1)
+    float normal_scale = 1.0f;
     float ior = 1.5f;
     float transmission = 0.0f;   // KHR_materials_transmission factor: solid dielectric
     float specular = 1.0f;       // KHR_materials_specular factor
     Color specular_color{1.0f};  // KHR_materials_specular colour factor
     Color emission{0.0f};        // emitted radiance: emissiveFactor * emissive_strength
+    TextureRef emissive_texture;  // multiplies emission
+    /// KHR_materials_clearcoat: a GGX dielectric layer (F0 0.04) over the whole material.
+    float clearcoat = 0.0f;
+    TextureRef clearcoat_texture;  // R multiplies clearcoat
+    float clearcoat_roughness = 0.0f;
+    TextureRef clearcoat_roughness_texture;  // G multiplies clearcoat_roughness
+    /// KHR_materials_volume inside a transmissive solid: Beer-Lambert attenuation coefficient
+    /// -ln(attenuationColor) / attenuationDistance per channel, per world unit (0: clear).
+    Color attenuation{0.0f};
+    AlphaMode alpha_mode = AlphaMode::Opaque;
+    float alpha_cutoff = 0.5f;   // MASK: covered where alpha >= cutoff
     bool double_sided = false;   // emits from both faces when true (else the front face only)
 
     bool is_emissive() const { return max_component(emission) > 0.0f; }
+    /// Metallic, roughness or the clearcoat vary over the surface: BSDF constants per hit.
+    bool varying_bsdf() const {
+        return metallic_roughness_texture.present() || clearcoat_texture.present() ||
+               clearcoat_roughness_texture.present();
+    }
+    bool has_volume() const { return max_component(attenuation) > 0.0f; }
+    /// Rays may pass its surface (MASK or BLEND): its triangles get Embree's alpha filter.
+    bool alpha_tested() const { return alpha_mode != AlphaMode::Opaque; }
+    /// Whether shading reads texture coordinates or vertex colours at all.
+    bool textured() const {
+        return base_color_texture.present() || metallic_roughness_texture.present() ||
+               normal_texture.present() || emissive_texture.present() ||
+               clearcoat_texture.present() || clearcoat_roughness_texture.present();
+    }
+};
+
+/// A material's inputs at one surface point, textures and vertex colour applied.
+struct MaterialPoint {
+    Color base_color{0.8f};
+    float alpha = 1.0f;
+    float metallic = 0.0f;
+    float roughness = 1.0f;
+    float clearcoat = 0.0f;
+    float clearcoat_roughness = 0.0f;
+};
+
+/// Where a surface point lies in texture space: both TEXCOORD slots, the vertex colour, and the
+/// ray footprint's width in texture coordinates (0: the finest level) for mip-mapping.
+struct TexturePoint {
+    Vec2 uv{0.0f};
+    Vec2 uv1{0.0f};
+    Vec4 color{1.0f};  // COLOR_0
+    float footprint = 0.0f;
+    float footprint1 = 0.0f;
 };
 
 enum class PunctualLightType : uint8_t { Point, Spot, Directional };
@@ -121,7 +216,14 @@ struct Scene {
     std::string name;
     std::vector<Vec3> positions;
     std::vector<Vec3> normals;  // per vertex, unit, same size as positions
-    std::vector<Vec2> uvs;      // per vertex, same size as positions
+    std::vector<Vec2> uvs;      // per vertex, same size as positions (TEXCOORD slot 0)
+    /// Per vertex, TEXCOORD slot 1; empty when no mesh uses a second set (else positions' size).
+    std::vector<Vec2> uvs1;
+    /// Per vertex COLOR_0 (RGBA, linear); empty when no mesh has vertex colours.
+    std::vector<Vec4> colors;
+    /// Per vertex tangent (xyz unit, w = bitangent sign: B = w cross(N, T)); empty when no
+    /// material has a normal texture. From TANGENT, else generated by the loader.
+    std::vector<Vec4> tangents;
     std::vector<glm::uvec3> triangles;
     std::vector<uint32_t> triangle_materials;  // per triangle, index into materials
     /// Per triangle, unit, zero for degenerate triangles; derived from the positions by
@@ -150,8 +252,23 @@ struct Scene {
     /// Base colour of a material at a texture coordinate (texture times factor).
     Color base_color(uint32_t material, const Vec2& uv) const {
         const Material& m = materials[material];
-        return m.base_color_texture < 0 ? m.base_color : textured_base_color(m, uv);
+        if (!m.base_color_texture.present()) return m.base_color;
+        TexturePoint tp;
+        tp.uv = tp.uv1 = uv;
+        return material_point(material, tp).base_color;
     }
+    /// Every texture of a material read at one point: base colour and alpha (times COLOR_0),
+    /// metallic and roughness.
+    MaterialPoint material_point(uint32_t material, const TexturePoint& tp) const;
+    /// Emitted radiance of an emissive material at a point (emission times emissive texture).
+    Color emission_at(uint32_t material, const TexturePoint& tp) const;
+    /// The texture point of triangle `triangle` at barycentrics (u, v) of its second and third
+    /// vertices (no footprint).
+    TexturePoint texture_point(uint32_t triangle, float u, float v) const;
+    /// Base-colour alpha (factor, texture, COLOR_0) of an alpha-tested triangle at (u, v).
+    float alpha_at(uint32_t triangle, float u, float v) const;
+    /// One texture reference read at a point, with the footprint of its slot.
+    Vec4 sample(const TextureRef& ref, const TexturePoint& tp) const;
     float triangle_area(uint32_t triangle) const;
     Vec3 triangle_normal(uint32_t triangle) const {  // geometric, unit (zero for degenerate)
         return triangle_normals[triangle];
@@ -159,10 +276,6 @@ struct Scene {
     /// Recomputes triangle_normals and flat_shaded from the positions and normals (after
     /// editing them).
     void derive_triangle_data();
-
-private:
-    /// uv by value: a reference would keep a caller's whole interaction in memory.
-    Color textured_base_color(const Material& m, Vec2 uv) const;
 };
 
 /// Assembles a Scene: transforms meshes into world space, generates flat normals where a mesh
@@ -172,6 +285,13 @@ public:
     explicit SceneBuilder(std::string name);
 
     uint32_t add_material(Material material);
+    /// Optional per-vertex attributes of add_mesh beyond normals and the first uv set: each
+    /// empty or one entry per position.
+    struct MeshExtras {
+        std::span<const Vec2> uvs1;
+        std::span<const Vec4> colors;
+        std::span<const Vec4> tangents;  // object space; w = bitangent sign
+    };
     uint32_t add_texture(Texture texture);
     void add_light(PunctualLight light);
     void add_camera(CameraDesc camera);
@@ -183,7 +303,8 @@ public:
     /// determinant reverses the winding so that front faces stay front faces.
     Status add_mesh(std::span<const Vec3> positions, std::span<const Vec3> normals,
                     std::span<const Vec2> uvs, std::span<const glm::uvec3> triangles,
-                    uint32_t material, const Mat4& transform = Mat4(1.0f));
+                    uint32_t material, const Mat4& transform = Mat4(1.0f),
+                    const MeshExtras& extras = {});
 
     /// Validates and returns the scene; the builder is left empty.
     Expected<Scene> build();

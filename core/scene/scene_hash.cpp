@@ -9,17 +9,18 @@ namespace {
 
 // These fire when a field is added to a struct the hashes read: hash the new field (if it affects
 // light transport) in scene_content_hash or photon_map_key, then update the size here.
-static_assert(sizeof(Material) == sizeof(std::string) + 64,
+static_assert(sizeof(Material) == sizeof(std::string) + 288,
               "Material changed: hash the new field in scene_content_hash");
 static_assert(sizeof(PunctualLight) == sizeof(std::string) + 56,
               "PunctualLight changed: hash the new field in scene_content_hash");
-static_assert(sizeof(Texture) == 8 + sizeof(std::vector<Color>),
+// Texture::mip_levels are derived from the texels and need no hashing of their own.
+static_assert(sizeof(Texture) == 16 + 3 * sizeof(std::vector<Color>),
               "Texture changed: hash the new field in scene_content_hash");
 // Scene::triangle_normals and flat_shaded are derived from the positions and normals and need no
 // hashing of their own; cameras and warnings do not affect light transport.
 static_assert(sizeof(Environment) == sizeof(std::string) + sizeof(std::vector<Color>) + 32,
               "Environment changed: hash the new field in scene_content_hash");
-static_assert(sizeof(Scene) == sizeof(std::string) + 12 * sizeof(std::vector<int>) +
+static_assert(sizeof(Scene) == sizeof(std::string) + 15 * sizeof(std::vector<int>) +
                                    sizeof(std::optional<Environment>) + sizeof(Bounds3),
               "Scene changed: hash the new field in scene_content_hash");
 static_assert(sizeof(void*) != 8 || sizeof(PhotonTracingSettings) == 48,
@@ -59,6 +60,13 @@ Sha256Digest scene_content_hash(const Scene& scene) {
     hash_array(hasher, scene.positions, [&](const Vec3& p) { hash_vec3(hasher, p); });
     hash_array(hasher, scene.normals, [&](const Vec3& n) { hash_vec3(hasher, n); });
     hash_array(hasher, scene.uvs, [&](const Vec2& uv) { hash_vec2(hasher, uv); });
+    const auto hash_vec4 = [&](const Vec4& v) {
+        hash_vec3(hasher, Vec3(v));
+        hash_float(hasher, v.w);
+    };
+    hash_array(hasher, scene.uvs1, [&](const Vec2& uv) { hash_vec2(hasher, uv); });
+    hash_array(hasher, scene.colors, hash_vec4);
+    hash_array(hasher, scene.tangents, hash_vec4);
     hash_array(hasher, scene.triangles, [&](const glm::uvec3& t) {
         hasher.update_value(uint32_t(t.x));
         hasher.update_value(uint32_t(t.y));
@@ -66,8 +74,28 @@ Sha256Digest scene_content_hash(const Scene& scene) {
     });
     hash_array(hasher, scene.triangle_materials, [&](uint32_t m) { hasher.update_value(m); });
     hash_array(hasher, scene.materials, [&](const Material& m) {
+        const auto hash_ref = [&](const TextureRef& r) {
+            hasher.update_value(int32_t(r.texture));
+            hasher.update_value(uint8_t(r.slot));
+            hasher.update_value(uint8_t(r.transformed ? 1 : 0));
+            hash_vec2(hasher, r.m0);
+            hash_vec2(hasher, r.m1);
+            hash_vec2(hasher, r.offset);
+        };
         hash_vec3(hasher, m.base_color);
-        hasher.update_value(int32_t(m.base_color_texture));
+        hash_float(hasher, m.base_alpha);
+        hash_ref(m.base_color_texture);
+        hash_ref(m.metallic_roughness_texture);
+        hash_ref(m.normal_texture);
+        hash_float(hasher, m.normal_scale);
+        hash_ref(m.emissive_texture);
+        hash_float(hasher, m.clearcoat);
+        hash_ref(m.clearcoat_texture);
+        hash_float(hasher, m.clearcoat_roughness);
+        hash_ref(m.clearcoat_roughness_texture);
+        hash_vec3(hasher, m.attenuation);
+        hasher.update_value(uint8_t(m.alpha_mode));
+        hash_float(hasher, m.alpha_cutoff);
         hash_float(hasher, m.metallic);
         hash_float(hasher, m.roughness);
         hash_float(hasher, m.ior);
@@ -81,6 +109,10 @@ Sha256Digest scene_content_hash(const Scene& scene) {
         hasher.update_value(int32_t(t.width));
         hasher.update_value(int32_t(t.height));
         hash_array(hasher, t.texels, [&](const Color& c) { hash_vec3(hasher, c); });
+        hash_array(hasher, t.alpha, [&](float a) { hash_float(hasher, a); });
+        hasher.update_value(uint8_t(t.wrap_s));
+        hasher.update_value(uint8_t(t.wrap_t));
+        hasher.update_value(uint8_t(t.nearest ? 1 : 0));
     });
     hash_array(hasher, scene.lights, [&](const PunctualLight& l) {
         hasher.update_value(uint8_t(l.type));

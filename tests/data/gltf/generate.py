@@ -98,6 +98,17 @@ def png(width, height, rows, bit_depth=8):
             chunk(b"IEND", b""))
 
 
+def png_rgba(width, height, rows):
+    """rows: list of rows of (r, g, b, a) tuples, 8 bits; RGBA colour type."""
+    def chunk(kind, payload):
+        return (struct.pack(">I", len(payload)) + kind + payload +
+                struct.pack(">I", zlib.crc32(kind + payload) & 0xffffffff))
+    raw = b"".join(b"\0" + bytes(c for px in row for c in px) for row in rows)
+    ihdr = struct.pack(">IIBBBBB", width, height, 8, 6, 0, 0, 0)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(raw)) +
+            chunk(b"IEND", b""))
+
+
 def png_data_uri(data):
     return "data:image/png;base64," + base64.b64encode(data).decode()
 
@@ -326,6 +337,116 @@ def textures():
         f.write(glb)
     with open(os.path.join(HERE, "broken", "truncated.glb"), "wb") as f:
         f.write(glb[:len(glb) // 2])
+
+
+def material_textures():
+    """The rest of the glTF material on the unit quad (tests/scene/material_textures_test.cpp)."""
+    # metallicRoughnessTexture: G roughness, B metallic, stored linearly (not sRGB); R, A unused.
+    b = Builder()
+    pos = b.floats(QUAD_POSITIONS, "VEC3")
+    nrm = b.floats([0, 0, 1] * 4, "VEC3")
+    uv = b.floats(QUAD_UVS, "VEC2")
+    idx = b.indices(QUAD_INDICES, U16)
+    rows = [[(0, 51, 255, 255), (0, 255, 0, 255)], [(0, 128, 64, 255), (0, 0, 255, 255)]]
+    b.doc["images"] = [{"uri": png_data_uri(png_rgba(2, 2, rows))}]
+    b.doc["samplers"] = [{"magFilter": 9728}]  # NEAREST
+    b.doc["textures"] = [{"source": 0, "sampler": 0}]
+    b.doc["materials"] = [{"name": "MR", "pbrMetallicRoughness": {
+        "metallicFactor": 1.0, "roughnessFactor": 0.5,
+        "metallicRoughnessTexture": {"index": 0}}}]
+    single_mesh_scene(b, [{"attributes": {"POSITION": pos, "NORMAL": nrm, "TEXCOORD_0": uv},
+                           "indices": idx, "material": 0}], "MetalRoughQuad")
+    write("metallic_roughness.gltf", b.finish())
+
+    # KHR_texture_transform (required) on a 2x2 colour texture; the second material reads
+    # TEXCOORD_1 through the extension's texCoord override, with CLAMP_TO_EDGE / MIRRORED_REPEAT.
+    b = Builder()
+    pos = b.floats(QUAD_POSITIONS, "VEC3")
+    uv0 = b.floats(QUAD_UVS, "VEC2")
+    uv1 = b.floats([0.5 * c for c in QUAD_UVS], "VEC2")
+    idx = b.indices(QUAD_INDICES, U16)
+    b.doc["images"] = [{"uri": png_data_uri(png(2, 2, [[(255, 0, 0), (0, 255, 0)],
+                                                      [(0, 0, 255), (255, 255, 255)]]))}]
+    b.doc["samplers"] = [{"magFilter": 9728, "wrapS": 33071, "wrapT": 33648}]
+    b.doc["textures"] = [{"source": 0, "sampler": 0}]
+    b.doc["extensionsUsed"] = ["KHR_texture_transform"]
+    b.doc["extensionsRequired"] = ["KHR_texture_transform"]
+    b.doc["materials"] = [
+        {"name": "Offset", "pbrMetallicRoughness": {"baseColorTexture": {
+            "index": 0, "extensions": {"KHR_texture_transform": {"offset": [0.5, 0.0]}}}}},
+        {"name": "RotateScaleSet1", "pbrMetallicRoughness": {"baseColorTexture": {
+            "index": 0, "extensions": {"KHR_texture_transform": {
+                "rotation": math.pi / 2, "scale": [2.0, 1.0], "texCoord": 1}}},
+            "metallicRoughnessTexture": {"index": 0, "texCoord": 0}}}]
+    attrs = {"POSITION": pos, "TEXCOORD_0": uv0, "TEXCOORD_1": uv1}
+    single_mesh_scene(b, [{"attributes": attrs, "indices": idx, "material": 0},
+                          {"attributes": attrs, "indices": idx, "material": 1}], "Transformed")
+    write("texture_transform.gltf", b.finish())
+
+    # Alpha: MASK with cutoff 0.3 (factor alpha x texture alpha x COLOR_0 alpha), BLEND, and
+    # a normal texture on a quad whose right half mirrors its UVs (no TANGENT: generated).
+    b = Builder()
+    pos = b.floats(QUAD_POSITIONS, "VEC3")
+    nrm = b.floats([0, 0, 1] * 4, "VEC3")
+    uv = b.floats(QUAD_UVS, "VEC2")
+    col = b.view(struct.pack("<16B", *([255, 255, 255, 255] * 2 + [255, 255, 255, 128] * 2)))
+    colors = b.accessor(col, U8, 4, "VEC4", normalized=True)
+    idx = b.indices(QUAD_INDICES, U16)
+    b.doc["images"] = [{"uri": png_data_uri(png_rgba(2, 1, [[(255, 255, 255, 255),
+                                                             (255, 255, 255, 102)]]))},
+                       {"uri": png_data_uri(png(1, 1, [[(128, 200, 200)]]))}]
+    b.doc["textures"] = [{"source": 0}, {"source": 1}]
+    b.doc["materials"] = [
+        {"name": "Mask", "alphaMode": "MASK", "alphaCutoff": 0.3, "pbrMetallicRoughness": {
+            "baseColorFactor": [1, 1, 1, 0.9], "baseColorTexture": {"index": 0}}},
+        {"name": "Blend", "alphaMode": "BLEND", "pbrMetallicRoughness": {
+            "baseColorFactor": [1, 1, 1, 0.25]}},
+        {"name": "Normal", "normalTexture": {"index": 1, "scale": 0.5}}]
+    # Two quads side by side for the normal map: x in [0, 1] with u = x, x in [1, 2] with u = 2 - x.
+    npos = b.floats([0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 1, 0, 0, 2, 0, 0, 2, 1, 0, 1, 1, 0], "VEC3")
+    nnrm = b.floats([0, 0, 1] * 8, "VEC3")
+    nuv = b.floats([0, 1, 1, 1, 1, 0, 0, 0, 1, 1, 0, 1, 0, 0, 1, 0], "VEC2")
+    nidx = b.indices([0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7], U16)
+    b.doc["meshes"] = [
+        {"name": "Alpha", "primitives": [
+            {"attributes": {"POSITION": pos, "NORMAL": nrm, "TEXCOORD_0": uv, "COLOR_0": colors},
+             "indices": idx, "material": 0},
+            {"attributes": {"POSITION": pos, "NORMAL": nrm}, "indices": idx, "material": 1}]},
+        {"name": "Mirrored", "primitives": [
+            {"attributes": {"POSITION": npos, "NORMAL": nnrm, "TEXCOORD_0": nuv},
+             "indices": nidx, "material": 2}]}]
+    b.doc["nodes"] = [{"name": "AlphaNode", "mesh": 0},
+                      {"name": "MirroredNode", "mesh": 1, "translation": [0, 0, 5]}]
+    b.doc["scenes"] = [{"nodes": [0, 1]}]
+    b.doc["scene"] = 0
+    write("alpha_normal.gltf", b.finish())
+
+    # KHR_materials_clearcoat (factor, roughness, a transformed clearcoatTexture) and
+    # KHR_materials_volume (attenuation inside a transmissive solid), both required.
+    b = Builder()
+    pos = b.floats(QUAD_POSITIONS, "VEC3")
+    uv = b.floats(QUAD_UVS, "VEC2")
+    idx = b.indices(QUAD_INDICES, U16)
+    b.doc["images"] = [{"uri": png_data_uri(png(1, 1, [[(128, 64, 255)]]))}]
+    b.doc["textures"] = [{"source": 0}]
+    b.doc["extensionsUsed"] = ["KHR_materials_clearcoat", "KHR_materials_volume",
+                               "KHR_materials_transmission", "KHR_texture_transform"]
+    b.doc["extensionsRequired"] = ["KHR_materials_clearcoat", "KHR_materials_volume"]
+    b.doc["materials"] = [
+        {"name": "Coated", "extensions": {"KHR_materials_clearcoat": {
+            "clearcoatFactor": 0.7, "clearcoatRoughnessFactor": 0.2,
+            "clearcoatTexture": {"index": 0, "extensions": {
+                "KHR_texture_transform": {"scale": [2, 2]}}}}}},
+        {"name": "Tinted glass", "extensions": {
+            "KHR_materials_transmission": {"transmissionFactor": 1.0},
+            "KHR_materials_volume": {"thicknessFactor": 0.1, "attenuationDistance": 2.0,
+                                     "attenuationColor": [0.5, 0.25, 1.0]}}},
+        {"name": "Opaque with volume", "extensions": {
+            "KHR_materials_volume": {"attenuationDistance": 2.0, "attenuationColor": [0.5, 0.5, 0.5]}}}]
+    attrs = {"POSITION": pos, "TEXCOORD_0": uv}
+    single_mesh_scene(b, [{"attributes": attrs, "indices": idx, "material": k} for k in range(3)],
+                      "CoatVolume")
+    write("coat_volume.gltf", b.finish())
 
 
 def sparse():
@@ -707,6 +828,7 @@ def main():
     lights()
     materials()
     textures()
+    material_textures()
     sparse()
     broken()
     camera_indexing()
