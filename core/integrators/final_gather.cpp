@@ -29,7 +29,7 @@ namespace {
 Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si, const Bsdf& bsdf,
                             const Vec3& wo, const GatherSettings& settings) {
     if (!maps.global) return Color(0.0f);
-    const Vec3 n = glm::dot(si.shading_normal, wo) >= 0.0f ? si.shading_normal : -si.shading_normal;
+    const Vec3 n = glm::dot(si.surface_normal, wo) >= 0.0f ? si.surface_normal : -si.surface_normal;
     if (maps.irradiance && !bsdf.has_non_lambertian_non_delta()) {
         Color e;
         if (maps.irradiance->nearest_irradiance(si.p, n, settings.max_radius, &e))

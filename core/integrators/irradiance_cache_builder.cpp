@@ -35,7 +35,7 @@ void collect_diffuse_points(const RenderScene& rs, const Ray& ray, float path_le
     const Bsdf bsdf = make_bsdf(rs, si, wo);
     const float length = path_length + hit->t;
     if (max_component(bsdf.diffuse_reflectance(wo)) > 0.0f) {
-        const Vec3 n = glm::dot(si.shading_normal, wo) >= 0.0f ? si.shading_normal : -si.shading_normal;
+        const Vec3 n = glm::dot(si.surface_normal, wo) >= 0.0f ? si.surface_normal : -si.surface_normal;
         const Vec3 ng = glm::dot(si.geometric_normal, wo) >= 0.0f ? si.geometric_normal : -si.geometric_normal;
         out.push_back({si.p, n, ng, footprint.at(length)});
     }

@@ -79,7 +79,8 @@ Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_
     const Bsdf bsdf = make_bsdf(rs, si, wo);
     if (bsdf.has_non_delta()) {
         radiance += sample_direct_light(rs, *direct_lights_, si, bsdf, wo, context, false);
-        const Vec3 normal = glm::dot(si.shading_normal, wo) >= 0.0f ? si.shading_normal : -si.shading_normal;
+        // Photon discs and cache records follow the surface, not its normal map (README).
+        const Vec3 normal = glm::dot(si.surface_normal, wo) >= 0.0f ? si.surface_normal : -si.surface_normal;
         if (maps_->caustic)
             radiance += maps_->caustic->estimate_radiance(si.p, normal, bsdf, wo, caustic_options_);
         if (gatherer_) {

@@ -123,7 +123,7 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
             const bool caustic_path = specular_bounces > 0 && !diffuse_seen;
             const uint8_t flags = static_cast<uint8_t>((bounce == 0 ? photon_flags::kDirect : 0) |
                                                        (caustic_path ? photon_flags::kCaustic : 0));
-            const Vec3 normal = glm::dot(si.shading_normal, wo) >= 0.0f ? si.shading_normal : -si.shading_normal;
+            const Vec3 normal = glm::dot(si.surface_normal, wo) >= 0.0f ? si.surface_normal : -si.surface_normal;
             const TracedPhoton photon{si.p, ray.direction, normal, flux, path_in_batch, flags};
             if (want_global) out.global.push_back(photon);
             if (want_caustic && caustic_path) out.caustic.push_back(photon);

@@ -11,6 +11,10 @@ struct SurfaceInteraction {
     Vec3 p{0.0f};
     Vec3 geometric_normal{0.0f, 0.0f, 1.0f};  // the triangle's front-face normal (winding)
     Vec3 shading_normal{0.0f, 0.0f, 1.0f};    // interpolated, on the geometric normal's side
+    /// The interpolated normal before any normal texture (else shading_normal): photon maps and
+    /// the irradiance cache orient their discs, records and gathers by it, since a normal map's
+    /// bumps would tilt them off the surface the photons lie on.
+    Vec3 surface_normal{0.0f, 0.0f, 1.0f};
     /// Interpolated texture coordinates, vertex colour and footprint; defaults (uv 0, colour 1)
     /// when the material reads no texture and the scene has no vertex colours.
     TexturePoint tex;
@@ -81,10 +85,17 @@ inline SurfaceInteraction make_interaction(const Scene& scene, const Hit& hit, c
         si.tex = scene.texture_point(hit.triangle, hit.u, hit.v);
         if (footprint_width > 0.0f && material.textured())
             set_texture_footprint(scene, tri, ray_direction, si.geometric_normal, footprint_width, si.tex);
-        if (material.normal_texture.present() && !scene.tangents.empty())
+        if (material.normal_texture.present() && !scene.tangents.empty()) {
+            si.surface_normal = oriented_shading_normal(shading, si.geometric_normal);
             shading = apply_normal_texture(scene, material, tri, hit.u, hit.v, si.tex, shading);
+            si.shading_normal = oriented_shading_normal(shading, si.geometric_normal);
+            si.front_face = glm::dot(ray_direction, si.geometric_normal) < 0.0f;
+            si.distance = hit.t;
+            return si;
+        }
     }
     si.shading_normal = oriented_shading_normal(shading, si.geometric_normal);
+    si.surface_normal = si.shading_normal;
     si.front_face = glm::dot(ray_direction, si.geometric_normal) < 0.0f;
     si.distance = hit.t;
     return si;

@@ -9,6 +9,7 @@
 
 #include "core/camera/camera.h"
 #include "core/integrators/direct.h"
+#include "core/integrators/photon_mapping.h"
 #include "core/math/rng.h"
 #include "core/scene/gltf_loader.h"
 #include "core/scene/shapes.h"
@@ -41,10 +42,12 @@ Color radiance_straight_down(const std::shared_ptr<const RenderScene>& rs, const
 
 /// A Lambertian quad z = 0 (albedo 0.5) whose normal texture tilts every normal by `tilt`
 /// towards the tangent +x (none when normal_mapped is false), lit by `light`.
+/// With `wall`, a white wall x = 1 (facing -x) stands on the quad, so that light reaches the quad
+/// indirectly too, and the quad's albedo is 0.05 (little of what it reflects comes back).
 std::shared_ptr<const RenderScene> tilted_quad(bool normal_mapped, float tilt,
-                                               const PunctualLight& light) {
+                                               const PunctualLight& light, bool wall = false) {
     SceneBuilder builder("normal-map");
-    Material m = lambertian(Color(0.5f));
+    Material m = lambertian(Color(wall ? 0.05f : 0.5f));
     if (normal_mapped) {
         Texture t;
         t.width = t.height = 1;
@@ -60,6 +63,11 @@ std::shared_ptr<const RenderScene> tilted_quad(bool normal_mapped, float tilt,
     EXPECT_TRUE(
         builder.add_mesh(q.positions, q.normals, q.uvs, q.triangles, material, Mat4(1.0f), extras)
             .is_ok());
+    if (wall) {
+        const uint32_t white = builder.add_material(lambertian(Color(0.9f)));
+        const MeshData w = make_quad(Vec3(1, -1, 0), Vec3(0, 2, 0), Vec3(0, 0, 2), Vec3(-1, 0, 0));
+        EXPECT_TRUE(builder.add_mesh(w.positions, w.normals, w.uvs, w.triangles, white).is_ok());
+    }
     builder.add_light(light);
     return make_render_scene(builder.build().value());
 }
@@ -78,6 +86,38 @@ TEST(NormalMap, ConstantTiltGivesTheCosineOfTheTiltedAngle) {
                 rho_over_pi * e, 1e-4f);
     EXPECT_NEAR(radiance_straight_down(tilted_quad(false, tilt, along), Vec3(0, 0, 2)).x,
                 rho_over_pi * e * std::cos(tilt), 1e-4f);
+}
+
+TEST(NormalMap, PhotonEstimatesFollowTheSurfaceNotTheBumps) {
+    // The photon map's share of the radiance (photon-map without final gathering minus direct
+    // light) is the same on a flat and on a normal-mapped quad: photons lie on the surface, and
+    // the estimate's disc must lie there too, not tilt with the normal map.
+    const float tilt = 30.0f * kPi / 180.0f;
+    const PunctualLight overhead = sun(Vec3(0.5f, 0, -1), 2.0f);
+    const auto photon_share = [&](bool normal_mapped) {
+        auto rs = tilted_quad(normal_mapped, tilt, overhead, true);
+        PhotonTracingSettings tracing;
+        tracing.global_photons = 400000;
+        tracing.caustic_photons = 0;
+        tracing.irradiance_stride = 0;
+        auto maps = std::make_shared<const PhotonMaps>(trace_photons(*rs, tracing).value());
+        PhotonMapIntegratorSettings settings;
+        settings.final_gather = false;
+        settings.irradiance_cache = false;
+        settings.k_global = 400;
+        PhotonMapIntegrator photon_map(rs, maps, settings);
+        Rng rng(1, 1);
+        RayCounters counters;
+        SampleContext context{rng, counters};
+        CameraRay ray;
+        ray.origin = Vec3(0.1f, 0.2f, 2.0f);
+        ray.direction = Vec3(0, 0, -1);
+        return photon_map.radiance(ray, context).x - radiance_straight_down(rs, ray.origin).x;
+    };
+    const float flat = photon_share(false), mapped = photon_share(true);
+    std::printf("photon share of the radiance: flat %.5f, normal-mapped %.5f\n", flat, mapped);
+    ASSERT_GT(flat, 0.001f);
+    EXPECT_NEAR(mapped, flat, 0.01f * flat);
 }
 
 TEST(NormalMap, MirroredUvHalvesShadeLikeTheUnmirroredHalf) {
