@@ -44,6 +44,10 @@ Expected<Scene> with_added_lighting(const Scene& scene, const AddedLighting& lig
             lit.positions.push_back(mesh.positions[i]);
             lit.normals.push_back(mesh.normals[i]);
             lit.uvs.push_back(mesh.uvs[i]);
+            // The optional per-vertex arrays stay empty or one entry per vertex.
+            if (!lit.uvs1.empty()) lit.uvs1.push_back(mesh.uvs[i]);
+            if (!lit.colors.empty()) lit.colors.push_back(Vec4(1.0f));
+            if (!lit.tangents.empty()) lit.tangents.push_back(Vec4(glm::normalize(quad.edge_u), 1.0f));
             lit.bounds.extend(mesh.positions[i]);
         }
         for (const glm::uvec3& t : mesh.triangles) {

@@ -325,4 +325,33 @@ TEST_F(PhotondRender, GltfCameraIndexesTheFilesCamerasArray) {
         << r.output;
 }
 
+TEST_F(PhotondRender, QuadLightOfTheJobIsVisibleGeometryAlsoOnNormalMappedScenes) {
+    // NormalTangentMirrorTest has normal textures, so its scene carries tangents: the quad's
+    // vertices get theirs too. Seen straight on, the quad shows its radiance.
+    const fs::path scene = fs::path(PHOTOND_TEST_DATA_DIR) / "gltf-samples" / "NormalTangentMirrorTest" / "glTF" /
+                           "NormalTangentMirrorTest.gltf";
+    const auto r = run("render " + scene.string() +
+                       " --integrator direct --width 16 --height 16 --spp 1 --quiet --set output.pixel_type=float "
+                       "--set 'lights=[{\"type\": \"quad\", \"position\": [-50, -50, 20], \"edge_u\": [100, 0, 0], "
+                       "\"edge_v\": [0, 100, 0], \"radiance\": 3, \"color\": [1, 0.5, 0.25]}]' "
+                       "--set camera.look_from=[0,0,10] --set camera.look_at=[0,0,30] -o " +
+                       (dir_ / "q.exr").string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const photond::Color mean = mean_of(dir_ / "q.exr");
+    // Its front face looks towards +z, away from this camera: seen from behind, it is black...
+    EXPECT_EQ(mean, photond::Color(0.0f));
+    const auto front = run("render " + scene.string() +
+                           " --integrator direct --width 16 --height 16 --spp 1 --quiet --set output.pixel_type=float "
+                           "--set 'lights=[{\"type\": \"quad\", \"position\": [-50, -50, 20], \"edge_u\": [0, 100, 0], "
+                           "\"edge_v\": [100, 0, 0], \"radiance\": 3, \"color\": [1, 0.5, 0.25]}]' "
+                           "--set camera.look_from=[0,0,10] --set camera.look_at=[0,0,30] -o " +
+                           (dir_ / "f.exr").string());
+    ASSERT_EQ(front.exit_code, 0) << front.output;
+    // ... and from the front, exactly its radiance times its colour.
+    const photond::Color seen = mean_of(dir_ / "f.exr");
+    EXPECT_NEAR(seen.x, 3.0f, 1e-3f);
+    EXPECT_NEAR(seen.y, 1.5f, 1e-3f);
+    EXPECT_NEAR(seen.z, 0.75f, 1e-3f);
+}
+
 }  // namespace
