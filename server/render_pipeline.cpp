@@ -108,8 +108,8 @@ std::string describe_colour(const std::array<double, 3>& c) {
 Expected<std::shared_ptr<const PhotonMaps>> build_photon_maps(const protocol::Job& job, const RenderScene& scene,
                                                               const PipelineOptions& options,
                                                               RenderStatistics& stats) {
-    const RenderPlan plan = plan_photon_passes(*scene.scene, *scene.lights,
-                                               {job.photons.global, job.photons.caustic});
+    const RenderPlan plan = plan_photon_passes(*scene.scene, *scene.lights, {job.photons.global, job.photons.caustic},
+                                               scene.lights_with_sky_peaks.get());
     stats.plan = plan.decisions;
     const PhotonTracingSettings settings = photon_settings(job, plan, options);
     if (settings.global_photons == 0 && settings.caustic_photons == 0) {

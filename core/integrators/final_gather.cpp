@@ -55,9 +55,9 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
             const std::optional<Hit> hit = trace_ray(rs, r, counters);
             if (first_distance) *first_distance = hit ? hit->t : std::numeric_limits<float>::infinity();
             if (!hit) {
-                // Only straight from the gathering point: the sky seen through specular
-                // surfaces is the caustic map's.
-                if (depth == 0 && g.settings_.gather_diffuse_sky && rs.diffuse_sky) return rs.diffuse_sky->radiance(r.direction);
+                // Also through specular surfaces: caustic photons leave the diffuse sky out
+                // (trace_photons), so that this is its only way to a surface.
+                if (g.settings_.gather_diffuse_sky && rs.diffuse_sky) return rs.diffuse_sky->radiance(r.direction);
                 return Color(0.0f);
             }
             const SurfaceInteraction si = make_interaction(*rs.scene, *hit, r.direction);

@@ -22,8 +22,9 @@ struct GatherSettings {
     int max_specular_depth = 4;  // ideal specular surfaces a gather ray may pass through
     uint32_t k_global = 50;      // photons per radiance estimate where no precomputed irradiance fits
     float max_radius = 0.0f;     // estimate radius cap (world units)
-    /// Gather rays that leave the scene straight away see the environment's diffuse sky
-    /// (RenderScene::diffuse_sky), which light sampling then leaves out; else they see nothing.
+    /// Gather rays that leave the scene, straight away or through ideal specular surfaces, see
+    /// the environment's diffuse sky (RenderScene::diffuse_sky), which light sampling and the
+    /// caustic map then leave out (maps traced with a global map do); else they see nothing.
     bool gather_diffuse_sky = false;
 };
 

@@ -94,10 +94,19 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
     const float u_select = rng.next_float();
     const Vec2 u_position = rng.next_vec2();
     const Vec2 u_direction = rng.next_vec2();
+    // With a global map under an environment, final gathering collects the diffuse sky, also
+    // through specular surfaces (RenderScene::diffuse_sky): caustic photons then come from the
+    // other lights and the sky's peaks only.
+    const bool sky_gathered = settings.global_photons > 0 && rs.lights_with_sky_peaks;
+    const LightSet& lights = !want_global && sky_gathered ? *rs.lights_with_sky_peaks : *rs.lights;
     // Photons for the caustic map alone are aimed at its casters when they come from far away.
     const EmissionFocus* focus = !want_global && rs.caustic_casters ? &rs.caustic_focus : nullptr;
-    const std::optional<EmissionSample> emission = rs.lights->sample_emission(u_select, u_position, u_direction, focus);
+    const std::optional<EmissionSample> emission = lights.sample_emission(u_select, u_position, u_direction, focus);
     if (!emission || is_black(emission->flux_weight)) return;
+    if (want_caustic && want_global && sky_gathered && lights.kind(emission->light) == LightKind::Environment) {
+        const EnvironmentLight* peaks = rs.lights_with_sky_peaks->environment();
+        if (!peaks || is_black(peaks->radiance(-emission->direction))) want_caustic = false;
+    }
 
     Color flux = emission->flux_weight;
     Ray ray{emission->origin, emission->direction};

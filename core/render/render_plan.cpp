@@ -32,7 +32,8 @@ SceneLightPaths analyse_light_paths(const Scene& scene, const LightSet& lights) 
     return paths;
 }
 
-RenderPlan plan_photon_passes(const Scene& scene, const LightSet& lights, const PhotonPassRequest& request) {
+RenderPlan plan_photon_passes(const Scene& scene, const LightSet& lights, const PhotonPassRequest& request,
+                              const LightSet* caustic_lights) {
     const SceneLightPaths paths = analyse_light_paths(scene, lights);
     RenderPlan plan;
     auto decide = [&](const std::string& pass, bool enabled, std::string reason) {
@@ -44,12 +45,17 @@ RenderPlan plan_photon_passes(const Scene& scene, const LightSet& lights, const 
         decide("global_map", false, "the scene has no light with positive power");
         return plan;
     }
+    const bool global = request.global_photons > 0 && paths.has_diffuse;
     if (request.caustic_photons == 0) {
         plan.caustic_map = decide("caustic_map", false, "the job asks for 0 caustic photons");
     } else if (!paths.has_specular) {
         plan.caustic_map = decide("caustic_map", false, "no surface is specular or glossy, so no L S+ D path exists");
     } else if (!paths.has_receiver) {
         plan.caustic_map = decide("caustic_map", false, "no surface stores photons (every surface is ideal specular)");
+    } else if (global && caustic_lights && caustic_lights->empty()) {
+        plan.caustic_map = decide("caustic_map", false,
+                                  "the only light is a diffuse sky, which final gathering collects, also through "
+                                  "specular surfaces");
     } else {
         plan.caustic_map = decide("caustic_map", true, "specular or glossy surfaces can focus light onto surfaces that store photons");
     }

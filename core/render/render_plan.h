@@ -42,6 +42,9 @@ struct PhotonPassRequest {
 };
 
 /// The plan of the photon-map integrator for a scene and the photon counts a job asks for.
-RenderPlan plan_photon_passes(const Scene& scene, const LightSet& lights, const PhotonPassRequest& request);
+/// `caustic_lights`, when given, are the lights caustic photons come from if a global map is
+/// traced (RenderScene::lights_with_sky_peaks: the diffuse sky is final gathering's then).
+RenderPlan plan_photon_passes(const Scene& scene, const LightSet& lights, const PhotonPassRequest& request,
+                              const LightSet* caustic_lights = nullptr);
 
 }  // namespace photond
