@@ -73,6 +73,7 @@ bench: build
 	$(BUILD)/bench/kd_tree_bench
 	$(BUILD)/bench/http_bench
 	python3 bench/run_benchmark.py --photond $(BUILD)/server/photond $(BENCH_ARGS)
+	python3 bench/gltf_samples.py --photond $(BUILD)/server/photond
 
 format:
 	find core protocol server clients tests bench -name '*.h' -o -name '*.cpp' | xargs clang-format -i

@@ -74,6 +74,10 @@ SCENES = [
     SceneSpec("spheres-room", "bench/references/spheres-room-256", 256, 256,
               [4, 16, 64, 256], [4, 16, 64],
               note="115 332 triangles (built-in, generated): the cost of scene size"),
+    SceneSpec("sunlit-room", "bench/references/sunlit-room-256", 256, 256,
+              [4, 16, 64, 256], [4, 16, 64],
+              note="a closed room lit only by a sky image and its sun through a window (built-in): "
+                   "where photon maps must earn their place"),
     SceneSpec("cornell-box-512", "bench/references/cornell-box-512", 512, 512,
               [4, 16, 64], [4, 16], builtin="cornell-box",
               note="cornell-box at 512 x 512: the presets' goals at four times the pixels"),

@@ -24,7 +24,8 @@ Color sample_distant_lights_by_bsdf(const RenderScene& rs, const LightSet& light
 }  // namespace
 
 Color sample_direct_light(const RenderScene& rs, const LightSet& lights, const SurfaceInteraction& si,
-                          const Bsdf& bsdf, const Vec3& wo, SampleContext& context, bool use_mis, LobeMask mask) {
+                          const Bsdf& bsdf, const Vec3& wo, SampleContext& context, bool use_mis, LobeMask mask,
+                          LobeMask mis_lobes, float mis_samples) {
     // Without the caller's MIS, distant area lights still get both strategies here: light
     // sampling alone is poor for glossy lobes under a sky, BSDF sampling alone for a small sun.
     const bool distant_mis = !use_mis && lights.has_distant_area_lights();
@@ -56,7 +57,14 @@ Color sample_direct_light(const RenderScene& rs, const LightSet& lights, const S
     const bool distant_area = !ls->is_delta && !std::isfinite(ls->distance);
     if ((use_mis || (distant_mis && distant_area)) && !ls->is_delta)
         weight = power_heuristic(ls->pdf, bsdf.pdf(wo, ls->wi, mask));
-    return radiance + f * ls->radiance * (cos_theta * weight / ls->pdf);
+    Color weighted = f * weight;
+    if (!use_mis && mis_lobes != 0 && !ls->is_delta && std::isfinite(ls->distance)) {
+        // An area light: the caller's BSDF samples of mis_lobes find it too.
+        const Color f_mis = bsdf.eval(wo, ls->wi, TransportMode::Radiance, mis_lobes);
+        const float w = power_heuristic(ls->pdf, mis_samples * bsdf.pdf(wo, ls->wi, mis_lobes));
+        weighted = glm::max(f - f_mis, Color(0.0f)) + f_mis * w;
+    }
+    return radiance + weighted * ls->radiance * (cos_theta / ls->pdf);
 }
 
 }  // namespace photond

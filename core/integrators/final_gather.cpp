@@ -43,7 +43,8 @@ Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si
 
 }  // namespace
 
-Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& counters, float* distance) const {
+Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& counters, float* distance,
+                                         FirstHitEmission* emission) const {
     const RenderScene& rs = *scene_;
     // Walk through ideal specular surfaces; `depth` counts them.
     struct Walker {
@@ -51,6 +52,7 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
         const RenderScene& rs;
         Rng& rng;
         RayCounters& counters;
+        FirstHitEmission* emission;
         Color along(const Ray& r, int depth, float* first_distance) const {
             const std::optional<Hit> hit = trace_ray(rs, r, counters);
             if (first_distance) *first_distance = hit ? hit->t : std::numeric_limits<float>::infinity();
@@ -62,6 +64,11 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
             }
             const SurfaceInteraction si = make_interaction(*rs.scene, *hit, r.direction);
             const Vec3 wo = -r.direction;
+            if (depth == 0 && emission) {
+                emission->radiance = volume_transmittance(*rs.scene, si) * rs.lights->emitted_radiance(si, wo);
+                emission->triangle = si.triangle;
+                emission->point = si.p;
+            }
             const Bsdf bsdf = make_bsdf(rs, si, wo);
             Color radiance(0.0f);
             if (bsdf.has_non_delta()) radiance += radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_);
@@ -74,7 +81,8 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
             return volume_transmittance(*rs.scene, si) * radiance;
         }
     };
-    return Walker{*this, rs, rng, counters}.along(ray, 0, distance);
+    if (emission) *emission = FirstHitEmission{};
+    return Walker{*this, rs, rng, counters, emission}.along(ray, 0, distance);
 }
 
 GatherResult FinalGatherer::gather(const Vec3& p, const Vec3& n, const Vec3& geometric_normal, Rng& rng,

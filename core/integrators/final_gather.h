@@ -58,7 +58,14 @@ public:
 
     /// Radiance leaving the first non-specular surface along a ray, from the photon maps (no
     /// emission); writes the hit distance (infinity on a miss).
-    Color gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& counters, float* distance) const;
+    /// What a gather ray found at its first hit, for callers that weight emission by MIS.
+    struct FirstHitEmission {
+        Color radiance{0.0f};  // emitted towards the ray's origin; zero when nothing emits
+        uint32_t triangle = 0;
+        Vec3 point{0.0f};
+    };
+    Color gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& counters, float* distance,
+                              FirstHitEmission* emission = nullptr) const;
 
     const GatherSettings& settings() const { return settings_; }
 

@@ -119,10 +119,12 @@ inline Bsdf make_bsdf(const RenderScene& rs, const SurfaceInteraction& si, const
 /// Next-event estimation: one light sample with a shadow ray, lobes in `mask` only. With
 /// `use_mis`, area-light samples are weighted by the power heuristic against BSDF sampling.
 /// Without `use_mis`, distant area lights (environment, soft suns) still get MIS against one
-/// BSDF sample taken here.
+/// BSDF sample taken here, and the lobes in `mis_lobes` get MIS against `mis_samples` BSDF
+/// samples of those lobes with which the caller adds the emission it hits, weighted with
+/// power_heuristic(mis_samples * bsdf_pdf, light_pdf) (photon-map's glossy rays).
 Color sample_direct_light(const RenderScene& rs, const LightSet& lights, const SurfaceInteraction& si,
                           const Bsdf& bsdf, const Vec3& wo, SampleContext& context, bool use_mis,
-                          LobeMask mask = kAllLobes);
+                          LobeMask mask = kAllLobes, LobeMask mis_lobes = 0, float mis_samples = 1.0f);
 /// The same with the scene's lights.
 inline Color sample_direct_light(const RenderScene& rs, const SurfaceInteraction& si, const Bsdf& bsdf,
                                  const Vec3& wo, SampleContext& context, bool use_mis,

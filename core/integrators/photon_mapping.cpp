@@ -78,7 +78,13 @@ Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_
     Color radiance = rs.lights->emitted_radiance(si, wo);
     const Bsdf bsdf = make_bsdf(rs, si, wo);
     if (bsdf.has_non_delta()) {
-        radiance += sample_direct_light(rs, *direct_lights_, si, bsdf, wo, context, false);
+        // Glossy and rough lobes are also BSDF-sampled below: emitters those rays hit are
+        // weighted against light sampling (multiple importance sampling).
+        const bool glossy = gatherer_ && bsdf.has_non_lambertian_non_delta();
+        const LobeMask glossy_lobes = kNonDeltaLobes | kExcludeLambertian;
+        const int glossy_rays = std::max(settings_.glossy_rays, 1);
+        radiance += sample_direct_light(rs, *direct_lights_, si, bsdf, wo, context, false, kAllLobes,
+                                        glossy ? glossy_lobes : LobeMask(0), static_cast<float>(glossy_rays));
         // Photon discs and cache records follow the surface, not its normal map (README).
         const Vec3 normal = glm::dot(si.surface_normal, wo) >= 0.0f ? si.surface_normal : -si.surface_normal;
         if (maps_->caustic)
@@ -90,22 +96,28 @@ Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_
                 const DiffusePoint point{si.p, normal, ng, footprint.at(length)};
                 radiance += rho * kInvPi * indirect_irradiance(point, context);
             }
-            if (bsdf.has_non_lambertian_non_delta()) {
+            if (glossy) {
                 // Glossy and rough lobes: BSDF-sampled rays reading the photon maps where they land
-                // (no emission there: direct light is light sampling's, caustics the maps').
-                const LobeMask mask = kNonDeltaLobes | kExcludeLambertian;
-                const int rays = std::max(settings_.glossy_rays, 1);
+                // (caustics are the maps'), and the emitters they hit weighted by MIS against
+                // light sampling, which alone cannot see an emitter behind rough glass.
                 Color sum(0.0f);
-                for (int i = 0; i < rays; ++i) {
+                for (int i = 0; i < glossy_rays; ++i) {
                     const float u_lobe = context.rng.next_float();
                     const Vec2 u = context.rng.next_vec2();
-                    const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Radiance, mask);
+                    const std::optional<BsdfSample> s =
+                        bsdf.sample(wo, u_lobe, u, TransportMode::Radiance, glossy_lobes);
                     if (!s || is_black(s->weight)) continue;
                     float distance = 0.0f;
+                    FinalGatherer::FirstHitEmission emitted;
                     sum += s->weight * gatherer_->gather_ray_radiance(spawn_ray(rs, si, s->wi), context.rng,
-                                                                      context.counters, &distance);
+                                                                      context.counters, &distance, &emitted);
+                    if (!is_black(emitted.radiance) && s->kind != LobeKind::Delta) {
+                        const float light_pdf = direct_lights_->pdf_incident_triangle(emitted.triangle, si.p, emitted.point);
+                        sum += s->weight * emitted.radiance *
+                               power_heuristic(static_cast<float>(glossy_rays) * s->pdf, light_pdf);
+                    }
                 }
-                radiance += sum / static_cast<float>(rays);
+                radiance += sum / static_cast<float>(glossy_rays);
             }
         } else if (maps_->global) {
             radiance += maps_->global->estimate_radiance(si.p, normal, bsdf, wo, global_options_);
