@@ -195,25 +195,22 @@ std::vector<std::string> incomplete_photon_map_warnings(const PhotonTracingStati
         return stored > 0 ? "1 photon stored per " + grouped((emitted + stored / 2) / stored) + " emitted"
                           : std::string("no photon stored");
     };
-    if (settings.caustic_photons > 0 && !photons.caustic_complete) {
-        warnings.push_back("photon map incomplete: the caustic map holds " + grouped(photons.stored_caustic) +
-                           " of the " + grouped(settings.caustic_photons) + " photons requested (" +
-                           rate(photons.stored_caustic, photons.emitted_caustic) + "; emission stopped at " +
-                           millions(photons.emitted_caustic) + " photons, the cap of " +
-                           grouped(settings.max_emitted_per_stored) +
-                           " per requested photon): little light reaches a diffuse surface through the specular "
-                           "ones, so its caustics are noisy. Set photons.caustic=0 to skip the caustic map, or "
-                           "give the scene more specular surfaces in the lights' reach");
-    }
-    if (settings.global_photons > 0 && !photons.global_complete) {
-        warnings.push_back("photon map incomplete: the global map holds " + grouped(photons.stored_global) +
-                           " of the " + grouped(settings.global_photons) + " photons requested (" +
-                           rate(photons.stored_global, photons.emitted_global) + "; emission stopped at " +
-                           millions(photons.emitted_global) + " photons, the cap of " +
-                           grouped(settings.max_emitted_per_stored) +
-                           " per requested photon): most photons leave the scene or land on nothing, so "
-                           "indirect light is noisy. Aim the lights at the geometry or close the scene");
-    }
+    const auto incomplete = [&](const char* map, uint64_t stored, uint32_t requested, uint64_t emitted,
+                                const char* consequence) {
+        warnings.push_back("photon map incomplete: the " + std::string(map) + " map holds " + grouped(stored) +
+                           " of the " + grouped(requested) + " photons requested (" + rate(stored, emitted) +
+                           "; emission stopped at " + millions(emitted) + " photons, the cap of " +
+                           grouped(settings.max_emitted_per_stored) + " per requested photon): " + consequence);
+    };
+    if (settings.caustic_photons > 0 && !photons.caustic_complete)
+        incomplete("caustic", photons.stored_caustic, settings.caustic_photons, photons.emitted_caustic,
+                   "little light reaches a diffuse surface through the specular ones, so its caustics are noisy. "
+                   "Set photons.caustic=0 to skip the caustic map, or give the scene more specular surfaces in "
+                   "the lights' reach");
+    if (settings.global_photons > 0 && !photons.global_complete)
+        incomplete("global", photons.stored_global, settings.global_photons, photons.emitted_global,
+                   "most photons leave the scene or land on nothing, so indirect light is noisy. Aim the lights "
+                   "at the geometry or close the scene");
     return warnings;
 }
 
