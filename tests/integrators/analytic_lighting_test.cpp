@@ -30,14 +30,7 @@ Color radiance_at(const Integrator& integrator, const Vec3& p, int samples, uint
     CameraRay ray;
     ray.origin = p + Vec3(0.3f, 5.0f, 0.2f);
     ray.direction = glm::normalize(p - ray.origin);
-    DVec3 sum(0.0);
-    RayCounters counters;
-    for (int s = 0; s < samples; ++s) {
-        Rng rng = Rng::for_stream(seed, static_cast<uint64_t>(s));
-        SampleContext context{rng, counters};
-        sum += DVec3(integrator.radiance(ray, context));
-    }
-    return Color(sum / static_cast<double>(samples));
+    return test_support::mean_radiance(integrator, ray, samples, seed);
 }
 
 TEST(AnalyticLighting, PointLightOverPlaneMatchesInverseSquareCosine) {

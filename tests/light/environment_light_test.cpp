@@ -21,6 +21,7 @@ namespace {
 using test_support::chi_square_p_value;
 using test_support::lambertian;
 using test_support::make_render_scene;
+using test_support::mean_radiance;
 
 constexpr double kPiD = 3.14159265358979323846;
 
@@ -181,18 +182,6 @@ TEST(EnvironmentLight, EmittedPhotonFluxIsTheMapIntegralOverTheSceneDisc) {
     }
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(flux[c] / kSamples / expected[c], 1.0, 0.01) << c;
     EXPECT_NEAR(DVec3(lights.total_power())[0] / expected[0], 1.0, 1e-5);
-}
-
-/// Mean radiance over `samples` camera samples along `ray`.
-Color mean_radiance(const Integrator& integrator, const CameraRay& ray, int samples, uint64_t seed) {
-    DVec3 sum(0.0);
-    RayCounters counters;
-    for (int s = 0; s < samples; ++s) {
-        Rng rng = Rng::for_stream(seed, static_cast<uint64_t>(s));
-        SampleContext context{rng, counters};
-        sum += DVec3(integrator.radiance(ray, context));
-    }
-    return Color(sum / static_cast<double>(samples));
 }
 
 std::vector<CameraRay> rays_at_sphere() {

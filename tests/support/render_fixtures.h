@@ -4,6 +4,7 @@
 
 #include <memory>
 
+#include "core/integrators/integrator.h"
 #include "core/render/render_scene.h"
 
 namespace photond::test_support {
@@ -25,6 +26,18 @@ inline Material lambertian(Color albedo) {
     m.roughness = 1.0f;
     m.specular = 0.0f;
     return m;
+}
+
+/// Mean radiance over `samples` camera samples along `ray`, sample s drawing stream (seed, s).
+inline Color mean_radiance(const Integrator& integrator, const CameraRay& ray, int samples, uint64_t seed = 1) {
+    DVec3 sum(0.0);
+    RayCounters counters;
+    for (int s = 0; s < samples; ++s) {
+        Rng rng = Rng::for_stream(seed, static_cast<uint64_t>(s));
+        SampleContext context{rng, counters};
+        sum += DVec3(integrator.radiance(ray, context));
+    }
+    return Color(sum / static_cast<double>(samples));
 }
 
 }  // namespace photond::test_support
