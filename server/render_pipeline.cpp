@@ -236,14 +236,11 @@ Expected<std::shared_ptr<const Scene>> load_job_scene(const protocol::SceneRef& 
         }
         case protocol::SceneRef::Kind::Path: {
             if (scene_root.empty()) return Error{"scene.path: no scene root is configured"};
-            const std::filesystem::path root = std::filesystem::weakly_canonical(scene_root);
-            const std::filesystem::path file = std::filesystem::weakly_canonical(root / ref.value);
-            const auto [root_end, file_it] = std::mismatch(root.begin(), root.end(), file.begin(), file.end());
-            if (root_end != root.end())
-                return Error{"scene.path: '" + ref.value + "' lies outside the scene root"};
+            const std::optional<std::filesystem::path> file = contained_path(scene_root, ref.value);
+            if (!file) return Error{"scene.path: '" + ref.value + "' lies outside the scene root"};
             GltfLoadOptions options;
-            options.bundle_root = file.parent_path();
-            auto scene = load_gltf_file(file, options);
+            options.bundle_root = file->parent_path();
+            auto scene = load_gltf_file(*file, options);
             if (!scene) return scene.error();
             return std::make_shared<const Scene>(std::move(scene).value());
         }

@@ -64,24 +64,34 @@ Color EnvironmentLight::texel(int x, int y) const {
     return e.intensity * e.texels[static_cast<size_t>(y) * static_cast<size_t>(e.width) + static_cast<size_t>(x)];
 }
 
-Vec2 EnvironmentLight::direction_to_uv(const Vec3& d) const {
-    // Into the image's frame: turn by -rotation about +Y.
-    const float x = cos_rotation_ * d.x - sin_rotation_ * d.z;
-    const float z = sin_rotation_ * d.x + cos_rotation_ * d.z;
-    float u = 0.5f + std::atan2(z, x) * kInv2Pi;
-    float v = std::acos(std::clamp(d.y, -1.0f, 1.0f)) * kInvPi;
-    u = std::clamp(u - std::floor(u), 0.0f, 0x1.fffffep-1f);
-    v = std::clamp(v, 0.0f, 0x1.fffffep-1f);
-    return {u, v};
+Vec2 equirectangular_uv(const Vec3& d) {
+    const float u = 0.5f + std::atan2(d.z, d.x) * kInv2Pi;
+    const float v = std::acos(std::clamp(d.y, -1.0f, 1.0f)) * kInvPi;
+    return {std::clamp(u - std::floor(u), 0.0f, 0x1.fffffep-1f), std::clamp(v, 0.0f, 0x1.fffffep-1f)};
 }
 
-Vec3 EnvironmentLight::uv_to_direction(const Vec2& uv) const {
+Vec3 equirectangular_direction(const Vec2& uv) {
     const float phi = 2.0f * kPi * (uv.x - 0.5f);
     const float theta = kPi * uv.y;
     const float sin_theta = std::sin(theta);
-    const float x = sin_theta * std::cos(phi), z = sin_theta * std::sin(phi);
+    return {sin_theta * std::cos(phi), std::cos(theta), sin_theta * std::sin(phi)};
+}
+
+Vec2 EnvironmentLight::direction_to_uv(const Vec3& d) const {
+    // Into the image's frame: turn by -rotation about +Y.
+    return equirectangular_uv({cos_rotation_ * d.x - sin_rotation_ * d.z, d.y, sin_rotation_ * d.x + cos_rotation_ * d.z});
+}
+
+Vec3 EnvironmentLight::uv_to_direction(const Vec2& uv) const {
+    const Vec3 d = equirectangular_direction(uv);
     // Out of the image's frame: turn by +rotation about +Y.
-    return {cos_rotation_ * x + sin_rotation_ * z, std::cos(theta), -sin_rotation_ * x + cos_rotation_ * z};
+    return {cos_rotation_ * d.x + sin_rotation_ * d.z, d.y, -sin_rotation_ * d.x + cos_rotation_ * d.z};
+}
+
+glm::ivec2 EnvironmentLight::texel_at(const Vec2& uv) const {
+    const Environment& e = *environment_;
+    return {std::min(static_cast<int>(uv.x * static_cast<float>(e.width)), e.width - 1),
+            std::min(static_cast<int>(uv.y * static_cast<float>(e.height)), e.height - 1)};
 }
 
 Color EnvironmentLight::radiance(const Vec3& d) const {
@@ -89,10 +99,8 @@ Color EnvironmentLight::radiance(const Vec3& d) const {
     if (!e.has_image()) return e.intensity * e.color;
     // Nearest texel: the same piecewise-constant function that sample() and pdf() describe, so
     // that light samples and BSDF samples of the sky agree exactly.
-    const Vec2 uv = direction_to_uv(d);
-    const int x = std::min(static_cast<int>(uv.x * static_cast<float>(e.width)), e.width - 1);
-    const int y = std::min(static_cast<int>(uv.y * static_cast<float>(e.height)), e.height - 1);
-    return texel(x, y);
+    const glm::ivec2 t = texel_at(direction_to_uv(d));
+    return texel(t.x, t.y);
 }
 
 Vec3 EnvironmentLight::sample(Vec2 u, float* pdf) const {
@@ -125,8 +133,8 @@ float EnvironmentLight::pdf(const Vec3& d) const {
     if (is_black()) return 0.0f;
     if (!e.has_image()) return kInv4Pi;
     const Vec2 uv = direction_to_uv(d);
-    const uint32_t x = static_cast<uint32_t>(std::min(static_cast<int>(uv.x * static_cast<float>(e.width)), e.width - 1));
-    const uint32_t y = static_cast<uint32_t>(std::min(static_cast<int>(uv.y * static_cast<float>(e.height)), e.height - 1));
+    const glm::ivec2 t = texel_at(uv);
+    const uint32_t x = static_cast<uint32_t>(t.x), y = static_cast<uint32_t>(t.y);
     const float sin_theta = std::sin(kPi * uv.y);
     if (!(sin_theta > 0.0f)) return 0.0f;
     const float pdf_uv = rows_.probability(y) * columns_[y].probability(x) * static_cast<float>(e.width) *

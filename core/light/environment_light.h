@@ -29,6 +29,11 @@ inline constexpr float kEnvironmentPeakFactor = 16.0f;
 EnvironmentSplit split_environment_peaks(const Environment& environment,
                                          float peak_factor = kEnvironmentPeakFactor);
 
+/// The equirectangular map of Environment (no rotation): image coordinates (u, v) in [0, 1)^2
+/// of a unit direction, and the direction at (u, v).
+Vec2 equirectangular_uv(const Vec3& d);
+Vec3 equirectangular_direction(const Vec2& uv);
+
 class EnvironmentLight {
 public:
     explicit EnvironmentLight(const Environment& environment);
@@ -50,6 +55,8 @@ public:
 
 private:
     Color texel(int x, int y) const;
+    /// The texel holding image coordinates uv (nearest: radiance, sample and pdf agree on it).
+    glm::ivec2 texel_at(const Vec2& uv) const;
 
     const Environment* environment_;
     float cos_rotation_ = 1.0f, sin_rotation_ = 0.0f;

@@ -263,12 +263,6 @@ Color LightSet::escaped_radiance(const Vec3& d, float bsdf_pdf) const {
     return sum;
 }
 
-Vec3 LightSet::parallel_origin(const Vec3& direction, Vec2 u) const {
-    const Frame frame(direction);
-    const Vec2 d = sample_concentric_disk(u) * scene_radius_;
-    return scene_center_ - direction * (2.0f * scene_radius_) + frame.s * d.x + frame.t * d.y;
-}
-
 Color LightSet::emitted_radiance(const SurfaceInteraction& si, const Vec3& wo) const {
     const Material& m = scene_->materials[si.material];
     if (!m.is_emissive()) return Color(0.0f);
@@ -318,16 +312,16 @@ Color LightSet::mean_emissive_texel(uint32_t triangle) const {
     return glm::max(mean, 1e-3f * whole);
 }
 
-Vec3 LightSet::parallel_origin(const Vec3& direction, Vec2 u, const EmissionFocus& focus, float* area_ratio) const {
-    const float radius = std::min(focus.radius, scene_radius_);
-    *area_ratio = (radius * radius) / (scene_radius_ * scene_radius_);
+Vec3 LightSet::parallel_origin(const Vec3& direction, Vec2 u, const EmissionFocus* focus, float* area_ratio) const {
+    const Vec3 center = focus ? focus->center : scene_center_;
+    const float radius = focus ? std::min(focus->radius, scene_radius_) : scene_radius_;
+    *area_ratio = focus ? (radius * radius) / (scene_radius_ * scene_radius_) : 1.0f;
     const Frame frame(direction);
     const Vec2 d = sample_concentric_disk(u) * radius;
-    // On the focus disc, then back along the ray to outside the scene's bounding sphere, so that
-    // whatever lies in front of the focus still blocks the photon.
-    const Vec3 on_disc = focus.center + frame.s * d.x + frame.t * d.y;
-    const Vec3 to_center = scene_center_ - on_disc;
-    const float along = glm::dot(to_center, direction);
+    // On the disc, then back along the ray to outside the scene's bounding sphere, so that
+    // whatever lies in front of a focus still blocks the photon.
+    const Vec3 on_disc = center + frame.s * d.x + frame.t * d.y;
+    const float along = glm::dot(scene_center_ - on_disc, direction);
     return on_disc + direction * (along - 2.0f * scene_radius_);
 }
 
@@ -367,8 +361,7 @@ std::optional<EmissionSample> LightSet::sample_emission(float u_select, Vec2 u_p
                               ? Frame(l.direction).to_world(sample_uniform_cone(u_direction, std::cos(l.angular_radius)))
                               : l.direction;
             float area_ratio = 1.0f;
-            s.origin = focus ? parallel_origin(s.direction, u_position, *focus, &area_ratio)
-                             : parallel_origin(s.direction, u_position);
+            s.origin = parallel_origin(s.direction, u_position, focus, &area_ratio);
             s.normal = s.direction;
             s.flux_weight = e.emission_weight * area_ratio;
             break;
@@ -379,8 +372,7 @@ std::optional<EmissionSample> LightSet::sample_emission(float u_select, Vec2 u_p
             if (!(pdf > 0.0f)) return std::nullopt;
             s.direction = -towards_sky;
             float area_ratio = 1.0f;
-            s.origin = focus ? parallel_origin(s.direction, u_position, *focus, &area_ratio)
-                             : parallel_origin(s.direction, u_position);
+            s.origin = parallel_origin(s.direction, u_position, focus, &area_ratio);
             s.normal = s.direction;
             s.flux_weight = e.emission_weight * environment_->radiance(towards_sky) * (area_ratio / pdf);
             break;

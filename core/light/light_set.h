@@ -105,11 +105,10 @@ private:
     /// The solid-angle pdf with which sample_incident picks direction d from distant area
     /// light `light` (choice included), and the radiance it sends along d.
     float distant_pdf(uint32_t light, const Vec3& d, Color* radiance) const;
-    /// The origin of a parallel photon travelling in `direction`: a point of a disc of the
-    /// scene's bounding radius perpendicular to it, outside the scene.
-    Vec3 parallel_origin(const Vec3& direction, Vec2 u) const;
-    /// The same aimed at `focus`; writes the ratio of the focus disc's area to the scene's.
-    Vec3 parallel_origin(const Vec3& direction, Vec2 u, const EmissionFocus& focus, float* area_ratio) const;
+    /// The origin of a parallel photon travelling in `direction`: a point of a disc
+    /// perpendicular to it, of the scene's bounding radius around its centre (or of `focus`,
+    /// when given), moved back outside the scene. Writes the disc's area over the scene's.
+    Vec3 parallel_origin(const Vec3& direction, Vec2 u, const EmissionFocus* focus, float* area_ratio) const;
 
     struct Entry {
         LightKind kind;

@@ -6,6 +6,7 @@
 #include <string>
 #include <utility>
 
+#include "core/light/environment_light.h"
 #include "core/math/frame.h"
 #include "core/scene/shapes.h"
 
@@ -413,9 +414,8 @@ Environment make_sunlit_room_sky() {
         const double theta0 = kPi * y / sky.height, theta1 = kPi * (y + 1) / sky.height;
         const double texel_solid_angle = 2.0 * kPi * (std::cos(theta0) - std::cos(theta1)) / sky.width;
         for (int x = 0; x < sky.width; ++x) {
-            const float theta = kPi * (static_cast<float>(y) + 0.5f) / static_cast<float>(sky.height);
-            const float phi = 2.0f * kPi * ((static_cast<float>(x) + 0.5f) / static_cast<float>(sky.width) - 0.5f);
-            const Vec3 d(std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi));
+            const Vec3 d = equirectangular_direction({(static_cast<float>(x) + 0.5f) / static_cast<float>(sky.width),
+                                                      (static_cast<float>(y) + 0.5f) / static_cast<float>(sky.height)});
             if (glm::dot(d, sun) < std::cos(kSunlitRoomSunRadius)) continue;
             sun_texels.push_back(static_cast<size_t>(y * sky.width + x));
             solid_angle += texel_solid_angle;
