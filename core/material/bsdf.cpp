@@ -18,19 +18,20 @@
 //
 // with E(mu) the layer's directional albedo and E_avg = int E(mu) 2 mu dmu. It is reciprocal and
 // its albedo is exactly c (1 - E(mu_o)), so layer + Lambert reflect E_true(mu_o) + c (1 - E(mu_o))
-// <= 1 as long as E is an upper bound of the true layer albedo. E comes from a table built at
-// first use whose interpolant is raised until it bounds the integrated albedo (AlbedoTable);
-// E_avg is the exact integral of that interpolant, so the identity above is exact.
+// <= 1 as long as E is an upper bound of the true layer albedo. E comes from a table integrated
+// when photond is built, whose interpolant is raised until it bounds the integrated albedo
+// (core/material/albedo_table.h); E_avg is the exact integral of that interpolant, so the
+// identity above is exact.
 // The three parts have weights summing to 1, hence sum f cos + delta weights <= 1 for c <= 1,
 // for every wo (Importance mode; Radiance mode adds the physical 1/eta^2 at refraction).
 #include "core/material/bsdf.h"
 
 #include <array>
-#include <mutex>
 #include <tuple>
 #include <utility>
 #include <vector>
 
+#include "core/material/albedo_table.h"
 #include "core/material/fresnel.h"
 #include "core/material/microfacet.h"
 #include "core/math/sampling.h"
@@ -65,81 +66,37 @@ LobeKind microfacet_lobe_kind(float roughness) {
 
 bool in_mask(LobeMask mask, LobeKind kind) { return (mask & mask_of(kind)) != 0; }
 
-/// Directional albedo of the GGX reflection lobe without Fresnel (`total`) and weighted by the
-/// Schlick term (1 - wo.h)^5 (`schlick`): a Schlick-Fresnel lobe reflects
-/// F0 total + (F90 - F0) schlick.
-struct SpecularAlbedo {
-    float total = 0.0f;
-    float schlick = 0.0f;
-};
-
-/// Integrates the albedo over visible normals (Heitz 2018): E = E_h[G2 / G1 * F], with a
-/// midpoint rule on a kQuadrature^2 grid of the sampling square. The albedo changes fast near
-/// u.x = 1 (microfacets near the horizon, whose reflections get shadowed), so u.x = 1 - (1 -
-/// v)^2 concentrates the nodes there; this keeps the error below 1e-3 for all roughnesses.
-SpecularAlbedo integrate_specular_albedo(float roughness, float cos_theta) {
-    constexpr int kQuadrature = 32;
-    const GgxDistribution ggx(std::max(roughness * roughness, kMinAlpha));
-    const float mu = std::max(cos_theta, 1e-6f);
-    const Vec3 wo(safe_sqrt(1.0f - mu * mu), 0.0f, mu);
-    const float g1 = ggx.g1(wo);
-    double total = 0.0, schlick = 0.0;
-    for (int i = 0; i < kQuadrature; ++i) {
-        const double v = (i + 0.5) / kQuadrature;
-        const float ux = static_cast<float>(1.0 - (1.0 - v) * (1.0 - v));
-        const double jacobian = 2.0 * (1.0 - v);
-        for (int j = 0; j < kQuadrature; ++j) {
-            const Vec3 h = ggx.sample_visible_normal(wo, Vec2(ux, (j + 0.5f) / kQuadrature));
-            const Vec3 wi = reflect(wo, h);
-            if (wi.z <= 0.0f) continue;
-            const double w = jacobian * ggx.g2(wo, wi) / g1;
-            total += w;
-            schlick += w * schlick_weight(glm::dot(wo, h));
-        }
-    }
-    const double n = kQuadrature * kQuadrature;
-    return {static_cast<float>(total / n), static_cast<float>(schlick / n)};
-}
-
-/// Upper bounds of the rough GGX lobe's albedo (total and Schlick-weighted) as a function of
-/// mu = cos(theta_o), for roughness between consecutive rows r_j = kDeltaRoughness *
-/// (1 / kDeltaRoughness)^(j / kRoughnessCells). Both axes are geometric near 0 because the
-/// albedo has a dip where mu ~ alpha (G1 at grazing angles). Each cell (a pair of rows) is
-/// built on first use, independently, so a scene pays only for the roughness values it uses.
-/// Within a cell the bound is interpolated linearly in roughness and in mu.
+/// The albedo table (core/material/albedo_table.h), integrated when photond was built.
 class AlbedoTable {
 public:
-    static constexpr int kRoughnessCells = 31;
-    static constexpr int kCosNodes = 96;
+    static constexpr int kRoughnessCells = albedo_table::kRoughnessCells;
+    static constexpr int kCosNodes = albedo_table::kCosNodes;
 
-    static AlbedoTable& instance() {
-        static AlbedoTable table;  // thread-safe initialisation
+    static const AlbedoTable& instance() {
+        static const AlbedoTable table;  // thread-safe initialisation
         return table;
     }
 
-    /// The cell containing `roughness` (in [kDeltaRoughness, 1]) and the weight of its upper
-    /// row. Builds the cell if needed.
-    std::pair<int, float> locate_roughness(float roughness) {
+    /// The cell containing `roughness` (in [kDeltaRoughness, 1]) and the weight of its upper row.
+    std::pair<int, float> locate_roughness(float roughness) const {
         roughness = std::clamp(roughness, kDeltaRoughness, 1.0f);
         const float x = std::log(roughness / kDeltaRoughness) / std::log(1.0f / kDeltaRoughness) *
                         kRoughnessCells;
         int j = std::clamp(static_cast<int>(x), 0, kRoughnessCells - 1);
-        const float r0 = row_roughness(j), r1 = row_roughness(j + 1);
-        std::call_once(built_[j], [&] { build_cell(j); });
+        const float r0 = row_roughness_[j], r1 = row_roughness_[j + 1];
         return {j, std::clamp((roughness - r0) / (r1 - r0), 0.0f, 1.0f)};
     }
 
-    /// Requires locate_roughness() to have returned `cell` (so that it is built).
     SpecularAlbedo lookup(int cell, float w_roughness, float mu) const {
         mu = std::clamp(mu, 0.0f, 1.0f);
-        const float t = std::log1p(mu * kExpBetaMinusOne) / kBeta * (kCosNodes - 1);
+        const float t = std::log1p(mu * albedo_table::kExpBetaMinusOne) / albedo_table::kBeta * (kCosNodes - 1);
         int k = std::clamp(static_cast<int>(t), 0, kCosNodes - 2);
         // Make sure mu lies in [mu_k, mu_k+1] despite the rounding of log1p.
         if (k > 0 && mu < node_cos_[k]) --k;
         if (k < kCosNodes - 2 && mu > node_cos_[k + 1]) ++k;
         const float w_mu =
             std::clamp((mu - node_cos_[k]) / (node_cos_[k + 1] - node_cos_[k]), 0.0f, 1.0f);
-        const Cell& c = cells_[cell];
+        const albedo_table::Cell& c = albedo_table::cell(cell);
         auto interpolate = [&](const std::array<float, 2 * kCosNodes>& v) {
             return std::lerp(std::lerp(v[k], v[k + 1], w_mu),
                              std::lerp(v[kCosNodes + k], v[kCosNodes + k + 1], w_mu), w_roughness);
@@ -149,112 +106,19 @@ public:
 
     /// int E(mu) 2 mu dmu of lookup()'s interpolant, exactly.
     SpecularAlbedo average(int cell, float w_roughness) const {
-        const Cell& c = cells_[cell];
+        const albedo_table::Cell& c = albedo_table::cell(cell);
         return {std::lerp(c.average[0].total, c.average[1].total, w_roughness),
                 std::lerp(c.average[0].schlick, c.average[1].schlick, w_roughness)};
     }
 
 private:
-    static constexpr float kBeta = 10.0f;  // mu_k = (exp(beta k / (n - 1)) - 1) / (exp(beta) - 1)
-    static constexpr float kExpBetaMinusOne = 22025.465794806718f;  // exp(10) - 1
-
-    struct Cell {
-        // Lower row (roughness r_j) then upper row (r_j+1), kCosNodes each.
-        std::array<float, 2 * kCosNodes> total{}, schlick{};
-        std::array<SpecularAlbedo, 2> average{};
-    };
-
-    static float row_roughness(int j) {
-        return kDeltaRoughness *
-               std::pow(1.0f / kDeltaRoughness, static_cast<float>(j) / kRoughnessCells);
+    AlbedoTable() : node_cos_(albedo_table::node_cos()) {
+        for (int j = 0; j <= kRoughnessCells; ++j) row_roughness_[j] = albedo_table::row_roughness(j);
     }
-
-    AlbedoTable() {
-        for (int k = 0; k < kCosNodes; ++k) {
-            node_cos_[k] =
-                static_cast<float>(std::expm1(static_cast<double>(kBeta) * k / (kCosNodes - 1)) /
-                                   std::expm1(static_cast<double>(kBeta)));
-        }
-        node_cos_[kCosNodes - 1] = 1.0f;
-    }
-
-    void build_cell(int j);
 
     std::array<float, kCosNodes> node_cos_{};
-    std::array<Cell, kRoughnessCells> cells_{};
-    std::array<std::once_flag, kRoughnessCells> built_;
+    std::array<float, kRoughnessCells + 1> row_roughness_{};
 };
-
-void AlbedoTable::build_cell(int j) {
-    // Integrate on a grid kRefine times finer than the nodes, start from the node values, then
-    // raise the 4 corners of every mu cell by the largest amount the fine samples inside it
-    // exceed the bilinear interpolant (raising a node only raises its neighbours'
-    // interpolants), so that the interpolant bounds the albedo from above. Finally add a
-    // margin for the quadrature error and clamp to the true albedo's bound 1.
-    constexpr int kRefine = 3;
-    constexpr float kRelativeMargin = 3e-3f, kAbsoluteMargin = 1.5e-3f;
-    constexpr int kFine = (kCosNodes - 1) * kRefine + 1;
-    const float r0 = row_roughness(j), r1 = row_roughness(j + 1);
-    std::vector<SpecularAlbedo> fine((kRefine + 1) * kFine);
-    for (int a = 0; a <= kRefine; ++a) {
-        const float roughness = std::lerp(r0, r1, static_cast<float>(a) / kRefine);
-        for (int b = 0; b < kFine; ++b) {
-            const int k = std::min(b / kRefine, kCosNodes - 2);
-            const float mu = std::lerp(node_cos_[k], node_cos_[k + 1],
-                                       static_cast<float>(b - k * kRefine) / kRefine);
-            fine[a * kFine + b] = integrate_specular_albedo(roughness, mu);
-        }
-    }
-    Cell& cell = cells_[j];
-    for (int row = 0; row < 2; ++row) {
-        for (int k = 0; k < kCosNodes; ++k) {
-            const SpecularAlbedo& e = fine[row * kRefine * kFine + k * kRefine];
-            cell.total[row * kCosNodes + k] = e.total;
-            cell.schlick[row * kCosNodes + k] = e.schlick;
-        }
-    }
-    auto bound = [&](std::array<float, 2 * kCosNodes>& nodes, float SpecularAlbedo::*member) {
-        std::array<float, 2 * kCosNodes> raise{};
-        for (int k = 0; k + 1 < kCosNodes; ++k) {
-            float deficit = 0.0f;
-            for (int a = 0; a <= kRefine; ++a) {
-                for (int db = 0; db <= kRefine; ++db) {
-                    const float wr = static_cast<float>(a) / kRefine;
-                    const float wm = static_cast<float>(db) / kRefine;
-                    const float interpolated = std::lerp(
-                        std::lerp(nodes[k], nodes[k + 1], wm),
-                        std::lerp(nodes[kCosNodes + k], nodes[kCosNodes + k + 1], wm), wr);
-                    const SpecularAlbedo& e = fine[a * kFine + k * kRefine + db];
-                    deficit = std::max(deficit, e.*member - interpolated);
-                }
-            }
-            for (int corner : {k, k + 1, kCosNodes + k, kCosNodes + k + 1}) {
-                raise[corner] = std::max(raise[corner], deficit);
-            }
-        }
-        for (size_t n = 0; n < nodes.size(); ++n) {
-            nodes[n] =
-                std::min(1.0f, (nodes[n] + raise[n]) * (1.0f + kRelativeMargin) + kAbsoluteMargin);
-        }
-    };
-    bound(cell.total, &SpecularAlbedo::total);
-    bound(cell.schlick, &SpecularAlbedo::schlick);
-
-    // Exact cosine-weighted integral of the piecewise-linear interpolant: on [a, a + h] with end
-    // values e0, e1, int 2 mu E dmu = h (a (e0 + e1) + h (e0 + 2 e1) / 3).
-    auto row_average = [&](const std::array<float, 2 * kCosNodes>& nodes, int row) {
-        double sum = 0.0;
-        for (int k = 0; k + 1 < kCosNodes; ++k) {
-            const double a = node_cos_[k], h = static_cast<double>(node_cos_[k + 1]) - a;
-            const double e0 = nodes[row * kCosNodes + k], e1 = nodes[row * kCosNodes + k + 1];
-            sum += h * (a * (e0 + e1) + h * (e0 + 2.0 * e1) / 3.0);
-        }
-        return static_cast<float>(sum);
-    };
-    for (int row = 0; row < 2; ++row) {
-        cell.average[row] = {row_average(cell.total, row), row_average(cell.schlick, row)};
-    }
-}
 
 /// Albedo of the GGX lobe without Fresnel and with the Schlick term: exact for the ideal
 /// mirror (1 and (1 - mu)^5; cell < 0), tabulated upper bounds for rough lobes.
@@ -292,7 +156,7 @@ BsdfMaterial::BsdfMaterial(const Material& material, float metallic_value, float
     // Rough reflection needs the albedo table (only the cell of this roughness is built).
     SpecularAlbedo avg{1.0f, 1.0f / 21.0f};  // ideal mirror: int (1 - mu)^5 2 mu dmu = 1/21
     if (!smooth && reflects) {
-        AlbedoTable& table = AlbedoTable::instance();
+        const AlbedoTable& table = AlbedoTable::instance();
         std::tie(albedo_cell, albedo_cell_weight) = table.locate_roughness(roughness);
         avg = table.average(albedo_cell, albedo_cell_weight);
     }

@@ -2,6 +2,7 @@
 // pdf(), sample weights against eval(), white-furnace energy bounds, reciprocity, the smooth
 // dielectric's Fresnel and Snell behaviour, lobe classification and shading-normal leaks.
 #include "core/material/bsdf.h"
+#include "core/material/albedo_table.h"
 #include "tests/support/chi_square.h"
 
 #include <gtest/gtest.h>
@@ -342,6 +343,28 @@ TEST(BsdfFurnace, NoDirectionReflectsMoreThanItReceives) {
         }
     }
     EXPECT_GT(configurations, 1000);
+}
+
+TEST(AlbedoTable, BuildsCellsAsTheIntegrationMakesThem) {
+    // The table is integrated when photond is built (core/tools/generate_albedo_table.cpp): the
+    // cells compiled in must be exactly what the integration gives here.
+    const std::array<float, albedo_table::kCosNodes> nodes = albedo_table::node_cos();
+    for (int j : {0, albedo_table::kRoughnessCells / 2, albedo_table::kRoughnessCells - 1}) {
+        const albedo_table::Cell fresh = albedo_table::build_cell(j, nodes);
+        const albedo_table::Cell& built = albedo_table::cell(j);
+        EXPECT_EQ(fresh.total, built.total) << "cell " << j;
+        EXPECT_EQ(fresh.schlick, built.schlick) << "cell " << j;
+        for (int row = 0; row < 2; ++row) {
+            EXPECT_EQ(fresh.average[row].total, built.average[row].total) << "cell " << j;
+            EXPECT_EQ(fresh.average[row].schlick, built.average[row].schlick) << "cell " << j;
+        }
+        // An albedo bound: positive, at most 1, and the Schlick-weighted part below the total.
+        for (size_t k = 0; k < built.total.size(); ++k) {
+            EXPECT_GT(built.total[k], 0.0f);
+            EXPECT_LE(built.total[k], 1.0f);
+            EXPECT_LE(built.schlick[k], built.total[k]);
+        }
+    }
 }
 
 TEST(BsdfFurnace, WhiteLambertReflectsEverything) {
