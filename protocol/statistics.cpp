@@ -43,6 +43,7 @@ nlohmann::json to_json(const RenderStatistics& s) {
             {"global_complete", p.global_complete},
             {"caustic_complete", p.caustic_complete},
             {"map_bytes", s.photon_map_bytes},
+            {"caustic_flux_share", s.caustic_flux_share},
         };
         if (!s.photon_cache.empty()) result["photons"]["cache"] = s.photon_cache;
         if (!s.photon_map_key.empty()) result["photons"]["key"] = s.photon_map_key;

@@ -133,8 +133,23 @@ Expected<std::shared_ptr<const PhotonMaps>> build_photon_maps(const protocol::Jo
     }
     stats.photons = maps->statistics;
     stats.photon_map_bytes = maps->bytes();
+    stats.caustic_flux_share = caustic_flux_share(*maps);
     for (std::string& warning : incomplete_photon_map_warnings(maps->statistics, settings))
         stats.warnings.push_back(std::move(warning));
+    if (caustic_stopped_as_negligible(maps->statistics, settings)) {
+        // Not a warning: the map is right, only its light is too faint to be worth more photons.
+        for (PassDecision& d : stats.plan) {
+            if (d.pass != "caustic_map") continue;
+            char text[320];
+            std::snprintf(text, sizeof text,
+                          "; stopped early at %llu of %u photons (%.1f M emitted): they carry %.2g %% of the light "
+                          "the global map brings to surfaces, under %.2g %%, so more would not show",
+                          static_cast<unsigned long long>(maps->statistics.stored_caustic), settings.caustic_photons,
+                          static_cast<double>(maps->statistics.emitted_caustic) * 1e-6,
+                          100.0 * stats.caustic_flux_share, 100.0 * kNegligibleCausticShare);
+            d.reason += text;
+        }
+    }
     const bool traced_here = stats.photon_cache != "hit";
     stats.passes.push_back({"photon_tracing", traced_here ? maps->statistics.tracing_seconds : 0.0});
     stats.passes.push_back({"photon_kdtree", traced_here ? maps->statistics.build_seconds : 0.0});
@@ -173,6 +188,13 @@ Expected<std::unique_ptr<Integrator>> make_integrator(const protocol::Job& job,
 
 }  // namespace
 
+bool caustic_stopped_as_negligible(const PhotonTracingStatistics& photons, const PhotonTracingSettings& settings) {
+    // Stopped short of the emission cap with photons in it: the negligible-share rule did it.
+    return settings.caustic_photons > 0 && !photons.caustic_complete && photons.stored_caustic > 0 &&
+           photons.emitted_caustic <
+               static_cast<uint64_t>(settings.caustic_photons) * settings.max_emitted_per_stored;
+}
+
 std::vector<std::string> incomplete_photon_map_warnings(const PhotonTracingStatistics& photons,
                                                         const PhotonTracingSettings& settings) {
     std::vector<std::string> warnings;
@@ -202,7 +224,7 @@ std::vector<std::string> incomplete_photon_map_warnings(const PhotonTracingStati
                            "; emission stopped at " + millions(emitted) + " photons, the cap of " +
                            grouped(settings.max_emitted_per_stored) + " per requested photon): " + consequence);
     };
-    if (settings.caustic_photons > 0 && !photons.caustic_complete)
+    if (settings.caustic_photons > 0 && !photons.caustic_complete && !caustic_stopped_as_negligible(photons, settings))
         incomplete("caustic", photons.stored_caustic, settings.caustic_photons, photons.emitted_caustic,
                    "little light reaches a diffuse surface through the specular ones, so its caustics are noisy. "
                    "Set photons.caustic=0 to skip the caustic map, or give the scene more specular surfaces in "

@@ -53,6 +53,7 @@ struct MapBuilder {
     bool complete = true;
     uint64_t emitted = 0;     // photons emitted for this map (set when it fills or stops)
     size_t count = 0;         // photons collected so far, over all parts
+    double flux_sum = 0.0;    // their flux's luminance, not yet divided by the emissions
     /// The collected photons in emission order: the chunks' own buffers, moved in rather than
     /// copied (copying every photon into one fresh array cost about a fifth of tracing).
     std::vector<TracedPhotons> parts;
@@ -70,6 +71,7 @@ struct MapBuilder {
                 active = false;
             }
             count += photons.size();
+            for (const TracedPhoton& p : photons) flux_sum += static_cast<double>(luminance(p.flux));
             parts.push_back(std::move(photons));
             photons = {};
             if (!active) return;
@@ -194,6 +196,17 @@ std::shared_ptr<const PhotonMap> finish_map(MapBuilder& builder) {
 
 }  // namespace
 
+double caustic_flux_share(const PhotonMaps& maps) {
+    if (!maps.global || !maps.caustic) return 0.0;
+    const auto total = [](const PhotonMap& map) {
+        double sum = 0.0;
+        for (const Photon& p : map.tree().photons()) sum += static_cast<double>(luminance(p.flux()));
+        return sum;
+    };
+    const double global = total(*maps.global);
+    return global > 0.0 ? total(*maps.caustic) / global : 0.0;
+}
+
 Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSettings& settings) {
     if (rs.lights->empty())
         return Error{"photon pass: the scene has no light with positive power, so no photon can be emitted"};
@@ -267,6 +280,17 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
         global.append(batch_chunks, &ChunkOutput::global, emitted);
         caustic.append(batch_chunks, &ChunkOutput::caustic, emitted);
         emitted += batch;
+        // A caustic map that carries next to no light is not worth its emissions: stop it.
+        if (caustic.active && global.target > 0 && !global.active && global.emitted > 0 && global.flux_sum > 0.0 &&
+            caustic.count >= kCausticShareMinPhotons) {
+            const double share = (caustic.flux_sum / static_cast<double>(emitted)) /
+                                 (global.flux_sum / static_cast<double>(global.emitted));
+            if (share < kNegligibleCausticShare) {
+                caustic.active = false;
+                caustic.complete = false;
+                caustic.emitted = emitted;
+            }
+        }
         for (MapBuilder* m : {&global, &caustic}) {
             // A map that nothing reached after a fair trial will not fill: stop early.
             const bool hopeless = m->count == 0 && emitted >= std::max<uint64_t>(kEmptyMapTrial, m->target);

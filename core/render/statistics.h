@@ -43,6 +43,7 @@ struct RenderStatistics {
     /// The photon pass, when one ran or its maps came from the cache.
     std::optional<PhotonTracingStatistics> photons;
     size_t photon_map_bytes = 0;
+    double caustic_flux_share = 0.0;  // caustic_flux_share (core/photon/photon_tracer.h) of the maps used
     /// "hit" when the photon maps came from the cache, "miss" when traced and stored, empty when
     /// no cache was used.
     std::string photon_cache;

@@ -15,7 +15,7 @@ struct PhotonTracingSettings;
 
 /// Bump when photon tracing changes what it stores for the same scene and settings (sampling,
 /// Russian roulette, flux encoding, kd-tree order): every cached photon map then misses.
-inline constexpr uint32_t kPhotonMapAlgorithmVersion = 5;
+inline constexpr uint32_t kPhotonMapAlgorithmVersion = 6;
 
 /// SHA-256 of the scene's light-transport content: positions, normals, uvs, triangles, triangle
 /// materials, every Material field but the name, textures (size and texels) and punctual lights

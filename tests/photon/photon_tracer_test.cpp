@@ -2,6 +2,8 @@
 // against an analytic irradiance, and scenes where photons cannot land.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 
 #include "core/photon/photon_tracer.h"
@@ -169,6 +171,66 @@ TEST(PhotonTracer, LightsFacingAwayEndWithAMessageInsteadOfLooping) {
     ASSERT_FALSE(maps.has_value());
     EXPECT_NE(maps.error().message.find("no photon"), std::string::npos) << maps.error().message;
     EXPECT_NE(maps.error().message.find("global"), std::string::npos) << maps.error().message;
+}
+
+/// The closed room lit by a point light of intensity 1 at (0, 1, 0), over a square ideal mirror
+/// of side `side` facing it at y = -1: the mirror's caustic carries the light's flux times the
+/// mirror's solid angle over 4 pi, onto the diffuse walls.
+Scene room_with_a_mirror(float side) {
+    Scene scene = closed_room(0.8f, Vec3(0.0f, 1.0f, 0.0f), Color(1.0f));
+    SceneBuilder builder("mirror room");
+    for (const Material& m : scene.materials) builder.add_material(m);
+    Material mirror;
+    mirror.metallic = 1.0f;
+    mirror.roughness = 0.0f;
+    mirror.base_color = Color(1.0f);
+    const uint32_t mirror_material = builder.add_material(mirror);
+    MeshData room = make_box(Vec3(-2.0f), Vec3(2.0f));
+    flip_orientation(room);
+    EXPECT_TRUE(add_mesh(builder, room, 0).is_ok());
+    const float h = 0.5f * side;
+    EXPECT_TRUE(
+        add_mesh(builder,
+                 make_quad(Vec3(-h, -1.0f, -h), Vec3(side, 0, 0), Vec3(0, 0, side), Vec3(0, 1, 0)),
+                 mirror_material)
+            .is_ok());
+    builder.add_light(scene.lights.at(0));
+    return builder.build().value();
+}
+
+TEST(PhotonTracer, CausticMapCarryingNegligibleLightStopsEarlyAndStaysUnbiased) {
+    PhotonTracingSettings settings;
+    settings.global_photons = 20000;
+    settings.caustic_photons = 20000;
+    // A 0.1 x 0.1 mirror 2 below the light: 1 photon in 5,000 reaches it, and its caustic is
+    // about 4e-5 of what the walls receive in all: the map stops long before its cap (20 M).
+    const auto small = trace_photons(*make_render_scene(room_with_a_mirror(0.1f)), settings);
+    ASSERT_TRUE(small) << small.error().message;
+    const PhotonTracingStatistics& s = small->statistics;
+    EXPECT_FALSE(s.caustic_complete);
+    EXPECT_GE(s.stored_caustic, kCausticShareMinPhotons);
+    EXPECT_LT(s.emitted_caustic, 4'000'000u) << "stopped at the cap, not by the share";
+    const double share = caustic_flux_share(*small);
+    EXPECT_GT(share, 0.0);
+    EXPECT_LT(share, kNegligibleCausticShare);
+    // What was traced is kept, divided by the photons emitted for it: the caustic's flux is the
+    // light's intensity times the mirror's solid angle (a rectangle a x b at distance d:
+    // 4 asin(ab / sqrt((a^2 + 4 d^2)(b^2 + 4 d^2)))), within the noise of ~200 photons.
+    const double solid_angle = 4.0 * std::asin(0.01 / std::sqrt((0.01 + 16.0) * (0.01 + 16.0)));
+    const double caustic_flux = summed_flux(*small->caustic, 0).x;
+    EXPECT_NEAR(caustic_flux / solid_angle, 1.0, 0.25) << s.stored_caustic << " photons";
+    std::printf(
+        "small mirror: %llu caustic photons of %llu emitted, share %.3g, flux / expected %.3f\n",
+        static_cast<unsigned long long>(s.stored_caustic),
+        static_cast<unsigned long long>(s.emitted_caustic), share, caustic_flux / solid_angle);
+
+    // A mirror a hundred times larger casts a caustic worth tracing: the map fills.
+    settings.caustic_photons = 5000;
+    const auto large = trace_photons(*make_render_scene(room_with_a_mirror(1.0f)), settings);
+    ASSERT_TRUE(large) << large.error().message;
+    EXPECT_TRUE(large->statistics.caustic_complete);
+    EXPECT_EQ(large->statistics.stored_caustic, 5000u);
+    EXPECT_GT(caustic_flux_share(*large), kNegligibleCausticShare);
 }
 
 TEST(PhotonTracer, SceneWithoutLightsIsRefused) {
