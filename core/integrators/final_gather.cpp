@@ -25,15 +25,18 @@ FinalGatherer::FinalGatherer(std::shared_ptr<const RenderScene> scene, std::shar
 namespace {
 
 /// Radiance leaving a non-delta surface towards wo, from the photon maps: precomputed
-/// irradiance times rho / pi where the surface is Lambertian, else the global map's estimate.
+/// irradiance times rho / pi where every lobe is diffuse or as rough as the photon passes take
+/// for diffuse (the rough metal and dielectric layer of most glTF materials: read by their
+/// albedo at wo, exact under uniform light, instead of evaluating the BSDF per photon), else the
+/// global map's estimate.
 Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si, const Bsdf& bsdf,
                             const Vec3& wo, const GatherSettings& settings) {
     if (!maps.global) return Color(0.0f);
     const Vec3 n = glm::dot(si.surface_normal, wo) >= 0.0f ? si.surface_normal : -si.surface_normal;
-    if (maps.irradiance && !bsdf.has_non_lambertian_non_delta()) {
+    if (maps.irradiance && bsdf.reads_as_diffuse()) {
         Color e;
         if (maps.irradiance->nearest_irradiance(si.p, n, settings.max_radius, &e))
-            return bsdf.diffuse_reflectance(wo) * kInvPi * e;
+            return bsdf.diffuse_like_reflectance(wo) * kInvPi * e;
     }
     RadianceEstimateOptions options;
     options.k = settings.k_global;

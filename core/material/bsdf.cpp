@@ -243,6 +243,23 @@ Color Bsdf::diffuse_reflectance(const Vec3& wo) const {
     return lambert_albedo(std::min(std::abs(glm::dot(wo, frame_.n)), 1.0f));
 }
 
+bool Bsdf::reads_as_diffuse() const {
+    const bool rough_glass = m_->glass_weight > 0.0f && !m_->glass_delta;
+    const bool rough_coat = m_->coat > 0.0f && !m_->coat_smooth;
+    return (lobes_ & mask_of(LobeKind::Glossy)) == 0 && !rough_glass && !rough_coat;
+}
+
+Color Bsdf::diffuse_like_reflectance(const Vec3& wo) const {
+    const float mu = std::min(std::abs(glm::dot(wo, frame_.n)), 1.0f);
+    Color rho = lambert_albedo(mu);
+    if (!m_->smooth && !m_->lambertian_only && (m_->metallic > 0.0f || m_->layer_weight > 0.0f)) {
+        // The coat, when there is one, passes light towards wo and on average from all wi.
+        const float coat = m_->coat > 0.0f ? coat_through(mu) * (1.0f - m_->coat * kCoatFresnelMean) : 1.0f;
+        rho += specular_albedo(mu) * coat;
+    }
+    return rho;
+}
+
 bool Bsdf::has_non_lambertian_non_delta() const {
     const bool rough_reflection = !m_->smooth && (m_->metallic > 0.0f || (m_->layer_weight > 0.0f && m_->specular_f90 > 0.0f));
     const bool rough_glass = m_->glass_weight > 0.0f && !m_->glass_delta;

@@ -188,6 +188,15 @@ public:
     /// Reflectance of the Lambertian lobe towards wo under uniform incident radiance: exact
     /// L_o(wo) = rho_d(wo) / pi * E for uniform (ambient) lighting, and the lobe's albedo.
     Color diffuse_reflectance(const Vec3& wo) const;
+    /// Whether every non-delta lobe is one the photon passes take as diffuse (roughness at
+    /// least kGlossyRoughness: Lambert, rough metal, rough dielectric layer; no non-delta
+    /// transmission and no rough clearcoat). Then final-gather hits read the surface as
+    /// diffuse_like_reflectance(wo) / pi * E.
+    bool reads_as_diffuse() const;
+    /// Reflectance towards wo of every non-delta reflection lobe under uniform incident
+    /// radiance (Lambert, and the metal and dielectric layer when rough): L_o(wo) = rho(wo) /
+    /// pi * E, exact for uniform lighting. For BSDFs that reads_as_diffuse().
+    Color diffuse_like_reflectance(const Vec3& wo) const;
 
 private:
     // Sampling slots: the Lambertian lobe, the specular reflection (metal + dielectric layer,

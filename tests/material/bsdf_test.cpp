@@ -426,6 +426,31 @@ TEST(BsdfFurnace, DiffuseReflectanceMatchesTheLambertLobe) {
 // ---------------------------------------------------------------------------------------------
 // Reciprocity and the radiance/importance adjoint relation.
 
+TEST(BsdfFurnace, RoughLobesReadAsDiffuseReflectTheirAlbedo) {
+    // Final-gather hits read a surface whose lobes are all as rough as the photon passes take
+    // for diffuse by rho(wo) / pi * E: rho(wo) must be the albedo of every non-delta lobe.
+    const Color c(0.8f, 0.5f, 0.2f);
+    for (const auto& [metallic, roughness] : {std::pair{0.0f, 0.6f}, {1.0f, 0.7f}, {0.5f, 0.5f}, {0.0f, 1.0f}}) {
+        const Bsdf bsdf = make_bsdf(make_material(metallic, roughness), c);
+        ASSERT_TRUE(bsdf.reads_as_diffuse()) << metallic << " " << roughness;
+        for (double theta : {0.0, 45.0, 75.0}) {
+            const Vec3 wo = direction(theta);
+            const Albedo a = estimate_albedo(bsdf, wo, TransportMode::Radiance, 40000,
+                                             7 + static_cast<uint64_t>(theta));
+            const Color rho = bsdf.diffuse_like_reflectance(wo);
+            for (int ch = 0; ch < 3; ++ch) {
+                // The table bounds the layer's albedo from above by a margin of about 0.5 %.
+                EXPECT_NEAR(rho[ch], a.mean[ch], 3.0f * a.sigma[ch] + 0.01f)
+                    << "metallic " << metallic << " roughness " << roughness << " theta " << theta << " ch " << ch;
+            }
+        }
+    }
+    // Glossy lobes and rough transmission are read from the photons, not as diffuse.
+    EXPECT_FALSE(make_bsdf(make_material(1.0f, 0.2f), c).reads_as_diffuse());
+    EXPECT_FALSE(make_bsdf(make_material(0.0f, 0.6f, 1.0f), c).reads_as_diffuse());
+    EXPECT_TRUE(make_bsdf(make_material(0.0f, 0.0f), c).reads_as_diffuse());  // smooth layer: delta
+}
+
 TEST(BsdfReciprocity, ReflectionIsSymmetricAndTransmissionAdjoint) {
     Rng rng = Rng::for_stream(42, 0);
     int reflections = 0, transmissions = 0;
