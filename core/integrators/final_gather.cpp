@@ -32,8 +32,12 @@ namespace {
 Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si, const Bsdf& bsdf,
                             const Vec3& wo, const GatherSettings& settings) {
     if (!maps.global) return Color(0.0f);
-    const Vec3 n = glm::dot(si.surface_normal, wo) >= 0.0f ? si.surface_normal : -si.surface_normal;
-    if (maps.irradiance && bsdf.reads_as_diffuse()) {
+    const bool front = glm::dot(si.surface_normal, wo) >= 0.0f;
+    const Vec3 n = front ? si.surface_normal : -si.surface_normal;
+    // A normal map bends the shading normal: the precomputed irradiance (about the unbent
+    // normal) would light the surface as if flat, and brighten what it lights in turn.
+    const Vec3 bent = bent_shading_normal(si, front);
+    if (maps.irradiance && bsdf.reads_as_diffuse() && bent == Vec3(0.0f)) {
         Color e;
         if (maps.irradiance->nearest_irradiance(si.p, n, settings.max_radius, &e))
             return bsdf.diffuse_like_reflectance(wo) * kInvPi * e;
@@ -41,6 +45,7 @@ Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si
     RadianceEstimateOptions options;
     options.k = settings.k_global;
     options.max_radius = settings.max_radius;
+    options.shading_normal = bent;
     return maps.global->estimate_radiance(si.p, n, bsdf, wo, options);
 }
 

@@ -85,10 +85,15 @@ Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_
         const int glossy_rays = std::max(settings_.glossy_rays, 1);
         radiance += sample_direct_light(rs, *direct_lights_, si, bsdf, wo, context, false, kAllLobes,
                                         glossy ? glossy_lobes : LobeMask(0), static_cast<float>(glossy_rays));
-        // Photon discs and cache records follow the surface, not its normal map (README).
-        const Vec3 normal = glm::dot(si.surface_normal, wo) >= 0.0f ? si.surface_normal : -si.surface_normal;
-        if (maps_->caustic)
-            radiance += maps_->caustic->estimate_radiance(si.p, normal, bsdf, wo, caustic_options_);
+        // Photon discs and cache records follow the surface, not its normal map; estimates weight
+        // their photons by the mapped normal (RadianceEstimateOptions::shading_normal; README).
+        const bool front = glm::dot(si.surface_normal, wo) >= 0.0f;
+        const Vec3 normal = front ? si.surface_normal : -si.surface_normal;
+        if (maps_->caustic) {
+            RadianceEstimateOptions caustic = caustic_options_;
+            caustic.shading_normal = bent_shading_normal(si, front);
+            radiance += maps_->caustic->estimate_radiance(si.p, normal, bsdf, wo, caustic);
+        }
         if (gatherer_) {
             const Color rho = bsdf.diffuse_reflectance(wo);
             if (max_component(rho) > 0.0f) {
@@ -120,7 +125,9 @@ Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_
                 radiance += sum / static_cast<float>(glossy_rays);
             }
         } else if (maps_->global) {
-            radiance += maps_->global->estimate_radiance(si.p, normal, bsdf, wo, global_options_);
+            RadianceEstimateOptions global = global_options_;
+            global.shading_normal = bent_shading_normal(si, front);
+            radiance += maps_->global->estimate_radiance(si.p, normal, bsdf, wo, global);
         }
     }
     if (bsdf.has_delta() && depth < settings_.max_specular_depth) {

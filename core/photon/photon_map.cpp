@@ -53,6 +53,7 @@ Color PhotonMap::estimate_radiance(const Vec3& p, const Vec3& normal, const Bsdf
     // Cone filter weight w = 1 - d / (k_cone r), normalised by 1 - 2 / (3 k_cone) (Jensen 2001).
     constexpr double kCone = 1.1;
     DVec3 sum(0.0);
+    const bool bent = glm::dot(options.shading_normal, options.shading_normal) > 0.0f;
     for (const KnnNeighbor& n : found.neighbors) {
         const Photon& photon = tree_.photon(n.index);
         if (photon.user_flags() & options.exclude_flags) continue;
@@ -60,6 +61,13 @@ Color PhotonMap::estimate_radiance(const Vec3& p, const Vec3& normal, const Bsdf
         const Vec3 wi = -photon.direction();
         const Color f = bsdf.eval(wo, wi, TransportMode::Radiance, options.lobes);
         DVec3 contribution = DVec3(f) * DVec3(photon.flux());
+        if (bent) {
+            const float cos_bent = glm::dot(options.shading_normal, wi);
+            if (!(cos_bent > 0.0f)) continue;
+            // photon_counts() kept only photons in front of `normal`; the floor bounds the
+            // weight of the few that graze it.
+            contribution *= static_cast<double>(cos_bent / std::max(glm::dot(normal, wi), 0.05f));
+        }
         if (options.cone_filter) contribution *= 1.0 - std::sqrt(static_cast<double>(n.dist2)) / (kCone * r);
         sum += contribution;
     }

@@ -52,6 +52,10 @@ struct RadianceEstimateOptions {
     /// the global map is read for indirect light only).
     uint8_t exclude_flags = 0;
     LobeMask lobes = kNonDeltaLobes;  // which BSDF lobes reflect the photons
+    /// Non-zero on a surface whose shading normal is bent (a normal map), on wo's side: the
+    /// photons' density is per area of the unbent surface (`normal`), so each one counts
+    /// cos(shading_normal, wi) / cos(normal, wi) as much, and none from behind the bent normal.
+    Vec3 shading_normal{0.0f};
 };
 
 class PhotonMap {

@@ -25,6 +25,14 @@ struct SurfaceInteraction {
     float distance = 0.0f;  // ray parameter t of the hit
 };
 
+/// The shading normal where a normal texture bent it away from surface_normal (on the side
+/// `front` says: surface_normal's when true), else zero: photon estimates then weight their
+/// photons by it (RadianceEstimateOptions::shading_normal).
+inline Vec3 bent_shading_normal(const SurfaceInteraction& si, bool front) {
+    if (glm::dot(si.shading_normal, si.surface_normal) > 0.99999f) return Vec3(0.0f);
+    return front ? si.shading_normal : -si.shading_normal;
+}
+
 /// Interpolated normals that point away from the geometric side are flipped onto it, so that
 /// inverted vertex normals in the input cannot turn a surface inside out.
 inline Vec3 oriented_shading_normal(const Vec3& shading, const Vec3& geometric) {

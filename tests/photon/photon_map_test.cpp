@@ -108,5 +108,41 @@ TEST(PhotonMap, AFlatSurfaceReadsTheSameWithOrWithoutNormals) {
     }
 }
 
+TEST(PhotonMap, OnANormalMappedSurfaceEachPhotonCountsByTheBentNormal) {
+    // Photons on the floor y = 0 (normal up), all arriving 60 degrees off the normal from -x.
+    // A normal map tilting the shading normal 30 degrees towards them makes the floor's facet
+    // face them at 30 degrees: cos 30 / cos 60 = 1.732 times the flat floor's radiance; tilted
+    // 36 degrees away, the facet turns its back to them: nothing.
+    std::vector<Photon> photons;
+    Rng rng(5, 6);
+    const Vec3 travel(std::sin(kPi / 3.0f), -std::cos(kPi / 3.0f), 0.0f);
+    for (int i = 0; i < 4000; ++i) {
+        const Vec3 p(rng.next_float(), 0.0f, rng.next_float());
+        photons.push_back(make_photon(p, travel, Color(1e-3f), 0, Vec3(0.0f, 1.0f, 0.0f)));
+    }
+    const PhotonMap map(std::move(photons), 4000);
+    const Vec3 p(0.5f, 0.0f, 0.5f), up(0.0f, 1.0f, 0.0f);
+    const Material white = white_material();
+    const BsdfMaterial constants(white);
+    const auto estimate = [&](const Vec3& bent) {
+        const Vec3 shading = glm::dot(bent, bent) > 0.0f ? bent : up;
+        const Bsdf bsdf(constants, white.base_color, Frame(shading), up);
+        RadianceEstimateOptions options;
+        options.k = 200;
+        options.max_radius = 0.3f;
+        options.shading_normal = bent;
+        return map.estimate_radiance(p, up, bsdf, up, options).x;
+    };
+    const float flat = estimate(Vec3(0.0f));
+    ASSERT_GT(flat, 0.0f);
+    const Vec3 towards(-std::sin(kPi / 6.0f), std::cos(kPi / 6.0f), 0.0f);  // towards where they come from
+    const Vec3 away(std::sin(kPi / 5.0f), std::cos(kPi / 5.0f), 0.0f);      // 36 degrees: cos 96 < 0
+    // The stored direction is quantised (to about a degree): the ratio is the decoded one's.
+    const Vec3 wi = -map.tree().photon(0).direction();
+    EXPECT_NEAR(glm::dot(towards, wi) / glm::dot(up, wi), std::cos(kPi / 6.0f) / std::cos(kPi / 3.0f), 0.02);
+    EXPECT_NEAR(estimate(towards) / flat, glm::dot(towards, wi) / glm::dot(up, wi), 1e-4);
+    EXPECT_EQ(estimate(away), 0.0f);
+}
+
 }  // namespace
 }  // namespace photond
