@@ -150,6 +150,13 @@ Expected<std::shared_ptr<const PhotonMaps>> build_photon_maps(const protocol::Jo
             d.reason += text;
         }
     }
+    if (settings.caustic_photons > 0 && maps->statistics.stored_caustic == 0) {
+        for (PassDecision& d : stats.plan) {
+            if (d.pass != "caustic_map") continue;
+            d.reason += "; no photon reached a diffuse surface through them after " +
+                        std::to_string(maps->statistics.emitted_caustic) + " emitted: the scene has no caustics";
+        }
+    }
     const bool traced_here = stats.photon_cache != "hit";
     stats.passes.push_back({"photon_tracing", traced_here ? maps->statistics.tracing_seconds : 0.0});
     stats.passes.push_back({"photon_kdtree", traced_here ? maps->statistics.build_seconds : 0.0});
@@ -224,7 +231,9 @@ std::vector<std::string> incomplete_photon_map_warnings(const PhotonTracingStati
                            "; emission stopped at " + millions(emitted) + " photons, the cap of " +
                            grouped(settings.max_emitted_per_stored) + " per requested photon): " + consequence);
     };
-    if (settings.caustic_photons > 0 && !photons.caustic_complete && !caustic_stopped_as_negligible(photons, settings))
+    // An empty caustic map is not incomplete: no light focuses (the plan's reason says so).
+    if (settings.caustic_photons > 0 && !photons.caustic_complete && photons.stored_caustic > 0 &&
+        !caustic_stopped_as_negligible(photons, settings))
         incomplete("caustic", photons.stored_caustic, settings.caustic_photons, photons.emitted_caustic,
                    "little light reaches a diffuse surface through the specular ones, so its caustics are noisy. "
                    "Set photons.caustic=0 to skip the caustic map, or give the scene more specular surfaces in "

@@ -7,6 +7,13 @@
 
 namespace photond {
 
+namespace {
+
+/// Glossy lobes a gather ray follows by sampling before it reads the photon maps with them.
+constexpr int kMaxGlossyGatherBounces = 2;
+
+}  // namespace
+
 GatherGrid GatherGrid::for_rays(uint32_t rays) {
     // N ~ pi M (Ward): M = sqrt(rays / pi), N = rays / M.
     GatherGrid g;
@@ -30,14 +37,14 @@ namespace {
 /// albedo at wo, exact under uniform light, instead of evaluating the BSDF per photon), else the
 /// global map's estimate.
 Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si, const Bsdf& bsdf,
-                            const Vec3& wo, const GatherSettings& settings) {
+                            const Vec3& wo, const GatherSettings& settings, LobeMask lobes = kNonDeltaLobes) {
     if (!maps.global) return Color(0.0f);
     const bool front = glm::dot(si.surface_normal, wo) >= 0.0f;
     const Vec3 n = front ? si.surface_normal : -si.surface_normal;
     // A normal map bends the shading normal: the precomputed irradiance (about the unbent
     // normal) would light the surface as if flat, and brighten what it lights in turn.
     const Vec3 bent = bent_shading_normal(si, front);
-    if (maps.irradiance && bsdf.reads_as_diffuse() && bent == Vec3(0.0f)) {
+    if (maps.irradiance && bsdf.reads_as_diffuse(lobes) && bent == Vec3(0.0f)) {
         Color e;
         if (maps.irradiance->nearest_irradiance(si.p, n, settings.max_radius, &e))
             return bsdf.diffuse_like_reflectance(wo) * kInvPi * e;
@@ -46,6 +53,8 @@ Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si
     options.k = settings.k_global;
     options.max_radius = settings.max_radius;
     options.shading_normal = bent;
+    options.both_sides = bsdf.transmits_non_delta();
+    options.lobes = lobes;
     return maps.global->estimate_radiance(si.p, n, bsdf, wo, options);
 }
 
@@ -54,17 +63,29 @@ Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si
 Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& counters, float* distance,
                                          FirstHitEmission* emission) const {
     const RenderScene& rs = *scene_;
-    // Walk through ideal specular surfaces; `depth` counts them.
+    // Walk through ideal specular surfaces; `depth` counts them. At glossy surfaces the glossy
+    // lobes are followed too (up to kMaxGlossyGatherBounces): reading them from the photons
+    // would evaluate a sharp lobe per photon, whose rare aligned photons are fireflies.
     struct Walker {
         const FinalGatherer& g;
         const RenderScene& rs;
         Rng& rng;
         RayCounters& counters;
         FirstHitEmission* emission;
-        Color along(const Ray& r, int depth, float* first_distance) const {
+        /// Where a ray that samples a glossy lobe started, and the lobe's pdf for it (0 once a
+        /// delta bounce followed: then no light sample could have found what it meets).
+        struct GlossyOrigin {
+            Vec3 point;
+            float pdf;
+        };
+        Color along(const Ray& r, int depth, float* first_distance, int glossy_bounces = 0,
+                    const GlossyOrigin* from = nullptr) const {
             const std::optional<Hit> hit = trace_ray(rs, r, counters);
             if (first_distance) *first_distance = hit ? hit->t : std::numeric_limits<float>::infinity();
             if (!hit) {
+                // After a glossy lobe, the whole sky and soft suns, weighted against the light
+                // samples taken where the lobe was sampled.
+                if (from) return rs.lights->escaped_radiance(r.direction, from->pdf);
                 // Also through specular surfaces: caustic photons leave the diffuse sky out
                 // (trace_photons), so that this is its only way to a surface.
                 if (g.settings_.gather_diffuse_sky && rs.diffuse_sky) return rs.diffuse_sky->radiance(r.direction);
@@ -77,16 +98,52 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
                 emission->triangle = si.triangle;
                 emission->point = si.p;
             }
-            const Bsdf bsdf = make_bsdf(rs, si, wo);
             Color radiance(0.0f);
-            if (bsdf.has_non_delta()) radiance += radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_);
+            if (from) {
+                const Color emitted = rs.lights->emitted_radiance(si, wo);
+                if (!is_black(emitted)) {
+                    const float weight =
+                        from->pdf > 0.0f
+                            ? power_heuristic(from->pdf, rs.lights->pdf_incident_triangle(si.triangle, from->point, si.p))
+                            : 1.0f;
+                    radiance += emitted * weight;
+                }
+            }
+            const Bsdf bsdf = make_bsdf(rs, si, wo);
+            if (bsdf.has_non_delta()) {
+                constexpr LobeMask kGlossy = mask_of(LobeKind::Glossy);
+                if ((bsdf.lobes() & kGlossy) && glossy_bounces < kMaxGlossyGatherBounces) {
+                    radiance += glossy_lobes(si, bsdf, wo, depth, glossy_bounces);
+                    radiance += radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_, kNonDeltaLobes & ~kGlossy);
+                } else {
+                    radiance += radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_);
+                }
+            }
             if (bsdf.has_delta() && depth < g.settings_.max_specular_depth) {
                 // One lobe per gather ray is enough: the gather averages many rays.
+                const GlossyOrigin after_delta{si.p, 0.0f};
                 radiance += follow_delta_lobes(bsdf, wo, false, rng, [&](const BsdfSample& s) {
-                    return along(spawn_ray(rs, si, s.wi), depth + 1, nullptr);
+                    return along(spawn_ray(rs, si, s.wi), depth + 1, nullptr, glossy_bounces,
+                                 from ? &after_delta : nullptr);
                 });
             }
             return volume_transmittance(*rs.scene, si) * radiance;
+        }
+        /// The glossy lobes' reflection at a gather hit, as a path tracer takes it: a light
+        /// sample and a lobe sample, weighted by the power heuristic.
+        Color glossy_lobes(const SurfaceInteraction& si, const Bsdf& bsdf, const Vec3& wo, int depth,
+                           int glossy_bounces) const {
+            constexpr LobeMask kGlossy = mask_of(LobeKind::Glossy);
+            SampleContext context{rng, counters};
+            Color radiance = sample_direct_light(rs, *rs.lights, si, bsdf, wo, context, true, kGlossy);
+            const float u_lobe = rng.next_float();
+            const Vec2 u = rng.next_vec2();
+            const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Radiance, kGlossy);
+            if (s && s->pdf > 0.0f && !is_black(s->weight)) {
+                const GlossyOrigin origin{si.p, s->pdf};
+                radiance += s->weight * along(spawn_ray(rs, si, s->wi), depth, nullptr, glossy_bounces + 1, &origin);
+            }
+            return radiance;
         }
     };
     if (emission) *emission = FirstHitEmission{};

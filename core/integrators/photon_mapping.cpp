@@ -92,6 +92,7 @@ Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_
         if (maps_->caustic) {
             RadianceEstimateOptions caustic = caustic_options_;
             caustic.shading_normal = bent_shading_normal(si, front);
+            caustic.both_sides = bsdf.transmits_non_delta();
             radiance += maps_->caustic->estimate_radiance(si.p, normal, bsdf, wo, caustic);
         }
         if (gatherer_) {
@@ -127,6 +128,7 @@ Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_
         } else if (maps_->global) {
             RadianceEstimateOptions global = global_options_;
             global.shading_normal = bent_shading_normal(si, front);
+            global.both_sides = bsdf.transmits_non_delta();
             radiance += maps_->global->estimate_radiance(si.p, normal, bsdf, wo, global);
         }
     }

@@ -243,16 +243,20 @@ Color Bsdf::diffuse_reflectance(const Vec3& wo) const {
     return lambert_albedo(std::min(std::abs(glm::dot(wo, frame_.n)), 1.0f));
 }
 
-bool Bsdf::reads_as_diffuse() const {
-    const bool rough_glass = m_->glass_weight > 0.0f && !m_->glass_delta;
-    const bool rough_coat = m_->coat > 0.0f && !m_->coat_smooth;
-    return (lobes_ & mask_of(LobeKind::Glossy)) == 0 && !rough_glass && !rough_coat;
+bool Bsdf::reads_as_diffuse(LobeMask lobes) const {
+    const bool glossy = (lobes & lobes_ & mask_of(LobeKind::Glossy)) != 0;
+    const bool rough_glass = m_->glass_weight > 0.0f && !m_->glass_delta && in_mask(lobes, m_->glass_kind);
+    const bool rough_coat = m_->coat > 0.0f && !m_->coat_smooth && in_mask(lobes, m_->coat_kind);
+    return !glossy && !rough_glass && !rough_coat;
 }
+
+bool Bsdf::transmits_non_delta() const { return m_->glass_weight > 0.0f && !m_->glass_delta; }
 
 Color Bsdf::diffuse_like_reflectance(const Vec3& wo) const {
     const float mu = std::min(std::abs(glm::dot(wo, frame_.n)), 1.0f);
     Color rho = lambert_albedo(mu);
-    if (!m_->smooth && !m_->lambertian_only && (m_->metallic > 0.0f || m_->layer_weight > 0.0f)) {
+    if (m_->specular_kind == LobeKind::Diffuse && !m_->lambertian_only &&
+        (m_->metallic > 0.0f || m_->layer_weight > 0.0f)) {
         // The coat, when there is one, passes light towards wo and on average from all wi.
         const float coat = m_->coat > 0.0f ? coat_through(mu) * (1.0f - m_->coat * kCoatFresnelMean) : 1.0f;
         rho += specular_albedo(mu) * coat;

@@ -188,14 +188,16 @@ public:
     /// Reflectance of the Lambertian lobe towards wo under uniform incident radiance: exact
     /// L_o(wo) = rho_d(wo) / pi * E for uniform (ambient) lighting, and the lobe's albedo.
     Color diffuse_reflectance(const Vec3& wo) const;
-    /// Whether every non-delta lobe is one the photon passes take as diffuse (roughness at
-    /// least kGlossyRoughness: Lambert, rough metal, rough dielectric layer; no non-delta
-    /// transmission and no rough clearcoat). Then final-gather hits read the surface as
-    /// diffuse_like_reflectance(wo) / pi * E.
-    bool reads_as_diffuse() const;
-    /// Reflectance towards wo of every non-delta reflection lobe under uniform incident
-    /// radiance (Lambert, and the metal and dielectric layer when rough): L_o(wo) = rho(wo) /
-    /// pi * E, exact for uniform lighting. For BSDFs that reads_as_diffuse().
+    /// Whether the non-delta lobes of `lobes` are ones the photon passes take as diffuse
+    /// (roughness at least kGlossyRoughness: Lambert, rough metal, rough dielectric layer; no
+    /// glossy lobe, no non-delta transmission and no rough clearcoat among them). Then
+    /// final-gather hits read their share as diffuse_like_reflectance(wo) / pi * E.
+    bool reads_as_diffuse(LobeMask lobes = kNonDeltaLobes) const;
+    /// Whether light passes through a non-delta lobe (rough transmission).
+    bool transmits_non_delta() const;
+    /// Reflectance towards wo of the lobes of diffuse kind under uniform incident radiance
+    /// (Lambert, and the metal and dielectric layer when rough): L_o(wo) = rho(wo) / pi * E,
+    /// exact for uniform lighting. For BSDFs that reads_as_diffuse(their lobes).
     Color diffuse_like_reflectance(const Vec3& wo) const;
 
 private:

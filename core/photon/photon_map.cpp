@@ -36,6 +36,11 @@ bool photon_counts(const Photon& photon, const Vec3& n) {
     return !photon.has_normal() || glm::dot(photon.normal(), n) > kPhotonNormalCosine;
 }
 
+/// photon_counts() for either side of the surface: n's or the opposite one.
+bool photon_counts_either_side(const Photon& photon, const Vec3& n) {
+    return photon_counts(photon, n) || photon_counts(photon, -n);
+}
+
 }  // namespace
 
 Color PhotonMap::estimate_radiance(const Vec3& p, const Vec3& normal, const Bsdf& bsdf,
@@ -57,16 +62,19 @@ Color PhotonMap::estimate_radiance(const Vec3& p, const Vec3& normal, const Bsdf
     for (const KnnNeighbor& n : found.neighbors) {
         const Photon& photon = tree_.photon(n.index);
         if (photon.user_flags() & options.exclude_flags) continue;
-        if (!photon_counts(photon, normal)) continue;
+        if (!(options.both_sides ? photon_counts_either_side(photon, normal) : photon_counts(photon, normal)))
+            continue;
         const Vec3 wi = -photon.direction();
         const Color f = bsdf.eval(wo, wi, TransportMode::Radiance, options.lobes);
         DVec3 contribution = DVec3(f) * DVec3(photon.flux());
         if (bent) {
-            const float cos_bent = glm::dot(options.shading_normal, wi);
+            // The photon's side of the surface: normal's, or the other one (both_sides).
+            const float side = glm::dot(normal, wi) >= 0.0f ? 1.0f : -1.0f;
+            const float cos_bent = side * glm::dot(options.shading_normal, wi);
             if (!(cos_bent > 0.0f)) continue;
-            // photon_counts() kept only photons in front of `normal`; the floor bounds the
+            // photon_counts() kept only photons in front of their side; the floor bounds the
             // weight of the few that graze it.
-            contribution *= static_cast<double>(cos_bent / std::max(glm::dot(normal, wi), 0.05f));
+            contribution *= static_cast<double>(cos_bent / std::max(side * glm::dot(normal, wi), 0.05f));
         }
         if (options.cone_filter) contribution *= 1.0 - std::sqrt(static_cast<double>(n.dist2)) / (kCone * r);
         sum += contribution;

@@ -56,6 +56,10 @@ struct RadianceEstimateOptions {
     /// photons' density is per area of the unbent surface (`normal`), so each one counts
     /// cos(shading_normal, wi) / cos(normal, wi) as much, and none from behind the bent normal.
     Vec3 shading_normal{0.0f};
+    /// The surface transmits through a non-delta lobe (rough glass): photons stored on its
+    /// other side (arrived from behind, stored with the opposite normal) count too, through
+    /// the BSDF's transmission.
+    bool both_sides = false;
 };
 
 class PhotonMap {

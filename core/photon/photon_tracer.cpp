@@ -139,13 +139,15 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
             if (want_global) out.global.push_back(photon);
             if (want_caustic && caustic_path) out.caustic.push_back(photon);
         }
-        // Only caustic paths wanted, and every way on from here is diffuse: no need to sample it.
-        if (!want_global && bsdf.lobes() == mask_of(LobeKind::Diffuse)) return;
+        // Only caustic paths wanted, and no ideal specular way on from here: no need to sample it.
+        if (!want_global && !bsdf.has_delta()) return;
         const float u_lobe = bsdf.samples_lobe_choice() ? rng.next_float() : 0.0f;
         const Vec2 u = rng.next_vec2();
         const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Importance);
         if (!s || !(s->pdf > 0.0f)) return;
-        if (s->kind == LobeKind::Diffuse) {
+        // Caustic paths are L S+ D with S ideal specular: light a glossy lobe reflects is the
+        // final gather's, which follows glossy lobes by sampling (FinalGatherer).
+        if (s->kind != LobeKind::Delta) {
             diffuse_seen = true;
             if (!want_global) return;  // only caustic paths are wanted, and this is none any more
         } else {
@@ -304,12 +306,12 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
     if (cancelled) return Error{"photon pass: cancelled"};
     stats.emitted = emitted;
     stats.tracing_seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    for (const auto& [builder, name] : {std::pair{&global, "global"}, std::pair{&caustic, "caustic"}}) {
-        if (builder->target > 0 && builder->count == 0) {
-            return Error{std::string("photon pass: no photon reached a surface that stores it for the ") + name +
-                         " map after " + std::to_string(emitted) +
-                         " photons were emitted (lights facing away from the scene, or nothing reflects)"};
-        }
+    // An empty global map means no light reaches a diffuse surface: the image cannot be right.
+    // An empty caustic map only means that no light focuses (PhotonTracingStatistics says so).
+    if (global.target > 0 && global.count == 0) {
+        return Error{"photon pass: no photon reached a surface that stores it for the global map after " +
+                     std::to_string(emitted) +
+                     " photons were emitted (lights facing away from the scene, or nothing reflects)"};
     }
     stats.emitted_global = global.emitted;
     stats.emitted_caustic = caustic.emitted;

@@ -2,7 +2,8 @@
 // scene (ALGORITHMS.md section 2; Jensen 2001, ch. 5). Russian roulette on the BSDF's
 // reflectivities, importance-sampled directions, no flux change at refraction, storage at every
 // non-delta interaction. Paths are classified by the light-path grammar: the global map gets
-// L[S|D]*D, the caustic map L S+ D.
+// L[S|D]*D, the caustic map L S+ D with S an ideal specular (delta) bounce: glossy bounces
+// count as D, their light reaches the image through final gathering.
 //
 // Deterministic in parallel: photon i draws from the random stream (seed, i), photons are traced
 // in batches, and each batch's stored photons are appended in photon order, so the maps do not
@@ -86,7 +87,8 @@ struct PhotonMaps {
 double caustic_flux_share(const PhotonMaps& maps);
 
 /// Traces the photons and builds the maps. Fails (with a message naming the reason) when the
-/// scene has no light with power, or when a requested map received no photon within the cap.
+/// scene has no light with power, or when the global map received no photon within the cap (a
+/// caustic map that none reached is kept empty: nothing focuses light).
 Expected<PhotonMaps> trace_photons(const RenderScene& scene, const PhotonTracingSettings& settings);
 
 }  // namespace photond

@@ -22,7 +22,7 @@ Expected<std::shared_ptr<const RenderScene>> RenderScene::create(std::shared_ptr
     render_scene->bsdf_materials.reserve(scene->materials.size());
     for (const Material& material : scene->materials) render_scene->bsdf_materials.emplace_back(material);
     std::vector<uint32_t> specular;
-    constexpr LobeMask kCausticLobes = mask_of(LobeKind::Delta) | mask_of(LobeKind::Glossy);
+    constexpr LobeMask kCausticLobes = mask_of(LobeKind::Delta);  // L S+ D: S ideal specular
     std::vector<LobeMask> lobes(scene->materials.size());
     for (size_t i = 0; i < lobes.size(); ++i) {
         const Material& m = scene->materials[i];
