@@ -7,13 +7,6 @@
 
 namespace photond {
 
-namespace {
-
-/// Glossy lobes a gather ray follows by sampling before it reads the photon maps with them.
-constexpr int kMaxGlossyGatherBounces = 2;
-
-}  // namespace
-
 GatherGrid GatherGrid::for_rays(uint32_t rays) {
     // N ~ pi M (Ward): M = sqrt(rays / pi), N = rays / M.
     GatherGrid g;
@@ -64,7 +57,7 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
                                          FirstHitEmission* emission) const {
     const RenderScene& rs = *scene_;
     // Walk through ideal specular surfaces; `depth` counts them. At glossy surfaces the glossy
-    // lobes are followed too (up to kMaxGlossyGatherBounces): reading them from the photons
+    // lobes are followed too (up to settings_.max_glossy_bounces): reading them from the photons
     // would evaluate a sharp lobe per photon, whose rare aligned photons are fireflies.
     struct Walker {
         const FinalGatherer& g;
@@ -78,7 +71,8 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
             Vec3 point;
             float pdf;
         };
-        Color along(const Ray& r, int depth, float* first_distance, int glossy_bounces = 0,
+        /// `first`: the gather ray itself (its hit's emission is reported to the caller).
+        Color along(const Ray& r, int depth, float* first_distance, bool first, int glossy_bounces = 0,
                     const GlossyOrigin* from = nullptr) const {
             const std::optional<Hit> hit = trace_ray(rs, r, counters);
             if (first_distance) *first_distance = hit ? hit->t : std::numeric_limits<float>::infinity();
@@ -93,7 +87,7 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
             }
             const SurfaceInteraction si = make_interaction(*rs.scene, *hit, r.direction);
             const Vec3 wo = -r.direction;
-            if (depth == 0 && emission) {
+            if (first && emission) {
                 emission->radiance = volume_transmittance(*rs.scene, si) * rs.lights->emitted_radiance(si, wo);
                 emission->triangle = si.triangle;
                 emission->point = si.p;
@@ -112,7 +106,7 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
             const Bsdf bsdf = make_bsdf(rs, si, wo);
             if (bsdf.has_non_delta()) {
                 constexpr LobeMask kGlossy = mask_of(LobeKind::Glossy);
-                if ((bsdf.lobes() & kGlossy) && glossy_bounces < kMaxGlossyGatherBounces) {
+                if ((bsdf.lobes() & kGlossy) && glossy_bounces < g.settings_.max_glossy_bounces) {
                     radiance += glossy_lobes(si, bsdf, wo, depth, glossy_bounces);
                     radiance += radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_, kNonDeltaLobes & ~kGlossy);
                 } else {
@@ -123,7 +117,7 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
                 // One lobe per gather ray is enough: the gather averages many rays.
                 const GlossyOrigin after_delta{si.p, 0.0f};
                 radiance += follow_delta_lobes(bsdf, wo, false, rng, [&](const BsdfSample& s) {
-                    return along(spawn_ray(rs, si, s.wi), depth + 1, nullptr, glossy_bounces,
+                    return along(spawn_ray(rs, si, s.wi), depth + 1, nullptr, false, glossy_bounces,
                                  from ? &after_delta : nullptr);
                 });
             }
@@ -141,13 +135,13 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
             const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Radiance, kGlossy);
             if (s && s->pdf > 0.0f && !is_black(s->weight)) {
                 const GlossyOrigin origin{si.p, s->pdf};
-                radiance += s->weight * along(spawn_ray(rs, si, s->wi), depth, nullptr, glossy_bounces + 1, &origin);
+                radiance += s->weight * along(spawn_ray(rs, si, s->wi), depth, nullptr, false, glossy_bounces + 1, &origin);
             }
             return radiance;
         }
     };
     if (emission) *emission = FirstHitEmission{};
-    return Walker{*this, rs, rng, counters, emission}.along(ray, 0, distance);
+    return Walker{*this, rs, rng, counters, emission}.along(ray, 0, distance, true);
 }
 
 GatherResult FinalGatherer::gather(const Vec3& p, const Vec3& n, const Vec3& geometric_normal, Rng& rng,

@@ -7,7 +7,10 @@
 //
 // Gather rays add no emitted light, and pass through ideal specular surfaces (up to a depth)
 // without counting emitters behind them either: light arriving through specular surfaces straight
-// from an emitter is the caustic map's share, so nothing is counted twice.
+// from an emitter is the caustic map's share, so nothing is counted twice. Glossy lobes where a
+// gather ray lands are followed by sampling, with light samples there and the emitters their
+// rays meet weighted by the power heuristic: light a glossy lobe reflects is no caustic (the
+// caustic map holds L S+ D with S ideal specular only).
 #pragma once
 
 #include <array>
@@ -20,6 +23,9 @@ namespace photond {
 struct GatherSettings {
     uint32_t rays = 512;         // M x N, N ~ pi M
     int max_specular_depth = 4;  // ideal specular surfaces a gather ray may pass through
+    /// Glossy lobes a gather ray follows by sampling (a light sample and a lobe sample, power
+    /// heuristic) before it reads the photon maps with the lobe; 0 reads them at once.
+    int max_glossy_bounces = 2;
     uint32_t k_global = 50;      // photons per radiance estimate where no precomputed irradiance fits
     float max_radius = 0.0f;     // estimate radius cap (world units)
     /// Gather rays that leave the scene, straight away or through ideal specular surfaces, see

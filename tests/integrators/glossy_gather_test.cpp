@@ -1,0 +1,88 @@
+// Glossy surfaces seen in glossy surfaces: the photon-map integrator's glossy rays land on another
+// glossy surface, where final gathering follows the glossy lobe by sampling (a light sample and
+// a lobe sample, power heuristic) instead of reading the photons with the sharp lobe, whose rare
+// photons along its peak are fireflies. Both against `path`, pixel by pixel.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "core/image/image_metrics.h"
+#include "core/integrators/path.h"
+#include "core/integrators/photon_mapping.h"
+#include "core/photon/photon_tracer.h"
+#include "core/render/render_plan.h"
+#include "core/render/tile_renderer.h"
+#include "core/scene/shapes.h"
+
+#include "tests/support/render_fixtures.h"
+
+namespace photond {
+namespace {
+
+using test_support::lambertian;
+using test_support::make_render_scene;
+
+/// Two glossy metal spheres (roughness 0.1) side by side on a Lambertian floor under a square
+/// area light: the camera sees each sphere in the other.
+std::shared_ptr<const RenderScene> glossy_spheres() {
+    SceneBuilder builder("glossy spheres");
+    const uint32_t floor = builder.add_material(lambertian(Color(0.6f, 0.5f, 0.4f)));
+    Material metal;
+    metal.base_color = Color(0.9f, 0.85f, 0.8f);
+    metal.metallic = 1.0f;
+    metal.roughness = 0.1f;
+    const uint32_t glossy = builder.add_material(metal);
+    Material lamp = lambertian(Color(0.0f));
+    lamp.emission = Color(6.0f);
+    const uint32_t emitter = builder.add_material(lamp);
+    EXPECT_TRUE(add_mesh(builder, make_quad(Vec3(-4, 0, -4), Vec3(8, 0, 0), Vec3(0, 0, 8), Vec3(0, 1, 0)), floor).is_ok());
+    EXPECT_TRUE(add_mesh(builder, make_icosphere(Vec3(-0.55f, 0.5f, 0.0f), 0.5f, 4), glossy).is_ok());
+    EXPECT_TRUE(add_mesh(builder, make_icosphere(Vec3(0.55f, 0.5f, 0.0f), 0.5f, 4), glossy).is_ok());
+    EXPECT_TRUE(add_mesh(builder, make_quad(Vec3(-1, 3, -1), Vec3(2, 0, 0), Vec3(0, 0, 2), Vec3(0, -1, 0)), emitter).is_ok());
+    CameraDesc view;
+    view.position = Vec3(0.0f, 0.9f, 2.4f);
+    view.look_at = Vec3(0.0f, 0.45f, 0.0f);
+    view.vfov_deg = 40.0f;
+    builder.add_camera(view);
+    return make_render_scene(builder.build().value());
+}
+
+TEST(GlossyGather, GlossyLobesFollowedBySamplingAgreeWithPathPerPixel) {
+    const auto rs = glossy_spheres();
+    const Camera camera = Camera::create(rs->scene->cameras.at(0), 48, 32).value();
+    TileSettings path_tiles;
+    path_tiles.samples_per_pixel = 1024;
+    const Image reference = render_tiles(PathIntegrator(rs), camera, path_tiles).image;
+
+    const RenderPlan plan = plan_photon_passes(*rs->scene, *rs->lights, {100000, 20000});
+    EXPECT_FALSE(plan.caustic_map) << "light glossy lobes reflect is final gathering's, not a caustic";
+    PhotonTracingSettings tracing;
+    tracing.global_photons = 100000;
+    tracing.caustic_photons = 0;
+    auto traced = trace_photons(*rs, tracing);
+    ASSERT_TRUE(traced) << traced.error().message;
+    const auto maps = std::make_shared<const PhotonMaps>(std::move(traced).value());
+    const auto render = [&](int max_glossy_bounces) {
+        PhotonMapIntegratorSettings settings;
+        settings.gather.rays = 128;
+        settings.gather.max_glossy_bounces = max_glossy_bounces;
+        settings.irradiance_cache = false;
+        const PhotonMapIntegrator photon_map(rs, maps, settings);
+        TileSettings tiles;
+        tiles.samples_per_pixel = 32;
+        const Image image = render_tiles(photon_map, camera, tiles).image;
+        for (const Color& c : image.pixels()) EXPECT_TRUE(is_finite(c));
+        return compare_images(image, reference).value();
+    };
+    const ImageError followed = render(2), read = render(0);
+    std::printf("glossy spheres 48x32 vs path: lobes followed relMSE %.5f (mean %+.2f %%), read from photons "
+                "%.5f (%+.2f %%)\n",
+                followed.relative_mse, 100.0 * followed.mean_bias, read.relative_mse, 100.0 * read.mean_bias);
+    // Measured: followed 0.051 (+0.5 %), read 0.070 (-1.9 %); an emitter counted both by a
+    // glossy sample's continuation and as the gather ray's first hit made the mean +4 % at 256 spp.
+    EXPECT_NEAR(followed.mean_bias, 0.0, 0.015);
+    EXPECT_LT(followed.relative_mse, 0.85 * read.relative_mse);
+}
+
+}  // namespace
+}  // namespace photond
