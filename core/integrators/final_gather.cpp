@@ -24,6 +24,9 @@ FinalGatherer::FinalGatherer(std::shared_ptr<const RenderScene> scene, std::shar
 
 namespace {
 
+/// Photons of an estimate at a gather hit on a normal-mapped surface read as diffuse.
+constexpr uint32_t kBentNormalPhotons = 32;
+
 /// Radiance leaving a non-delta surface towards wo, from the photon maps: precomputed
 /// irradiance times rho / pi where every lobe is diffuse or as rough as the photon passes take
 /// for diffuse (the rough metal and dielectric layer of most glTF materials: read by their
@@ -43,7 +46,9 @@ Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si
             return bsdf.diffuse_like_reflectance(wo) * kInvPi * e;
     }
     RadianceEstimateOptions options;
-    options.k = settings.k_global;
+    // Where only the bent normal keeps the precomputed irradiance from serving, fewer photons:
+    // each gather ray's value is averaged with the others' (the irradiance cache's hundreds).
+    options.k = bsdf.reads_as_diffuse(lobes) ? std::min(settings.k_global, kBentNormalPhotons) : settings.k_global;
     options.max_radius = settings.max_radius;
     options.shading_normal = bent;
     options.both_sides = bsdf.transmits_non_delta();
