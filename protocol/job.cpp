@@ -7,6 +7,8 @@
 #include <initializer_list>
 #include <span>
 
+#include "core/util/json_depth.h"
+#include "protocol/json_text.h"
 #include "protocol/presets.h"
 
 namespace photond::protocol {
@@ -50,7 +52,7 @@ std::string format_range(const NumberRange& range) {
 /// " (got <value>)", shortened: the value a user sent, to quote back in a message.
 std::string got(const json& value) {
     constexpr size_t kMaxShown = 48;
-    std::string text = value.dump(-1, ' ', false, json::error_handler_t::replace);
+    std::string text = json_text(value);
     if (text.size() > kMaxShown) text = text.substr(0, kMaxShown) + "...";
     return " (got " + text + ")";
 }
@@ -929,6 +931,7 @@ std::variant<Job, FieldError> parse_job_detailed(const nlohmann::json& document)
 }
 
 std::variant<Job, FieldError> parse_job_text_detailed(std::string_view text) {
+    if (json_nesting_depth(text) > kMaxJsonNesting) return FieldError{"", json_nesting_message()};
     json document;
     try {
         document = json::parse(text.begin(), text.end());

@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <ctime>
 
+#include "protocol/json_text.h"
+
 namespace photond::protocol {
 namespace {
 
@@ -147,7 +149,7 @@ Expected<JobStatus> job_status_from_json(const json& d) {
         JobStatus s;
         s.id = d.at("id").get<std::string>();
         const auto state = parse_job_state(d.at("state").get<std::string>());
-        if (!state) return Error{"status: unknown state " + d.at("state").dump()};
+        if (!state) return Error{"status: unknown state " + json_text(d.at("state"))};
         s.state = *state;
         s.pass = d.value("pass", std::string());
         s.priority = d.value("priority", 0);
@@ -207,7 +209,7 @@ std::string tile_url(const std::string& job_id, TileIndex tile) {
 std::string format_sse(const JobEvent& event) {
     // dump() escapes control characters, so the data is one line and needs one "data:" field.
     return "id: " + std::to_string(event.id) + "\nevent: " + std::string(to_string(event.type)) +
-           "\ndata: " + event.data.dump(-1, ' ', false, json::error_handler_t::replace) + "\n\n";
+           "\ndata: " + json_text(event.data) + "\n\n";
 }
 
 json to_json(const Problem& p) {

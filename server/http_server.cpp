@@ -12,8 +12,10 @@
 #include <set>
 #include <vector>
 
+#include "core/util/json_depth.h"
 #include "protocol/job.h"
 #include "protocol/job_status.h"
+#include "protocol/json_text.h"
 #include "server/job_manager.h"
 #include "server/metrics.h"
 #include "server/openapi.h"
@@ -47,7 +49,7 @@ void write_problem(Response& res, ErrorKind kind, const std::string& detail,
     problem.field = field;
     problem.instance = instance;
     res.status = problem.status;
-    res.set_content(protocol::to_json(problem).dump(2) + "\n", kProblemType);
+    res.set_content(protocol::json_text(protocol::to_json(problem), 2) + "\n", kProblemType);
 }
 
 void write_problem(Response& res, const ServiceError& error, const Request& req) {
@@ -86,7 +88,7 @@ ErrorKind kind_of_status(int status) {
 
 void send_json(Response& res, const json& document, int status = 200) {
     res.status = status;
-    res.set_content(document.dump(2) + "\n", kJsonType);
+    res.set_content(protocol::json_text(document, 2) + "\n", kJsonType);
 }
 
 void send_bytes(Response& res, std::vector<uint8_t> bytes, const char* type) {
@@ -113,6 +115,8 @@ bool same_secret(std::string_view given, std::string_view expected) {
 }
 
 protocol::Job decode_job(const std::string& body) {
+    if (json_nesting_depth(body) > kMaxJsonNesting)
+        throw ServiceError(ErrorKind::MalformedRequest, json_nesting_message());
     const json document = json::parse(body, nullptr, false);
     if (document.is_discarded()) {
         // Parsed again for the message with line and column.
@@ -357,6 +361,10 @@ void HttpServer::Impl::submit_job(const Request& req, Response& res) {
     if (key.size() > 256)
         throw ServiceError(ErrorKind::MalformedRequest,
                            "Idempotency-Key: longer than 256 characters");
+    // Stored with the job and compared byte for byte: visible ASCII only (a UUID, a hash).
+    if (std::any_of(key.begin(), key.end(), [](char c) { return c < 0x21 || c > 0x7e; }))
+        throw ServiceError(ErrorKind::MalformedRequest,
+                           "Idempotency-Key: only visible ASCII characters (0x21 to 0x7E) are accepted");
     const JobManager::Submitted submitted = services.jobs.submit(job, key);
     res.set_header("Location", "/v1/jobs/" + submitted.status.id);
     send_json(res, protocol::to_json(submitted.status), submitted.created ? 202 : 200);

@@ -10,6 +10,7 @@
 #include "core/render/tile_renderer.h"
 #include "core/scene/builtin_scenes.h"
 #include "core/util/sha256.h"
+#include "protocol/json_text.h"
 #include "protocol/statistics.h"
 #include "server/atomic_file.h"
 #include "server/render_pipeline.h"
@@ -312,7 +313,7 @@ int JobManager::retry_after_seconds_locked() const {
 JobManager::Submitted JobManager::submit(const protocol::Job& job,
                                          const std::string& idempotency_key) {
     std::lock_guard submit_lock(submit_mutex_);
-    const std::string normalized = protocol::to_json(job).dump();
+    const std::string normalized = protocol::json_text(protocol::to_json(job));
     const std::string digest =
         sha256_hex({reinterpret_cast<const uint8_t*>(normalized.data()), normalized.size()});
     JobSubmission submission;

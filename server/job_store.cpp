@@ -8,6 +8,8 @@
 #include <sstream>
 #include <system_error>
 
+#include "core/util/json_depth.h"
+#include "protocol/json_text.h"
 #include "server/atomic_file.h"
 
 namespace photond::service {
@@ -21,6 +23,7 @@ Expected<json> read_json(const fs::path& path) {
     if (!in) return Error{path.string() + ": cannot be read"};
     std::ostringstream text;
     text << in.rdbuf();
+    if (json_nesting_depth(text.view()) > kMaxJsonNesting) return Error{path.string() + ": " + json_nesting_message()};
     json document = json::parse(text.str(), nullptr, false);
     if (document.is_discarded()) return Error{path.string() + ": not valid JSON"};
     return document;
@@ -51,12 +54,12 @@ Status JobStore::save_submission(const JobSubmission& s) {
                            {"created_at", protocol::format_timestamp(s.created_at_ms)},
                            {"idempotency_key", s.idempotency_key},
                            {"request_digest", s.request_digest}};
-    return write_file_atomically(job_directory(s.id) / "job.json", document.dump(2) + "\n");
+    return write_file_atomically(job_directory(s.id) / "job.json", protocol::json_text(document, 2) + "\n");
 }
 
 Status JobStore::save_status(const protocol::JobStatus& status) {
     return write_file_atomically(job_directory(status.id) / "status.json",
-                                 protocol::to_json(status, false).dump(2) + "\n");
+                                 protocol::json_text(protocol::to_json(status, false), 2) + "\n");
 }
 
 JobStore::Loaded JobStore::load_all() const {

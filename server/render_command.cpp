@@ -9,7 +9,9 @@
 #include <sstream>
 
 #include "core/image/exr_io.h"
+#include "core/util/json_depth.h"
 #include "protocol/job.h"
+#include "protocol/json_text.h"
 #include "protocol/statistics.h"
 #include "server/atomic_file.h"
 #include "server/render_pipeline.h"
@@ -207,6 +209,10 @@ int run_render_command(std::span<const std::string> args) {
             std::fprintf(stderr, "photond render: %s\n", text.error().message.c_str());
             return 2;
         }
+        if (json_nesting_depth(*text) > kMaxJsonNesting) {
+            std::fprintf(stderr, "photond render: %s: %s\n", a.job_file.c_str(), json_nesting_message().c_str());
+            return 2;
+        }
         document = nlohmann::json::parse(*text, nullptr, false);
         if (document.is_discarded()) {
             auto job = protocol::parse_job_text(*text);  // for its line/column message
@@ -279,7 +285,7 @@ int run_render_command(std::span<const std::string> args) {
         nlohmann::json stats = protocol::to_json(result->statistics);
         stats["job"] = protocol::to_json(*job);
         std::ofstream out(a.stats_json);
-        out << stats.dump(2) << "\n";
+        out << protocol::json_text(stats, 2) << "\n";
         if (!out) {
             std::fprintf(stderr, "photond render: %s: cannot be written\n", a.stats_json.c_str());
             return 1;

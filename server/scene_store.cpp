@@ -7,7 +7,9 @@
 #include <system_error>
 
 #include "core/scene/gltf_loader.h"
+#include "core/util/json_depth.h"
 #include "core/util/sha256.h"
+#include "protocol/json_text.h"
 #include "server/atomic_file.h"
 
 namespace photond::service {
@@ -206,7 +208,7 @@ std::variant<SceneStore::Added, SceneStore::Refused> SceneStore::add(
             file, {reinterpret_cast<const char*>(bytes.data()), bytes.size()});
         !written)
         return Refused{false, written.error().message};
-    const std::string metadata = to_json(scene_info).dump(2) + "\n";
+    const std::string metadata = protocol::json_text(to_json(scene_info), 2) + "\n";
     // The metadata only saves a load on GET; losing it costs nothing but time.
     (void)write_file_atomically(metadata_file_of(id), metadata);
     remember_loaded(id, std::make_shared<const Scene>(std::move(scene).value()));
@@ -247,7 +249,7 @@ std::variant<SceneStore::Added, SceneStore::Refused> SceneStore::add_bundle(
         Refused refused = discard("the bundle cannot be stored: " + error.message());
         if (!stored) return refused;
     }
-    (void)write_file_atomically(metadata_file_of(id), to_json(scene_info).dump(2) + "\n");
+    (void)write_file_atomically(metadata_file_of(id), protocol::json_text(to_json(scene_info), 2) + "\n");
     remember_loaded(id, std::make_shared<const Scene>(std::move(scene).value()));
     return Added{scene_info, true};
 }
@@ -299,7 +301,10 @@ std::optional<SceneInfo> SceneStore::info(const std::string& id) {
     if (!normalized) return std::nullopt;
     if (!contains(*normalized)) return std::nullopt;
     if (auto bytes = read_file_bytes(metadata_file_of(*normalized))) {
-        const json document = json::parse(bytes->begin(), bytes->end(), nullptr, false);
+        const std::string_view text(reinterpret_cast<const char*>(bytes->data()), bytes->size());
+        const json document = json_nesting_depth(text) > kMaxJsonNesting
+                                  ? json(json::value_t::discarded)
+                                  : json::parse(bytes->begin(), bytes->end(), nullptr, false);
         if (!document.is_discarded())
             if (auto info = info_from_json(document); info && info->id == *normalized) return info;
     }

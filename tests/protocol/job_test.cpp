@@ -1,5 +1,6 @@
 // The job description v1: presets, JSON round trip, every validation rule with its field path,
 // overrides, malformed JSON, and the JSON Schema built from the same limits.
+#include "core/util/json_depth.h"
 #include "protocol/job.h"
 
 #include <gtest/gtest.h>
@@ -965,4 +966,25 @@ TEST(JobErrors, DescribeJoinsPathAndMessage) {
 }
 
 }  // namespace
+TEST(JsonNesting, CountsArraysAndObjectsOutsideStrings) {
+    EXPECT_EQ(json_nesting_depth(R"({"a": [1, {"b": [[]]}]})"), 5);
+    // Brackets inside strings, also after escaped quotes and backslashes, do not count.
+    EXPECT_EQ(json_nesting_depth(R"({"a": "[[[{{{", "b": "\"[[[", "c": "\\", "d": [1]})"), 2);
+    EXPECT_EQ(json_nesting_depth("[]"), 1);
+    EXPECT_EQ(json_nesting_depth("\"[\""), 0);
+    // Counting stops just past the limit, however deep the text goes.
+    EXPECT_EQ(json_nesting_depth(std::string(100000, '[')), kMaxJsonNesting + 1);
+    EXPECT_EQ(json_nesting_depth(std::string(kMaxJsonNesting, '[') + std::string(kMaxJsonNesting, ']')), kMaxJsonNesting);
+    // A job exactly at the limit parses on to its own checks; one level more is refused by name.
+    const auto deep = parse_job_text_detailed("{\"scene\": " + std::string(kMaxJsonNesting, '[') +
+                                              std::string(kMaxJsonNesting, ']') + "}");
+    ASSERT_TRUE(std::holds_alternative<FieldError>(deep));
+    EXPECT_NE(std::get<FieldError>(deep).message.find("nest more than"), std::string::npos);
+    const auto at_limit = parse_job_text_detailed("{\"scene\": " + std::string(kMaxJsonNesting - 1, '[') +
+                                                  std::string(kMaxJsonNesting - 1, ']') + "}");
+    ASSERT_TRUE(std::holds_alternative<FieldError>(at_limit));
+    EXPECT_EQ(std::get<FieldError>(at_limit).message.find("nest more than"), std::string::npos)
+        << std::get<FieldError>(at_limit).message;
+}
+
 }  // namespace photond::protocol

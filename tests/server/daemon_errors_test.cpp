@@ -186,6 +186,48 @@ TEST_F(DaemonErrors, BadJobsAndUploadsGetProblemsAndTheDaemonKeepsServing) {
     EXPECT_EQ(daemon.stop(), 0) << daemon.log();
 }
 
+TEST_F(DaemonErrors, InvalidUtf8AndDeepNestingAreProblemsNotCrashes) {
+    // Bytes that are not UTF-8 reach error messages (paths, field values, headers); the JSON
+    // writer once threw on them inside the error handler and ended the daemon. Documents nested
+    // 100,000 deep overflowed the stack of the parser or of the code that walks them.
+    Daemon daemon(dir_.path() / "cache");
+    ASSERT_TRUE(daemon.started()) << daemon.log();
+    const HttpClient client = daemon.client();
+    for (const std::string path : {"/%F9", "/\xF9", "/v1/jobs/%F9", "/v1/jobs/\xF9", "/v1/scenes/%F9",
+                                   "/v1/photon-maps/%F9"}) {
+        const HttpResponse r = client.get(path);
+        EXPECT_GE(r.status, 400) << path;
+        EXPECT_LT(r.status, 500) << path << ": " << r.body;
+        EXPECT_TRUE(r.json_body().is_object()) << path << ": " << r.body;
+        ASSERT_EQ(client.get("/healthz").status, 200) << "the daemon died on " << path << "\n" << daemon.log();
+    }
+    // A job whose values hold invalid UTF-8: 400 for the malformed text, named by position.
+    expect_problem(client, client.post("/v1/jobs", "{\"scene\": {\"builtin\": \"corn\xf9\"}}"), 400);
+    expect_problem(client, client.post("/v1/jobs", "{\"scene\": \xc3\xa9}"), 400);
+    expect_problem(client, client.post("/v1/jobs", "{\"preset\": \"" + std::string(60, 'x') + "\xe9\"}"), 400);
+    // A valid UTF-8 value cut inside an error message's quote: still valid JSON out.
+    std::string accents;
+    for (int i = 0; i < 40; ++i) accents += "\xc3\xa9";
+    expect_problem(client, client.post("/v1/jobs", with(kSmallJob, "/preset", accents).dump()), 422, "preset");
+    // An Idempotency-Key with a byte beyond ASCII: refused, and no job directory is left.
+    expect_problem(client, client.post("/v1/jobs", kSmallJob.dump(), {{"Idempotency-Key", "key\xf9"}}), 400, "",
+                   "Idempotency-Key");
+    EXPECT_FALSE(fs::exists(dir_.path() / "cache" / "jobs") && !fs::is_empty(dir_.path() / "cache" / "jobs"));
+    // Nested 100,000 deep inside the scene, and just past the limit: refused before parsing.
+    const std::string deep = "{\"scene\": " + std::string(100000, '[') + std::string(100000, ']') + "}";
+    expect_problem(client, client.post("/v1/jobs", deep), 400, "", "nest more than 128");
+    const std::string just_past = "{\"scene\": " + std::string(128, '[') + std::string(128, ']') + "}";
+    expect_problem(client, client.post("/v1/jobs", just_past), 400, "", "nest more than 128");
+    // A glTF upload whose extras nest 100,000 deep.
+    const std::string deep_gltf = "{\"asset\": {\"version\": \"2.0\"}, \"extras\": " + std::string(100000, '[') +
+                                  std::string(100000, ']') + "}";
+    const HttpResponse upload = client.post("/v1/scenes", deep_gltf, {{"Content-Type", "model/gltf+json"}});
+    EXPECT_GE(upload.status, 400) << upload.body;
+    EXPECT_LT(upload.status, 500) << upload.body;
+    EXPECT_NE(upload.body.find("nest more than 128"), std::string::npos) << upload.body;
+    EXPECT_EQ(client.get("/healthz").status, 200) << daemon.log();
+}
+
 TEST_F(DaemonErrors, LightingThatCannotWorkIsRefusedAtSubmission) {
     const fs::path root = dir_.path() / "scenes";
     fs::create_directories(root);

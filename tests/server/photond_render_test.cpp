@@ -259,6 +259,20 @@ bool contains_warning(const nlohmann::json& warnings, const std::string& text) {
     return false;
 }
 
+TEST_F(PhotondRender, DeeplyNestedJobsAndGltfFilesAreRefusedByName) {
+    // 100,000 levels overflowed the stack of the parsers; refused before parsing, exit 2 / 1.
+    std::ofstream(dir_ / "deep.json") << ("{\"scene\": " + std::string(100000, '[') + std::string(100000, ']') + "}");
+    const auto job = run("render --job " + (dir_ / "deep.json").string() + " -o " + (dir_ / "d.exr").string());
+    EXPECT_EQ(job.exit_code, 2) << job.output;
+    EXPECT_NE(job.output.find("nest more than 128 levels deep"), std::string::npos) << job.output;
+    std::ofstream(dir_ / "deep.gltf") << ("{\"asset\": {\"version\": \"2.0\"}, \"extras\": " + std::string(100000, '{') +
+                                       std::string(100000, '}') + "}");
+    const auto gltf = run("render " + (dir_ / "deep.gltf").string() + " -o " + (dir_ / "g.exr").string());
+    EXPECT_NE(gltf.exit_code, 0) << gltf.output;
+    EXPECT_NE(gltf.output.find("deep.gltf: arrays and objects nest more than 128"), std::string::npos) << gltf.output;
+    EXPECT_FALSE(fs::exists(dir_ / "g.exr"));
+}
+
 TEST_F(PhotondRender, IncompletePhotonMapIsAWarningThatSaysWhatToChange) {
     // One small mirror catches about 1 in 1,400 photons: 2,000 caustic photons need 2.8 M
     // emissions, beyond the cap of 1,000 per requested photon.
