@@ -3,6 +3,7 @@
 #include <httplib.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <charconv>
 #include <cstdio>
 #include <fstream>
@@ -248,15 +249,38 @@ void HttpServer::Impl::register_routes() {
 void HttpServer::Impl::install() {
     std::map<std::string, std::set<std::string>> methods_of;  // pattern -> methods
     for (const Route& r : routes) methods_of[r.pattern].insert(r.method);
-    auto add = [this](const std::string& method, const std::string& pattern, Handler handler) {
+    // Bodies are read through a content reader, whatever their Content-Type: cpp-httplib parses
+    // an application/x-www-form-urlencoded body (what curl's --data-binary sends by default) as a
+    // form and refuses it beyond 8 KiB, which README's uploads of real files hit. The reader
+    // still enforces --max-body-mb.
+    auto with_body = [this](Handler handler) {
+        return [this, handler = std::move(handler)](const Request& req, Response& res,
+                                                    const httplib::ContentReader& content) {
+            Request read = req;
+            const bool complete = content([&](const char* data, size_t length) {
+                read.body.append(data, length);
+                return true;
+            });
+            if (!complete) {
+                const uint64_t declared = std::strtoull(req.get_header_value("Content-Length").c_str(), nullptr, 10);
+                if (declared > options.max_body_bytes)
+                    throw ServiceError(ErrorKind::PayloadTooLarge, "the request body exceeds the limit of " +
+                                                                       std::to_string(options.max_body_bytes >> 20) +
+                                                                       " MiB (--max-body-mb)");
+                throw ServiceError(ErrorKind::MalformedRequest, "the request body could not be read to its end");
+            }
+            handler(read, res);
+        };
+    };
+    auto add = [this, &with_body](const std::string& method, const std::string& pattern, Handler handler) {
         if (method == "GET")
             server.Get(pattern, std::move(handler));
         else if (method == "POST")
-            server.Post(pattern, std::move(handler));
+            server.Post(pattern, with_body(std::move(handler)));
         else if (method == "PUT")
-            server.Put(pattern, std::move(handler));
+            server.Put(pattern, with_body(std::move(handler)));
         else if (method == "PATCH")
-            server.Patch(pattern, std::move(handler));
+            server.Patch(pattern, with_body(std::move(handler)));
         else if (method == "DELETE")
             server.Delete(pattern, std::move(handler));
     };

@@ -228,6 +228,24 @@ TEST_F(DaemonErrors, InvalidUtf8AndDeepNestingAreProblemsNotCrashes) {
     EXPECT_EQ(client.get("/healthz").status, 200) << daemon.log();
 }
 
+TEST_F(DaemonErrors, BodiesOver8KiBAreReadWhateverTheirContentType) {
+    // curl's --data-binary and -d send application/x-www-form-urlencoded unless told otherwise;
+    // cpp-httplib parsed such bodies as forms and answered 413 beyond 8 KiB.
+    Daemon daemon(dir_.path() / "cache", {"--max-body-mb", "1"});
+    ASSERT_TRUE(daemon.started()) << daemon.log();
+    const HttpClient client = daemon.client();
+    const Headers form{{"Content-Type", "application/x-www-form-urlencoded"}};
+    const std::string job = kSmallJob.dump() + std::string(20000, ' ');
+    const HttpResponse submitted = client.post("/v1/jobs", job, form);
+    EXPECT_EQ(submitted.status, 202) << submitted.body;
+    std::string gltf = read_file(fs::path(PHOTOND_TEST_DATA_DIR) / "gltf" / "lights.gltf");
+    gltf += std::string(20000, '\n');
+    const HttpResponse uploaded = client.post("/v1/scenes", gltf, form);
+    EXPECT_EQ(uploaded.status, 201) << uploaded.body;
+    // Beyond --max-body-mb the 413 names the real limit.
+    expect_problem(client, client.post("/v1/jobs", std::string(2 << 20, ' '), form), 413, "", "1 MiB");
+}
+
 TEST_F(DaemonErrors, LightingThatCannotWorkIsRefusedAtSubmission) {
     const fs::path root = dir_.path() / "scenes";
     fs::create_directories(root);
