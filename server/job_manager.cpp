@@ -625,13 +625,39 @@ void JobManager::worker_loop() {
             push_event_locked(*entry, JobEventType::State, {{"state", "running"}});
             entry->changed.notify_all();
         }
-        (void)store_.save_status(status(entry->id()));
-        log("job " + entry->id() + " started");
-        run(entry);
+        // Whatever a job throws ends that job, not the worker (an escaping exception would end
+        // the daemon through std::terminate).
+        std::string thrown;
+        try {
+            (void)store_.save_status(status(entry->id()));
+            log("job " + entry->id() + " started");
+            run(entry);
+        } catch (const std::exception& error) {
+            thrown = error.what();
+        } catch (...) {
+            thrown = "an exception that is not a std::exception";
+        }
+        if (!thrown.empty()) fail_after_exception(entry, thrown);
         std::lock_guard lock(mutex_);
         running_.reset();
     }
     worker_running_ = false;
+}
+
+void JobManager::fail_after_exception(const std::shared_ptr<Entry>& entry, const std::string& what) {
+    const std::string reason = "internal error while running the job: " + what;
+    try {
+        log("job " + entry->id() + " failed: " + reason);
+    } catch (...) {  // the log itself may be what threw
+    }
+    try {
+        finish(entry, JobState::Failed, reason, nullptr);
+    } catch (...) {
+        // Recording the failure failed too (its files): at least the job is no longer running.
+        std::lock_guard lock(mutex_);
+        finish_locked(*entry, JobState::Failed, reason, nullptr);
+        entry->changed.notify_all();
+    }
 }
 
 void JobManager::run(const std::shared_ptr<Entry>& entry) {

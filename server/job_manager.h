@@ -153,6 +153,8 @@ private:
     void push_event_locked(Entry& entry, protocol::JobEventType type, nlohmann::json data);
     void worker_loop();
     void run(const std::shared_ptr<Entry>& entry);
+    /// Fails a job whose run threw, with the exception's message, whatever else throws.
+    void fail_after_exception(const std::shared_ptr<Entry>& entry, const std::string& what);
     /// Ends a job: state, statistics, events, files, metrics. Takes the mutex itself.
     void finish(const std::shared_ptr<Entry>& entry, protocol::JobState state, std::string error,
                 const RenderStatistics* statistics);
