@@ -3,10 +3,13 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <mutex>
+#include <optional>
 #include <sstream>
+#include <vector>
 
 #include "core/image/exr_io.h"
 #include "core/util/json_depth.h"
@@ -97,6 +100,8 @@ Expected<Arguments> parse_arguments(std::span<const std::string> args) {
             } catch (const std::exception&) {
                 return Error{"--threads: expected a non-negative integer, got '" + *v + "'"};
             }
+            // As `photond serve --threads`: oneTBB fails inside its arena beyond a few thousand.
+            if (a.threads > 4096) return Error{"--threads: at most 4096, got " + *v};
         } else if (arg == "--scene-root") {
             auto v = value("--scene-root");
             if (!v) return v.error();
@@ -126,6 +131,16 @@ Expected<Arguments> parse_arguments(std::span<const std::string> args) {
     }
     if (a.output.empty()) return Error{"missing -o OUT.exr"};
     if (a.scene.empty() && a.job_file.empty()) return Error{"missing SCENE or --job FILE"};
+    // Where the outputs go is checked before the render, not after it.
+    for (const auto& [option, file] : {std::pair{"-o", &a.output}, {"--preview", &a.preview}, {"--stats-json", &a.stats_json}}) {
+        if (file->empty()) continue;
+        const std::filesystem::path parent = std::filesystem::absolute(*file).parent_path();
+        std::error_code error;
+        if (!std::filesystem::is_directory(parent, error))
+            return Error{std::string(option) + " " + *file + ": the directory " + parent.string() + " does not exist"};
+        if (std::filesystem::is_directory(*file, error))
+            return Error{std::string(option) + " " + *file + ": is a directory"};
+    }
     return a;
 }
 
@@ -260,36 +275,42 @@ int run_render_command(std::span<const std::string> args) {
         return 1;
     }
 
-    ExrWriteOptions exr;
-    exr.pixel_type = job->output.pixel_type == "float" ? ExrPixelType::Float : ExrPixelType::Half;
-    exr.tile_size = job->image.tile_size;
-    if (Status st = write_exr(a.output, result->layers, exr); !st) {
-        std::fprintf(stderr, "photond render: %s\n", st.error().message.c_str());
-        return 1;
-    }
+    // Every output is made before any is written, and a failed write removes the ones written
+    // before it: a run leaves all its files or none.
+    std::optional<std::vector<uint8_t>> png;
     if (!a.preview.empty()) {
-        auto png = encode_job_preview(*job, result->layers.beauty);
-        if (!png) {
-            std::fprintf(stderr, "photond render: PNG '%s': %s\n", a.preview.c_str(),
-                         png.error().message.c_str());
+        auto encoded = encode_job_preview(*job, result->layers.beauty);
+        if (!encoded) {
+            std::fprintf(stderr, "photond render: PNG '%s': %s\n", a.preview.c_str(), encoded.error().message.c_str());
             return 1;
         }
-        if (Status st = write_file_atomically(
-                a.preview, {reinterpret_cast<const char*>(png->data()), png->size()});
-            !st) {
-            std::fprintf(stderr, "photond render: %s\n", st.error().message.c_str());
-            return 1;
-        }
+        png = std::move(encoded).value();
     }
+    std::string stats_text;
     if (!a.stats_json.empty()) {
         nlohmann::json stats = protocol::to_json(result->statistics);
         stats["job"] = protocol::to_json(*job);
-        std::ofstream out(a.stats_json);
-        out << protocol::json_text(stats, 2) << "\n";
-        if (!out) {
-            std::fprintf(stderr, "photond render: %s: cannot be written\n", a.stats_json.c_str());
-            return 1;
-        }
+        stats_text = protocol::json_text(stats, 2) + "\n";
+    }
+    std::vector<std::filesystem::path> written;
+    const auto fail = [&](const std::string& message) {
+        std::fprintf(stderr, "photond render: %s\n", message.c_str());
+        std::error_code ignored;
+        for (const std::filesystem::path& file : written) std::filesystem::remove(file, ignored);
+        return 1;
+    };
+    ExrWriteOptions exr;
+    exr.pixel_type = job->output.pixel_type == "float" ? ExrPixelType::Float : ExrPixelType::Half;
+    exr.tile_size = job->image.tile_size;
+    if (Status st = write_exr(a.output, result->layers, exr); !st) return fail(st.error().message);
+    written.push_back(a.output);
+    if (png) {
+        if (Status st = write_file_atomically(a.preview, {reinterpret_cast<const char*>(png->data()), png->size()}); !st)
+            return fail(st.error().message);
+        written.push_back(a.preview);
+    }
+    if (!a.stats_json.empty()) {
+        if (Status st = write_file_atomically(a.stats_json, stats_text); !st) return fail(st.error().message);
     }
     if (!a.quiet) print_statistics(result->statistics);
     // Warnings are never silenced: --quiet prints them alone.

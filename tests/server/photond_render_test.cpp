@@ -259,6 +259,31 @@ bool contains_warning(const nlohmann::json& warnings, const std::string& text) {
     return false;
 }
 
+TEST_F(PhotondRender, BadOutputsAndThreadCountsAreRefusedBeforeTheRenderAndLeaveNothing) {
+    const std::string small = "render builtin:cornell-box --integrator direct --width 16 --height 16 --spp 1 ";
+    // oneTBB failed inside its arena at 100,000 threads; serve caps at 4096, so does render.
+    const auto threads = run(small + "--threads 100000 -o " + (dir_ / "t.exr").string());
+    EXPECT_EQ(threads.exit_code, 2) << threads.output;
+    EXPECT_NE(threads.output.find("--threads: at most 4096"), std::string::npos) << threads.output;
+    // A missing output directory: refused up front, by name (it failed after the whole render).
+    const auto missing = run(small + "-o " + (dir_ / "nowhere" / "m.exr").string());
+    EXPECT_EQ(missing.exit_code, 2) << missing.output;
+    EXPECT_NE(missing.output.find("nowhere does not exist"), std::string::npos) << missing.output;
+    const auto preview = run(small + "-o " + (dir_ / "p.exr").string() + " --preview " + (dir_ / "no" / "p.png").string());
+    EXPECT_EQ(preview.exit_code, 2) << preview.output;
+    EXPECT_FALSE(fs::exists(dir_ / "p.exr"));
+    // A statistics file that cannot be written once the render is done (no file can be made in
+    // /proc, not even by root): no EXR is left behind.
+    const auto stats = run(small + "-o " + (dir_ / "s.exr").string() + " --stats-json /proc/photond-test-stats.json");
+    EXPECT_EQ(stats.exit_code, 1) << stats.output;
+    EXPECT_FALSE(fs::exists(dir_ / "s.exr")) << "an EXR was left behind by a failed run";
+    // A file where the statistics should go is a directory: refused up front as well.
+    fs::create_directories(dir_ / "stats-dir");
+    const auto dir_stats = run(small + "-o " + (dir_ / "d.exr").string() + " --stats-json " + (dir_ / "stats-dir").string());
+    EXPECT_EQ(dir_stats.exit_code, 2) << dir_stats.output;
+    EXPECT_FALSE(fs::exists(dir_ / "d.exr"));
+}
+
 TEST_F(PhotondRender, DeeplyNestedJobsAndGltfFilesAreRefusedByName) {
     // 100,000 levels overflowed the stack of the parsers; refused before parsing, exit 2 / 1.
     std::ofstream(dir_ / "deep.json") << ("{\"scene\": " + std::string(100000, '[') + std::string(100000, ']') + "}");
