@@ -650,7 +650,14 @@ void HttpServer::Impl::readyz(const Request&, Response& res) {
         throw ServiceError(ErrorKind::Unavailable, "the render worker is not running");
     if (!services.jobs.cache_dir_writable())
         throw ServiceError(ErrorKind::Unavailable, "the cache directory is not writable");
-    send_json(res, {{"status", "ready"}});
+    // A full disk fails every job (and refuses every submission): not ready, and why.
+    const std::optional<uint64_t> free = services.jobs.cache_dir_free_bytes();
+    if (free && *free < options.min_free_bytes)
+        throw ServiceError(ErrorKind::Unavailable, "the cache directory's disk has " + std::to_string(*free >> 20) +
+                                                       " MiB free, under the " +
+                                                       std::to_string(options.min_free_bytes >> 20) +
+                                                       " MiB that --min-free-mb asks for");
+    send_json(res, {{"status", "ready"}, {"cache_free_bytes", free ? json(*free) : json(nullptr)}});
 }
 
 void HttpServer::Impl::metrics(const Request&, Response& res) {

@@ -140,6 +140,13 @@ JobManager::JobManager(JobManagerOptions options, std::shared_ptr<EmbreeDevice> 
 
 JobManager::~JobManager() { shutdown(); }
 
+std::optional<uint64_t> JobManager::cache_dir_free_bytes() const {
+    std::error_code error;
+    const std::filesystem::space_info space = std::filesystem::space(options_.cache_dir, error);
+    if (error) return std::nullopt;
+    return space.available;
+}
+
 void JobManager::log(const std::string& line) const {
     if (options_.log) options_.log(line);
 }

@@ -78,6 +78,8 @@ public:
     bool stopping() const { return stopping_.load(); }
     bool worker_running() const { return worker_running_.load(); }
     bool cache_dir_writable() const { return store_.writable(); }
+    /// Bytes available to the daemon on the cache directory's file system; nullopt when unknown.
+    std::optional<uint64_t> cache_dir_free_bytes() const;
 
     struct Submitted {
         protocol::JobStatus status;

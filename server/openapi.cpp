@@ -291,7 +291,7 @@ json openapi_document() {
                           json::array(), false)}};
     paths["/readyz"] = {
         {"get",
-         operation("readyz", "Readiness: the worker runs and the cache directory is writable",
+         operation("readyz", "Readiness: the worker runs, the cache directory is writable and its disk has --min-free-mb free",
                    {{"200", response("ready")}, {"503", problem("not ready")}}, json::array(),
                    false)}};
     paths["/metrics"] = {

@@ -43,6 +43,8 @@ constexpr const char* kUsage =
     "  --scene-root DIR        the only directory {\"path\": ...} scenes may be read from\n"
     "                          (default: the current directory)\n"
     "  --max-body-mb N         largest request body, e.g. a scene upload (default 256)\n"
+    "  --min-free-mb N         /readyz answers 503 while the cache directory's disk has less free\n"
+    "                          (default 64)\n"
     "  --max-bundle-mb N       largest unpacked size of an uploaded zip/tar scene bundle\n"
     "                          (default 1024)\n"
     "  --max-bundle-entries N  most entries of an uploaded scene bundle (default 4096)\n"
@@ -63,6 +65,7 @@ struct Arguments {
     fs::path token_file;
     fs::path scene_root;
     size_t max_body_mb = 256;
+    uint64_t min_free_mb = 64;
     BundleLimits bundle_limits;
     int http_threads = 128;
     bool access_log = false;
@@ -135,6 +138,10 @@ Expected<Arguments> parse_arguments(std::span<const std::string> args) {
             auto n = parse_count<size_t>(arg, *v, 1, size_t{1} << 20);
             if (!n) return n.error();
             a.max_body_mb = *n;
+        } else if (arg == "--min-free-mb") {
+            auto n = parse_count<uint64_t>(arg, *v, 0, uint64_t{1} << 40);
+            if (!n) return n.error();
+            a.min_free_mb = *n;
         } else if (arg == "--max-bundle-mb") {
             auto n = parse_count<uint64_t>(arg, *v, 1, uint64_t{1} << 24);
             if (!n) return n.error();
@@ -284,6 +291,7 @@ int run_serve_command(std::span<const std::string> args) {
     http_options.port = a.port;
     http_options.token = token;
     http_options.max_body_bytes = a.max_body_mb << 20;
+    http_options.min_free_bytes = a.min_free_mb << 20;
     http_options.http_threads = a.http_threads;
     http_options.access_log = a.access_log;
     http_options.log = log_line;

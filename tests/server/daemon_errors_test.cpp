@@ -246,6 +246,20 @@ TEST_F(DaemonErrors, BodiesOver8KiBAreReadWhateverTheirContentType) {
     expect_problem(client, client.post("/v1/jobs", std::string(2 << 20, ' '), form), 413, "", "1 MiB");
 }
 
+TEST_F(DaemonErrors, ReadinessSaysWhenTheCacheDiskIsFull) {
+    // A disk with less free space than --min-free-mb (here more than any disk has: 2^40 MiB) is
+    // a full one for readiness: 503 with what is free; health stays 200 (the process is fine).
+    Daemon full(dir_.path() / "full", {"--min-free-mb", std::to_string(uint64_t{1} << 40)});
+    ASSERT_TRUE(full.started()) << full.log();
+    const HttpClient client = full.client();
+    expect_problem(client, client.get("/readyz"), 503, "", "MiB free, under the");
+    Daemon roomy(dir_.path() / "roomy", {"--min-free-mb", "0"});
+    ASSERT_TRUE(roomy.started()) << roomy.log();
+    const HttpResponse ready = roomy.client().get("/readyz");
+    EXPECT_EQ(ready.status, 200) << ready.body;
+    EXPECT_GT(ready.json_body().value("cache_free_bytes", uint64_t{0}), 0u) << ready.body;
+}
+
 TEST_F(DaemonErrors, LightingThatCannotWorkIsRefusedAtSubmission) {
     const fs::path root = dir_.path() / "scenes";
     fs::create_directories(root);
