@@ -82,6 +82,7 @@ struct JobManager::Entry {
     std::map<TileIndex, std::shared_ptr<const Image>> tiles;  // finished, while rendering
     std::vector<TileIndex> finished_order;
     std::shared_ptr<const ImageLayers> image;  // a done job's final image, while in memory
+    bool image_verified = false;  // its file matched the checksum written with it (this process)
     bool cancelled_by_user = false;
     Clock::time_point pass_started;
     mutable std::condition_variable changed;
@@ -528,11 +529,51 @@ void JobManager::remember_image_locked(const std::shared_ptr<Entry>& entry) {
     }
 }
 
+bool JobManager::verify_image(const std::shared_ptr<Entry>& entry) {
+    {
+        std::lock_guard lock(mutex_);
+        if (entry->image_verified) return true;
+    }
+    const std::string id = entry->id();
+    auto expected = read_file_bytes(store_.image_checksum_path(id));
+    if (!expected) return true;  // a job kept by an earlier version, which wrote no checksum
+    std::string reason;
+    if (auto bytes = read_file_bytes(store_.image_path(id))) {
+        std::string recorded(expected->begin(), expected->end());
+        while (!recorded.empty() && (recorded.back() == '\n' || recorded.back() == '\r')) recorded.pop_back();
+        if (sha256_hex(*bytes) == recorded) {
+            std::lock_guard lock(mutex_);
+            entry->image_verified = true;
+            return true;
+        }
+        reason = "the result image does not match the checksum written with it (" + std::to_string(bytes->size()) +
+                 " bytes on disk): moved aside as image.exr.corrupt";
+    } else {
+        reason = "the result image cannot be read from the cache directory";
+    }
+    std::error_code ignored;
+    fs::rename(store_.image_path(id), store_.image_path(id).string() + ".corrupt", ignored);
+    fs::remove(store_.preview_path(id), ignored);
+    log("job " + id + ": " + reason);
+    protocol::JobStatus failed;
+    {
+        std::lock_guard lock(mutex_);
+        entry->status.state = JobState::Failed;
+        entry->status.error = reason;
+        entry->image.reset();
+        entry->changed.notify_all();
+        failed = entry->status;
+    }
+    if (Status saved = store_.save_status(failed); !saved) log("job " + id + ": " + saved.error().message);
+    return false;
+}
+
 std::shared_ptr<const ImageLayers> JobManager::final_image(const std::shared_ptr<Entry>& entry) {
     {
         std::lock_guard lock(mutex_);
         if (entry->image) return entry->image;
     }
+    if (!verify_image(entry)) return nullptr;
     auto image = read_exr(store_.image_path(entry->id()));
     if (!image) {
         log("job " + entry->id() + ": " + image.error().message);
@@ -545,9 +586,18 @@ std::shared_ptr<const ImageLayers> JobManager::final_image(const std::shared_ptr
     return shared;
 }
 
-fs::path JobManager::image_file(const std::string& id) const {
+fs::path JobManager::image_file(const std::string& id) {
+    std::shared_ptr<Entry> entry;
+    bool done = false;
+    {
+        std::lock_guard lock(mutex_);
+        entry = find_locked(id);
+        done = entry->status.state == JobState::Done;
+    }
+    // Checked against its checksum outside the lock (hashing a large file takes a while); a
+    // damaged file fails the job and is answered as a failed job's image is.
+    if (done) verify_image(entry);
     std::lock_guard lock(mutex_);
-    const auto entry = find_locked(id);
     const protocol::JobStatus& s = entry->status;
     switch (s.state) {
         case JobState::Done:
@@ -580,6 +630,10 @@ std::vector<uint8_t> JobManager::preview_png(const std::string& id) {
         if (state == JobState::Running) tiles.assign(entry->tiles.begin(), entry->tiles.end());
     }
     if (tiles.empty() && entry->status.state != JobState::Running) {
+        if (!verify_image(entry)) {
+            std::lock_guard lock(mutex_);
+            throw ServiceError(ErrorKind::Conflict, "job " + id + " failed: " + entry->status.error);
+        }
         if (auto bytes = read_file_bytes(store_.preview_path(id))) return std::move(*bytes);
         const auto image = final_image(entry);
         if (!image)
@@ -746,6 +800,20 @@ void JobManager::run(const std::shared_ptr<Entry>& entry) {
     if (Status written = write_exr(store_.image_path(e.id()), result->layers, exr); !written) {
         finish(entry, JobState::Failed, written.error().message, &result->statistics);
         return;
+    }
+    // Its checksum beside it, so that a file damaged later (a truncated copy, a bad disk) is
+    // never served as the result.
+    Status checksummed = Error{"the image cannot be read back"};
+    if (auto bytes = read_file_bytes(store_.image_path(e.id())))
+        checksummed = write_file_atomically(store_.image_checksum_path(e.id()), sha256_hex(*bytes) + "\n");
+    if (!checksummed) {
+        finish(entry, JobState::Failed, "the image's checksum cannot be written: " + checksummed.error().message,
+               &result->statistics);
+        return;
+    }
+    {
+        std::lock_guard lock(mutex_);
+        e.image_verified = true;
     }
     result->statistics.passes.push_back(
         {"writing", std::chrono::duration<double>(Clock::now() - writing_started).count()});

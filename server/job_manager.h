@@ -134,7 +134,7 @@ public:
     std::optional<std::vector<uint8_t>> tile_exr(const std::string& id, protocol::TileIndex tile);
 
     /// The final image's file; Conflict while the job is not done.
-    std::filesystem::path image_file(const std::string& id) const;
+    std::filesystem::path image_file(const std::string& id);
     /// A PNG preview: of the finished image, or of the tiles finished so far while rendering;
     /// Conflict for a queued, failed or cancelled job.
     std::vector<uint8_t> preview_png(const std::string& id);
@@ -162,6 +162,9 @@ private:
                 const RenderStatistics* statistics);
     void finish_locked(Entry& entry, protocol::JobState state, std::string error,
                        const RenderStatistics* statistics);
+    /// Whether a done job's image file matches the checksum written with it (once per process);
+    /// a damaged one is moved aside and the job failed with the reason.
+    bool verify_image(const std::shared_ptr<Entry>& entry);
     /// The final image of a done job, from memory or from its EXR on disk.
     std::shared_ptr<const ImageLayers> final_image(const std::shared_ptr<Entry>& entry);
     void remember_image_locked(const std::shared_ptr<Entry>& entry);

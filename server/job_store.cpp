@@ -38,6 +38,10 @@ JobStore::JobStore(fs::path directory) : directory_(std::move(directory)) {
 
 fs::path JobStore::job_directory(const std::string& id) const { return directory_ / id; }
 fs::path JobStore::image_path(const std::string& id) const { return directory_ / id / "image.exr"; }
+
+fs::path JobStore::image_checksum_path(const std::string& id) const {
+    return directory_ / id / "image.exr.sha256";
+}
 fs::path JobStore::preview_path(const std::string& id) const {
     return directory_ / id / "preview.png";
 }

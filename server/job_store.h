@@ -48,6 +48,8 @@ public:
     std::filesystem::path job_directory(const std::string& id) const;
     std::filesystem::path image_path(const std::string& id) const;
     std::filesystem::path preview_path(const std::string& id) const;
+    /// The SHA-256 (hex) of the final image as it was written, beside it.
+    std::filesystem::path image_checksum_path(const std::string& id) const;
 
     struct Loaded {
         std::vector<StoredJob> jobs;

@@ -70,6 +70,40 @@ TEST_F(DaemonCache, SecondViewOfASceneSkipsPhotonTracing) {
     EXPECT_EQ(daemon.stop(), 0) << daemon.log();
 }
 
+TEST_F(DaemonCache, ADamagedResultImageIsNeverServed) {
+    // The final EXR is written with its SHA-256 beside it; a file damaged afterwards (here cut to
+    // half) fails the job with the reason and is moved aside, also after a restart.
+    Daemon daemon(dir_.path() / "cache");
+    ASSERT_TRUE(daemon.started()) << daemon.log();
+    const HttpClient client = daemon.client();
+    const json job = {{"scene", {{"builtin", "cornell-box"}}}, {"integrator", "direct"},
+                      {"image", {{"width", 32}, {"height", 32}, {"spp", 1}}}};
+    const json done = render(client, job);
+    ASSERT_EQ(done.at("state"), "done") << done.dump();
+    const std::string id = done.at("id");
+    const fs::path image = dir_.path() / "cache" / "jobs" / id / "image.exr";
+    ASSERT_TRUE(fs::exists(image));
+    EXPECT_TRUE(fs::exists(image.string() + ".sha256"));
+    EXPECT_EQ(client.get("/v1/jobs/" + id + "/image.exr").status, 200);  // intact: served
+
+    // Cut to half while the daemon is down: the restarted one finds it out on the first request.
+    const std::string bytes = read_file(image);
+    EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+    write_file(image, bytes.substr(0, bytes.size() / 2));
+    Daemon restarted(dir_.path() / "cache");
+    ASSERT_TRUE(restarted.started()) << restarted.log();
+    const HttpClient again = restarted.client();
+    const HttpResponse refused = again.get("/v1/jobs/" + id + "/image.exr");
+    EXPECT_EQ(refused.status, 409) << refused.body;
+    EXPECT_NE(refused.body.find("does not match the checksum"), std::string::npos) << refused.body;
+    EXPECT_EQ(again.get("/v1/jobs/" + id + "/preview.png").status, 409);
+    const json status = again.get("/v1/jobs/" + id).json_body();
+    EXPECT_EQ(status.at("state"), "failed") << status.dump();
+    EXPECT_TRUE(fs::exists(image.string() + ".corrupt"));
+    EXPECT_FALSE(fs::exists(image));
+    EXPECT_EQ(again.get("/healthz").status, 200);
+}
+
 TEST_F(DaemonCache, PhotonMapsMoveBetweenDaemonsByExportAndImport) {
     Daemon source(dir_.path() / "source");
     Daemon target(dir_.path() / "target");
