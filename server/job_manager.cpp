@@ -357,11 +357,14 @@ JobManager::Submitted JobManager::submit(const protocol::Job& job,
     submission.idempotency_key = idempotency_key;
     submission.request_digest = digest;
     auto entry = std::make_shared<Entry>(submission);
-    // On disk first: a job the client was told about survives a crash right after.
-    if (Status saved = store_.save_submission(submission); !saved)
+    // On disk first: a job the client was told about survives a crash right after. A job that
+    // cannot be kept whole leaves nothing (the next start reported each such directory).
+    Status saved = store_.save_submission(submission);
+    if (saved) saved = store_.save_status(entry->status);
+    if (!saved) {
+        store_.discard(submission.id);
         throw ServiceError(ErrorKind::Unavailable, "cannot keep the job: " + saved.error().message);
-    if (Status saved = store_.save_status(entry->status); !saved)
-        throw ServiceError(ErrorKind::Unavailable, "cannot keep the job: " + saved.error().message);
+    }
 
     protocol::JobStatus status;
     {

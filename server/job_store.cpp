@@ -39,6 +39,11 @@ JobStore::JobStore(fs::path directory) : directory_(std::move(directory)) {
 fs::path JobStore::job_directory(const std::string& id) const { return directory_ / id; }
 fs::path JobStore::image_path(const std::string& id) const { return directory_ / id / "image.exr"; }
 
+void JobStore::discard(const std::string& id) {
+    std::error_code ignored;
+    fs::remove_all(job_directory(id), ignored);
+}
+
 fs::path JobStore::image_checksum_path(const std::string& id) const {
     return directory_ / id / "image.exr.sha256";
 }

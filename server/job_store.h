@@ -44,6 +44,8 @@ public:
 
     Status save_submission(const JobSubmission& submission);
     Status save_status(const protocol::JobStatus& status);
+    /// Removes a job's directory and all in it (a submission that could not be kept whole).
+    void discard(const std::string& id);
 
     std::filesystem::path job_directory(const std::string& id) const;
     std::filesystem::path image_path(const std::string& id) const;

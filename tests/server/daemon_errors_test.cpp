@@ -2,6 +2,9 @@
 // message (and the offending field's path for job fields), and the daemon keeps serving.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+#include <fstream>
+
 #include "tests/server/daemon_harness.h"
 
 namespace photond::test {
@@ -258,6 +261,60 @@ TEST_F(DaemonErrors, ReadinessSaysWhenTheCacheDiskIsFull) {
     const HttpResponse ready = roomy.client().get("/readyz");
     EXPECT_EQ(ready.status, 200) << ready.body;
     EXPECT_GT(ready.json_body().value("cache_free_bytes", uint64_t{0}), 0u) << ready.body;
+}
+
+/// A tmpfs of `kilobytes` mounted at `path` for the test's lifetime (needs CAP_SYS_ADMIN).
+class SmallDisk {
+public:
+    SmallDisk(const fs::path& path, int kilobytes) : path_(path) {
+        fs::create_directories(path);
+        mounted_ = std::system(("mount -t tmpfs -o size=" + std::to_string(kilobytes) + "k tmpfs '" + path.string() +
+                                "' 2>/dev/null")
+                                   .c_str()) == 0;
+    }
+    ~SmallDisk() {
+        if (mounted_) (void)std::system(("umount '" + path_.string() + "'").c_str());
+    }
+    bool mounted() const { return mounted_; }
+
+private:
+    fs::path path_;
+    bool mounted_ = false;
+};
+
+TEST_F(DaemonErrors, AFullCacheDiskRefusesJobsAndLeavesNoHalfWrittenOnes) {
+    const SmallDisk disk(dir_.path() / "disk", 512);
+    if (!disk.mounted()) GTEST_SKIP() << "mounting a tmpfs needs CAP_SYS_ADMIN";
+    const fs::path cache = dir_.path() / "disk" / "cache";
+    {
+        Daemon daemon(cache, {"--min-free-mb", "0"});
+        ASSERT_TRUE(daemon.started()) << daemon.log();
+        const HttpClient client = daemon.client();
+        // Fill the disk to the last byte.
+        {
+            std::ofstream filler(dir_.path() / "disk" / "filler", std::ios::binary);
+            const std::string block(4096, 'x');
+            while (filler.write(block.data(), static_cast<std::streamsize>(block.size()))) {
+            }
+        }
+        for (int i = 0; i < 5; ++i) {
+            const HttpResponse r = client.post("/v1/jobs", with(kSmallJob, "/seed", i).dump());
+            EXPECT_EQ(r.status, 503) << r.body;
+            EXPECT_NE(r.body.find("cannot keep the job"), std::string::npos) << r.body;
+        }
+        EXPECT_EQ(client.get("/healthz").status, 200);
+        size_t directories = 0;
+        for (const auto& entry : fs::directory_iterator(cache / "jobs")) directories += entry.is_directory();
+        EXPECT_EQ(directories, 0u) << "refused submissions left job directories behind";
+        EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+    }
+    // With room again, a restart reports no broken job and serves a new one.
+    fs::remove(dir_.path() / "disk" / "filler");
+    Daemon restarted(cache, {"--min-free-mb", "0"});
+    ASSERT_TRUE(restarted.started()) << restarted.log();
+    EXPECT_EQ(restarted.log().find("cannot"), std::string::npos) << restarted.log();
+    const HttpResponse accepted = restarted.client().post("/v1/jobs", kSmallJob.dump());
+    EXPECT_EQ(accepted.status, 202) << accepted.body;
 }
 
 TEST_F(DaemonErrors, LightingThatCannotWorkIsRefusedAtSubmission) {
