@@ -141,6 +141,20 @@ JobManager::JobManager(JobManagerOptions options, std::shared_ptr<EmbreeDevice> 
 
 JobManager::~JobManager() { shutdown(); }
 
+void JobManager::keep_status(const protocol::JobStatus& status) {
+    const Status saved = store_.save_status(status);
+    if (saved) return;
+    metrics_->record_store_failure();
+    const std::string warning = "the job's state could not be written to the cache directory (" +
+                                saved.error().message + "): a restart may find it as it was before";
+    log("job " + status.id + ": " + warning);
+    std::lock_guard lock(mutex_);
+    if (const auto it = jobs_.find(status.id); it != jobs_.end()) {
+        std::vector<std::string>& warnings = it->second->status.warnings;
+        if (std::find(warnings.begin(), warnings.end(), warning) == warnings.end()) warnings.push_back(warning);
+    }
+}
+
 std::optional<uint64_t> JobManager::cache_dir_free_bytes() const {
     std::error_code error;
     const std::filesystem::space_info space = std::filesystem::space(options_.cache_dir, error);
@@ -177,7 +191,7 @@ void JobManager::restore(StoredJob stored) {
         changed = true;
     }
     entry->status = std::move(status);
-    if (changed) (void)store_.save_status(entry->status);
+    if (changed) keep_status(entry->status);
 
     std::lock_guard lock(mutex_);
     Entry& e = *entry;
@@ -417,7 +431,7 @@ protocol::JobStatus JobManager::cancel(const std::string& id, std::chrono::milli
             finish_locked(*entry, JobState::Cancelled, "", nullptr);
             const protocol::JobStatus status = entry->status;
             lock.unlock();
-            (void)store_.save_status(status);
+            keep_status(status);
             log("job " + id + " cancelled while queued");
             return status;
         }
@@ -644,8 +658,10 @@ std::vector<uint8_t> JobManager::preview_png(const std::string& id) {
         auto png = encode_job_preview(entry->submission.job, image->beauty);
         if (!png) throw ServiceError(ErrorKind::Internal, png.error().message);
         // Made on the first request rather than with every job; kept for the next one.
-        (void)write_file_atomically(store_.preview_path(id),
-                                    {reinterpret_cast<const char*>(png->data()), png->size()});
+        if (Status kept = write_file_atomically(store_.preview_path(id),
+                                                {reinterpret_cast<const char*>(png->data()), png->size()});
+            !kept)
+            log("job " + id + ": the preview is not kept (made again on the next request): " + kept.error().message);
         return std::move(png).value();
     }
     // While rendering: the finished tiles on black.
@@ -693,7 +709,7 @@ void JobManager::worker_loop() {
         // the daemon through std::terminate).
         std::string thrown;
         try {
-            (void)store_.save_status(status(entry->id()));
+            keep_status(status(entry->id()));
             log("job " + entry->id() + " started");
             run(entry);
         } catch (const std::exception& error) {
@@ -783,7 +799,7 @@ void JobManager::run(const std::shared_ptr<Entry>& entry) {
             e.changed.notify_all();
             requeued = e.status;
         }
-        (void)store_.save_status(requeued);
+        keep_status(requeued);
         log("job " + e.id() + " interrupted by shutdown; queued again for the next start");
         return;
     }
@@ -880,7 +896,7 @@ void JobManager::finish(const std::shared_ptr<Entry>& entry, JobState state, std
         finish_locked(*entry, state, std::move(error), statistics);
         status = entry->status;
     }
-    (void)store_.save_status(status);
+    keep_status(status);
     std::string line = "job " + status.id + " " + std::string(protocol::to_string(state));
     if (statistics) {
         char seconds[32];

@@ -155,6 +155,9 @@ private:
     void push_event_locked(Entry& entry, protocol::JobEventType type, nlohmann::json data);
     void worker_loop();
     void run(const std::shared_ptr<Entry>& entry);
+    /// Writes a job's status; a refusal is logged, counted in /metrics and becomes a warning of
+    /// the job. Call without holding mutex_.
+    void keep_status(const protocol::JobStatus& status);
     /// Fails a job whose run threw, with the exception's message, whatever else throws.
     void fail_after_exception(const std::shared_ptr<Entry>& entry, const std::string& what);
     /// Ends a job: state, statistics, events, files, metrics. Takes the mutex itself.

@@ -49,6 +49,9 @@ std::string Metrics::render(const MetricsSnapshot& s) const {
     header(out, "photond_rays_total", "counter",
            "Rays traced by finished renders (intersection and shadow rays).");
     sample(out, "photond_rays_total", rays_.load());
+    header(out, "photond_store_write_failures_total", "counter",
+           "Job states the cache directory refused to take (the job carries a warning).");
+    sample(out, "photond_store_write_failures_total", store_failures_.load());
     header(out, "photond_photon_cache_hits_total", "counter",
            "Photon maps taken from the cache (memory or disk) instead of traced.");
     sample(out, "photond_photon_cache_hits_total", s.photon_cache_hits);

@@ -28,6 +28,8 @@ public:
     void record_submitted() { jobs_submitted_.fetch_add(1, std::memory_order_relaxed); }
     void record_tile() { tiles_rendered_.fetch_add(1, std::memory_order_relaxed); }
     void record_rays(uint64_t rays) { rays_.fetch_add(rays, std::memory_order_relaxed); }
+    /// A job record or status the cache directory refused to take.
+    void record_store_failure() { store_failures_.fetch_add(1, std::memory_order_relaxed); }
     /// One pass of one job ("scene", "photon_tracing", "render", ...).
     void record_pass(const std::string& pass, double seconds);
     /// One HTTP response, by status class.
@@ -50,6 +52,7 @@ private:
     std::atomic<uint64_t> jobs_submitted_{0};
     std::atomic<uint64_t> tiles_rendered_{0};
     std::atomic<uint64_t> rays_{0};
+    std::atomic<uint64_t> store_failures_{0};
     std::array<std::atomic<uint64_t>, 6> responses_{};  // 1xx..5xx by index 1..5, 0 = other
     mutable std::mutex mutex_;
     std::map<std::string, Histogram> pass_seconds_;

@@ -290,6 +290,9 @@ TEST_F(DaemonErrors, AFullCacheDiskRefusesJobsAndLeavesNoHalfWrittenOnes) {
         Daemon daemon(cache, {"--min-free-mb", "0"});
         ASSERT_TRUE(daemon.started()) << daemon.log();
         const HttpClient client = daemon.client();
+        // A job accepted while there is room, still rendering when the disk fills.
+        const HttpResponse running = client.post("/v1/jobs", kLongJob.dump());
+        ASSERT_EQ(running.status, 202) << running.body;
         // Fill the disk to the last byte.
         {
             std::ofstream filler(dir_.path() / "disk" / "filler", std::ios::binary);
@@ -303,16 +306,27 @@ TEST_F(DaemonErrors, AFullCacheDiskRefusesJobsAndLeavesNoHalfWrittenOnes) {
             EXPECT_NE(r.body.find("cannot keep the job"), std::string::npos) << r.body;
         }
         EXPECT_EQ(client.get("/healthz").status, 200);
+        // The running job cannot write its image: it fails with the reason, and the states the
+        // disk refused are counted and carried by the job as a warning.
+        const json ended = wait_for_status(client, running.json_body().at("id"), is_terminal_state);
+        EXPECT_EQ(ended.at("state"), "failed") << ended.dump();
+        bool warned = false;
+        for (const json& w : ended.value("warnings", json::array()))
+            warned = warned || w.get<std::string>().find("could not be written to the cache directory") != std::string::npos;
+        EXPECT_TRUE(warned) << ended.dump();
+        const std::string metrics = client.get("/metrics").body;
+        EXPECT_EQ(metrics.find("photond_store_write_failures_total 0\n"), std::string::npos) << metrics;
+        EXPECT_NE(metrics.find("photond_store_write_failures_total "), std::string::npos) << metrics;
         size_t directories = 0;
         for (const auto& entry : fs::directory_iterator(cache / "jobs")) directories += entry.is_directory();
-        EXPECT_EQ(directories, 0u) << "refused submissions left job directories behind";
+        EXPECT_EQ(directories, 1u) << "refused submissions left job directories behind (only the accepted one may stay)";
         EXPECT_EQ(daemon.stop(), 0) << daemon.log();
     }
-    // With room again, a restart reports no broken job and serves a new one.
+    // With room again, a restart finds no broken job directory and serves a new one.
     fs::remove(dir_.path() / "disk" / "filler");
     Daemon restarted(cache, {"--min-free-mb", "0"});
     ASSERT_TRUE(restarted.started()) << restarted.log();
-    EXPECT_EQ(restarted.log().find("cannot"), std::string::npos) << restarted.log();
+    EXPECT_EQ(restarted.log().find("cannot be read"), std::string::npos) << restarted.log();
     const HttpResponse accepted = restarted.client().post("/v1/jobs", kSmallJob.dump());
     EXPECT_EQ(accepted.status, 202) << accepted.body;
 }
