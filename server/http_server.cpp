@@ -631,8 +631,10 @@ void HttpServer::Impl::import_photon_maps(const Request& req, Response& res) {
                            "'" + key + "' is not a photon-map key (pm1-<64 hex digits>)");
     const std::span<const uint8_t> bytes(reinterpret_cast<const uint8_t*>(req.body.data()),
                                          req.body.size());
-    auto imported = services.photon_maps.import_maps(key, bytes);
-    if (!imported) throw ServiceError(ErrorKind::InvalidField, imported.error().message);
+    bool conflict = false;
+    auto imported = services.photon_maps.import_maps(key, bytes, &conflict);
+    if (!imported)
+        throw ServiceError(conflict ? ErrorKind::Conflict : ErrorKind::InvalidField, imported.error().message);
     send_json(res, {{"key", key}, {"created", *imported}}, *imported ? 201 : 200);
 }
 

@@ -1,6 +1,7 @@
 #include "server/photon_map_cache.h"
 
 #include <algorithm>
+#include <cstring>
 #include <regex>
 #include <system_error>
 
@@ -144,7 +145,24 @@ std::optional<std::vector<uint8_t>> PhotonMapCache::export_maps(const std::strin
     return std::move(bytes).value();
 }
 
-Expected<bool> PhotonMapCache::import_maps(const std::string& key, std::span<const uint8_t> bytes) {
+namespace {
+
+/// The same photons (bit for bit, in the same order) and emission counts in every map; the
+/// statistics' timings may differ between two traces of one key.
+bool same_photons(const PhotonMaps& a, const PhotonMaps& b) {
+    const auto same = [](const std::shared_ptr<const PhotonMap>& x, const std::shared_ptr<const PhotonMap>& y) {
+        if (!x || !y) return !x && !y;
+        const std::span<const Photon> p = x->tree().photons(), q = y->tree().photons();
+        return x->emitted() == y->emitted() && p.size() == q.size() &&
+               std::memcmp(p.data(), q.data(), p.size_bytes()) == 0;
+    };
+    return same(a.global, b.global) && same(a.caustic, b.caustic) && same(a.irradiance, b.irradiance);
+}
+
+}  // namespace
+
+Expected<bool> PhotonMapCache::import_maps(const std::string& key, std::span<const uint8_t> bytes, bool* conflict) {
+    if (conflict) *conflict = false;
     if (!is_valid_key(key))
         return Error{"'" + key + "' is not a photon-map key (pm1-<64 hex digits>)"};
     auto maps = deserialize_photon_maps(bytes, key);
@@ -152,10 +170,27 @@ Expected<bool> PhotonMapCache::import_maps(const std::string& key, std::span<con
     auto shared = std::make_shared<const PhotonMaps>(std::move(maps).value());
     std::error_code error;
     const bool on_disk = fs::exists(file_of(key), error);
-    bool in_memory = false;
+    std::shared_ptr<const PhotonMaps> kept;
     {
         std::lock_guard lock(mutex_);
-        in_memory = entries_.contains(key);
+        kept = find_locked(key);
+    }
+    const bool in_memory = kept != nullptr;
+    if (!kept && on_disk) {
+        if (auto file = read_file_bytes(file_of(key))) {
+            if (auto valid = deserialize_photon_maps(*file, key))
+                kept = std::make_shared<const PhotonMaps>(std::move(valid).value());
+        }
+    }
+    // Maps are keyed by what they were traced from: a valid one kept under this key is never
+    // replaced by different photons (relabelled maps of another scene were taken, and the next
+    // render reported a cache hit with another image). A corrupt file is replaced.
+    if (kept) {
+        if (same_photons(*kept, *shared)) return false;
+        if (conflict) *conflict = true;
+        return Error{"a different valid photon map is already kept under " + key +
+                     ": photon maps are keyed by the scene and settings they were traced from, so these photons were "
+                     "not traced for this key (the kept map stays)"};
     }
     // Written even when a file exists: it may be a corrupt one, and the rename is atomic.
     if (Status written = write_photon_maps_file(file_of(key), *shared, key); !written)

@@ -54,8 +54,9 @@ public:
 
     /// Imports maps exported by another node. The bytes are checked (format, checksum, kd-tree,
     /// and that they were written for `key`); an Error says what is wrong. Returns true when the
-    /// key was new, false when it was already cached (the bytes are then still checked).
-    Expected<bool> import_maps(const std::string& key, std::span<const uint8_t> bytes);
+    /// key was new, false when the same photons were already kept. Different photons than a
+    /// valid map kept under the key are refused, with *conflict set.
+    Expected<bool> import_maps(const std::string& key, std::span<const uint8_t> bytes, bool* conflict = nullptr);
 
     /// The keys on disk or in memory, sorted.
     std::vector<std::string> keys() const;

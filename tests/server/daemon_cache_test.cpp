@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "core/image/exr_io.h"
+#include "core/util/sha256.h"
 #include "tests/server/daemon_harness.h"
 
 namespace photond::test {
@@ -140,6 +141,22 @@ TEST_F(DaemonCache, PhotonMapsMoveBetweenDaemonsByExportAndImport) {
     EXPECT_EQ(imported.status, 201) << imported.body;
     EXPECT_EQ(client.request("PUT", "/v1/photon-maps/" + key, exported.body).status, 200);
     EXPECT_EQ(client.get("/v1/photon-maps/" + key).body, exported.body);
+    // Another scene's maps relabelled with this key (checksum recomputed) do not replace them.
+    json other_job = photon_job();
+    other_job["photons"]["seed"] = 4;
+    const std::string forged_from = render(source.client(), other_job).at("photons").at("key");
+    std::string forged = source.client().get("/v1/photon-maps/" + forged_from).body;
+    ASSERT_EQ(forged_from.size(), key.size());
+    const size_t at = forged.find(forged_from);
+    ASSERT_NE(at, std::string::npos);
+    forged.replace(at, key.size(), key);
+    const std::string body = forged.substr(0, forged.size() - 32);
+    const Sha256Digest digest = sha256({reinterpret_cast<const uint8_t*>(body.data()), body.size()});
+    forged = body + std::string(reinterpret_cast<const char*>(digest.data()), digest.size());
+    const HttpResponse refused = client.request("PUT", "/v1/photon-maps/" + key, forged);
+    EXPECT_EQ(refused.status, 409) << refused.body;
+    EXPECT_NE(refused.body.find("not traced for this key"), std::string::npos) << refused.body;
+    EXPECT_EQ(client.get("/v1/photon-maps/" + key).body, exported.body) << "the kept map was replaced";
 
     const json rendered = render(client, photon_job(kOtherView));
     ASSERT_EQ(rendered.at("state"), "done");
