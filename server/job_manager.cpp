@@ -1,5 +1,7 @@
 #include "server/job_manager.h"
 
+#include <malloc.h>
+
 #include <algorithm>
 #include <cmath>
 #include <ctime>
@@ -718,6 +720,10 @@ void JobManager::worker_loop() {
             thrown = "an exception that is not a std::exception";
         }
         if (!thrown.empty()) fail_after_exception(entry, thrown);
+        // A job's scene, acceleration structure and buffers are freed when it ends, but glibc
+        // keeps freed memory of its many arenas mapped: the daemon's RSS grew by about 1.4 MB per
+        // finished job (a thousand 1x1 jobs: +1.4 GB), all of it handed back by malloc_trim.
+        malloc_trim(0);
         std::lock_guard lock(mutex_);
         running_.reset();
     }

@@ -407,6 +407,13 @@ public:
     ~Daemon() { stop(); }
 
     bool started() const { return port_ > 0; }
+    /// The daemon's resident set size in kB (/proc/<pid>/status VmRSS); 0 when unknown.
+    long resident_kb() const {
+        std::ifstream status("/proc/" + std::to_string(pid_) + "/status");
+        for (std::string line; std::getline(status, line);)
+            if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+        return 0;
+    }
     int port() const { return port_; }
     const std::string& first_line() const { return first_line_; }
     std::string log() const { return read_file(log_path_); }
