@@ -291,7 +291,8 @@ json openapi_document() {
                           json::array(), false)}};
     paths["/readyz"] = {
         {"get",
-         operation("readyz", "Readiness: the worker runs, the cache directory is writable and its disk has --min-free-mb free",
+         operation("readyz",
+                   "Readiness: the worker runs, the cache directory is writable and its disk has --min-free-mb free",
                    {{"200", response("ready")}, {"503", problem("not ready")}}, json::array(),
                    false)}};
     paths["/metrics"] = {

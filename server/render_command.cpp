@@ -132,7 +132,8 @@ Expected<Arguments> parse_arguments(std::span<const std::string> args) {
     if (a.output.empty()) return Error{"missing -o OUT.exr"};
     if (a.scene.empty() && a.job_file.empty()) return Error{"missing SCENE or --job FILE"};
     // Where the outputs go is checked before the render, not after it.
-    for (const auto& [option, file] : {std::pair{"-o", &a.output}, {"--preview", &a.preview}, {"--stats-json", &a.stats_json}}) {
+    for (const auto& [option, file] :
+         {std::pair{"-o", &a.output}, {"--preview", &a.preview}, {"--stats-json", &a.stats_json}}) {
         if (file->empty()) continue;
         const std::filesystem::path parent = std::filesystem::absolute(*file).parent_path();
         std::error_code error;

@@ -101,10 +101,9 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
             if (from) {
                 const Color emitted = rs.lights->emitted_radiance(si, wo);
                 if (!is_black(emitted)) {
-                    const float weight =
-                        from->pdf > 0.0f
-                            ? power_heuristic(from->pdf, rs.lights->pdf_incident_triangle(si.triangle, from->point, si.p))
-                            : 1.0f;
+                    const float light_pdf =
+                        from->pdf > 0.0f ? rs.lights->pdf_incident_triangle(si.triangle, from->point, si.p) : 0.0f;
+                    const float weight = from->pdf > 0.0f ? power_heuristic(from->pdf, light_pdf) : 1.0f;
                     radiance += emitted * weight;
                 }
             }
@@ -140,7 +139,8 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
             const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Radiance, kGlossy);
             if (s && s->pdf > 0.0f && !is_black(s->weight)) {
                 const GlossyOrigin origin{si.p, s->pdf};
-                radiance += s->weight * along(spawn_ray(rs, si, s->wi), depth, nullptr, false, glossy_bounces + 1, &origin);
+                radiance += s->weight *
+                            along(spawn_ray(rs, si, s->wi), depth, nullptr, false, glossy_bounces + 1, &origin);
             }
             return radiance;
         }

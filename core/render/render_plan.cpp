@@ -49,7 +49,8 @@ RenderPlan plan_photon_passes(const Scene& scene, const LightSet& lights, const 
     if (request.caustic_photons == 0) {
         plan.caustic_map = decide("caustic_map", false, "the job asks for 0 caustic photons");
     } else if (!paths.has_specular) {
-        plan.caustic_map = decide("caustic_map", false, "no surface is ideal specular (mirror, smooth glass), so no L S+ D path exists");
+        plan.caustic_map = decide("caustic_map", false,
+                                  "no surface is ideal specular (mirror, smooth glass), so no L S+ D path exists");
     } else if (!paths.has_receiver) {
         plan.caustic_map = decide("caustic_map", false, "no surface stores photons (every surface is ideal specular)");
     } else if (global && caustic_lights && caustic_lights->empty()) {
@@ -57,7 +58,9 @@ RenderPlan plan_photon_passes(const Scene& scene, const LightSet& lights, const 
                                   "the only light is a diffuse sky, which final gathering collects, also through "
                                   "specular surfaces");
     } else {
-        plan.caustic_map = decide("caustic_map", true, "ideal specular surfaces (mirrors, smooth glass) can focus light onto surfaces that store photons");
+        plan.caustic_map = decide("caustic_map", true,
+                                  "ideal specular surfaces (mirrors, smooth glass) can focus light onto surfaces "
+                                  "that store photons");
     }
     if (request.global_photons == 0) {
         plan.global_map = decide("global_map", false, "the job asks for 0 global photons");
