@@ -116,6 +116,8 @@ bool same_secret(std::string_view given, std::string_view expected) {
 }
 
 protocol::Job decode_job(const std::string& body) {
+    if (body.empty())
+        throw ServiceError(ErrorKind::MalformedRequest, "the request has no body: send the job description as JSON");
     if (json_nesting_depth(body) > kMaxJsonNesting)
         throw ServiceError(ErrorKind::MalformedRequest, json_nesting_message());
     const json document = json::parse(body, nullptr, false);
@@ -257,6 +259,21 @@ void HttpServer::Impl::install() {
         return [this, handler = std::move(handler)](const Request& req, Response& res,
                                                     const httplib::ContentReader& content) {
             Request read = req;
+            // Without Content-Length or chunked encoding a request has no body (RFC 9112, 6.3),
+            // and a declared length beyond the limit is refused before any of it is read: the
+            // content reader waited 30 s (its read timeout) for bodies that never came.
+            const std::string declared_length = req.get_header_value("Content-Length");
+            const bool chunked = req.get_header_value("Transfer-Encoding").find("chunked") != std::string::npos;
+            if (declared_length.empty() && !chunked) {
+                handler(read, res);
+                return;
+            }
+            if (!chunked && std::strtoull(declared_length.c_str(), nullptr, 10) > options.max_body_bytes) {
+                res.set_header("Connection", "close");  // its body is not read: no next request on it
+                throw ServiceError(ErrorKind::PayloadTooLarge, "the request body exceeds the limit of " +
+                                                                   std::to_string(options.max_body_bytes >> 20) +
+                                                                   " MiB (--max-body-mb)");
+            }
             const bool complete = content([&](const char* data, size_t length) {
                 read.body.append(data, length);
                 return true;

@@ -247,6 +247,13 @@ TEST_F(DaemonErrors, BodiesOver8KiBAreReadWhateverTheirContentType) {
     EXPECT_EQ(uploaded.status, 201) << uploaded.body;
     // Beyond --max-body-mb the 413 names the real limit.
     expect_problem(client, client.post("/v1/jobs", std::string(2 << 20, ' '), form), 413, "", "1 MiB");
+    // A POST without a body, and one that declares 256 MiB and sends nothing, are answered at
+    // once (both waited out the 30 s read timeout).
+    const auto started = std::chrono::steady_clock::now();
+    expect_problem(client, client.post("/v1/jobs", "", {{"Content-Length", ""}}), 400, "", "no body");
+    expect_problem(client, client.request("POST", "/v1/jobs", "", {{"Content-Length", std::to_string(256 << 20)}}),
+                   413, "", "1 MiB");
+    EXPECT_LT(std::chrono::steady_clock::now() - started, std::chrono::seconds(10));
 }
 
 TEST_F(DaemonErrors, ReadinessSaysWhenTheCacheDiskIsFull) {

@@ -213,8 +213,10 @@ public:
         if (!token_.empty()) head += "Authorization: Bearer " + token_ + "\r\n";
         bool has_length = false;
         for (const auto& [name, value] : headers) {
-            head += name + ": " + value + "\r\n";
             has_length |= lower(name) == "content-length";
+            // {"Content-Length", ""} sends none: a request without a body (RFC 9112, 6.3).
+            if (lower(name) == "content-length" && value.empty()) continue;
+            head += name + ": " + value + "\r\n";
         }
         if (!has_length && (!body.empty() || method == "POST" || method == "PUT"))
             head += "Content-Length: " + std::to_string(body.size()) + "\r\n";
