@@ -27,7 +27,9 @@ struct FieldFailure {
 }
 
 std::string child_path(const std::string& path, std::string_view key) {
-    return path.empty() ? std::string(key) : path + "." + std::string(key);
+    // The empty key is written "" so that the path still names it (and not the whole document).
+    const std::string name = key.empty() ? std::string("\"\"") : std::string(key);
+    return path.empty() ? name : path + "." + name;
 }
 
 std::string element_path(const std::string& path, size_t index) {

@@ -215,7 +215,8 @@ std::string format_sse(const JobEvent& event) {
 json to_json(const Problem& p) {
     json document = {{"type", p.type}, {"title", p.title}, {"status", p.status}};
     if (!p.detail.empty()) document["detail"] = p.detail;
-    if (!p.field.empty()) document["field"] = p.field;
+    // An invalid field is always named; "" is the whole document (e.g. not a JSON object).
+    if (!p.field.empty() || p.status == 422) document["field"] = p.field;
     if (!p.instance.empty()) document["instance"] = p.instance;
     return document;
 }

@@ -80,6 +80,15 @@ TEST_F(DaemonErrors, BadJobsAndUploadsGetProblemsAndTheDaemonKeepsServing) {
                    client.post("/v1/jobs", with(kSmallJob, "/priority", json::array()).dump()), 422,
                    "priority");
     expect_problem(client, client.post("/v1/jobs", json::array({1, 2}).dump()), 422);
+    // The whole document and the empty key are named too ("" and "\"\"").
+    {
+        const json not_object = client.post("/v1/jobs", json::array({1, 2}).dump()).json_body();
+        EXPECT_TRUE(not_object.contains("field") && not_object.at("field") == "") << not_object.dump();
+        const json empty_key = client.post("/v1/jobs", with(kSmallJob, "/", 1).dump()).json_body();
+        EXPECT_EQ(empty_key.value("field", "(none)"), "\"\"") << empty_key.dump();
+        const json nested = client.post("/v1/jobs", with(kSmallJob, "/image/", 1).dump()).json_body();
+        EXPECT_EQ(nested.value("field", "(none)"), "image.\"\"") << nested.dump();
+    }
     // Out of range and absurd sizes.
     expect_problem(client, client.post("/v1/jobs", with(kSmallJob, "/image/width", 1000000).dump()),
                    422, "image.width");
