@@ -228,6 +228,14 @@ LobeMask possible_lobes(const Scene& scene, const Material& m) {
     return lobes;
 }
 
+Color Bsdf::layer_albedo_towards(float cos_theta) const {
+    if (cos_theta != layer_memo_cos_) {
+        layer_memo_cos_ = cos_theta;
+        layer_memo_ = layer_albedo(cos_theta);
+    }
+    return layer_memo_;
+}
+
 Color Bsdf::layer_albedo(float cos_theta) const {
     const SpecularAlbedo e = specular_albedo_terms(m_->albedo_cell, m_->albedo_cell_weight, cos_theta);
     return m_->specular_f0 * e.total + (Color(m_->specular_f90) - m_->specular_f0) * e.schlick;
@@ -336,7 +344,7 @@ Color Bsdf::eval_base_local(const Vec3& wo, const Vec3& wi, bool outside, Transp
     const GgxDistribution ggx(m_->alpha);
     if (wi.z > 0.0f) {
         if (in_mask(mask, LobeKind::Diffuse) && !(mask & kExcludeLambertian)) {
-            f += diffuse_weight_ * kInvPi * (Color(1.0f) - layer_albedo(wo.z)) *
+            f += diffuse_weight_ * kInvPi * (Color(1.0f) - layer_albedo_towards(wo.z)) *
                  (Color(1.0f) - layer_albedo(wi.z)) * m_->diffuse_norm;
         }
         const bool specular = !m_->smooth && in_mask(mask, m_->specular_kind);

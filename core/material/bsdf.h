@@ -132,6 +132,8 @@ public:
         diffuse_weight_ = other.diffuse_weight_;
         lobes_ = other.lobes_;
         pure_lambertian_ = other.pure_lambertian_;
+        layer_memo_cos_ = other.layer_memo_cos_;
+        layer_memo_ = other.layer_memo_;
         return *this;
     }
 
@@ -225,6 +227,8 @@ private:
     }
     float coat_through(float mu) const { return 1.0f - coat_fresnel(mu); }
     Color layer_albedo(float cos_theta) const;
+    /// layer_albedo for wo's cosine, remembered from the last call with the same cosine.
+    Color layer_albedo_towards(float cos_theta) const;
     Color lambert_albedo(float cos_theta) const;
     Color specular_albedo(float cos_theta) const;
     float relative_ior(bool outside) const { return outside ? m_->ior : 1.0f / m_->ior; }
@@ -278,6 +282,10 @@ private:
     /// Only the Lambertian lobe, with no specular layer above it (KHR_materials_specular factor 0,
     /// not metallic, not transmissive): eval, pdf and sample take their closed forms.
     bool pure_lambertian_ = false;
+    // layer_albedo_towards's last argument and value: estimates evaluate one wo against many
+    // photons' wi (a Bsdf belongs to one thread's shading point).
+    mutable float layer_memo_cos_ = -1.0f;
+    mutable Color layer_memo_{0.0f};
 };
 
 }  // namespace photond
