@@ -217,6 +217,12 @@ struct HttpServer::Impl {
     void readyz(const Request& req, Response& res);
     void metrics(const Request& req, Response& res);
     void openapi(const Request& req, Response& res);
+
+    /// The 413's detail, naming the limit.
+    std::string body_limit_message() const {
+        return "the request body exceeds the limit of " + std::to_string(options.max_body_bytes >> 20) +
+               " MiB (--max-body-mb)";
+    }
 };
 
 void HttpServer::Impl::register_routes() {
@@ -270,20 +276,16 @@ void HttpServer::Impl::install() {
             }
             if (!chunked && std::strtoull(declared_length.c_str(), nullptr, 10) > options.max_body_bytes) {
                 res.set_header("Connection", "close");  // its body is not read: no next request on it
-                throw ServiceError(ErrorKind::PayloadTooLarge, "the request body exceeds the limit of " +
-                                                                   std::to_string(options.max_body_bytes >> 20) +
-                                                                   " MiB (--max-body-mb)");
+                throw ServiceError(ErrorKind::PayloadTooLarge, body_limit_message());
             }
             const bool complete = content([&](const char* data, size_t length) {
                 read.body.append(data, length);
                 return true;
             });
             if (!complete) {
-                const uint64_t declared = std::strtoull(req.get_header_value("Content-Length").c_str(), nullptr, 10);
-                if (declared > options.max_body_bytes)
-                    throw ServiceError(ErrorKind::PayloadTooLarge, "the request body exceeds the limit of " +
-                                                                       std::to_string(options.max_body_bytes >> 20) +
-                                                                       " MiB (--max-body-mb)");
+                // A declared length was checked above: a chunked body past the limit, or a cut one.
+                if (chunked && read.body.size() >= options.max_body_bytes)
+                    throw ServiceError(ErrorKind::PayloadTooLarge, body_limit_message());
                 throw ServiceError(ErrorKind::MalformedRequest, "the request body could not be read to its end");
             }
             handler(read, res);
@@ -361,8 +363,7 @@ void HttpServer::Impl::install() {
                         "no route for " + req.method + " " + req.path + " (see /v1/openapi.json)";
                     break;
                 case 413:
-                    detail = "the request body exceeds the limit of " +
-                             std::to_string(options.max_body_bytes >> 20) + " MiB (--max-body-mb)";
+                    detail = body_limit_message();
                     break;
                 case 400:
                     detail = req.has_header("Content-Length") || req.has_header("Transfer-Encoding")

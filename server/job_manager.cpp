@@ -573,17 +573,11 @@ bool JobManager::verify_image(const std::shared_ptr<Entry>& entry) {
     std::error_code ignored;
     fs::rename(store_.image_path(id), store_.image_path(id).string() + ".corrupt", ignored);
     fs::remove(store_.preview_path(id), ignored);
-    log("job " + id + ": " + reason);
-    protocol::JobStatus failed;
     {
         std::lock_guard lock(mutex_);
-        entry->status.state = JobState::Failed;
-        entry->status.error = reason;
         entry->image.reset();
-        entry->changed.notify_all();
-        failed = entry->status;
     }
-    if (Status saved = store_.save_status(failed); !saved) log("job " + id + ": " + saved.error().message);
+    finish(entry, JobState::Failed, reason, nullptr);  // events, record and log as for any failure
     return false;
 }
 

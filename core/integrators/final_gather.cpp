@@ -48,12 +48,11 @@ Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si
     RadianceEstimateOptions options;
     // Where only the bent normal keeps the precomputed irradiance from serving, fewer photons:
     // each gather ray's value is averaged with the others' (the irradiance cache's hundreds).
-    options.k = bsdf.reads_as_diffuse(lobes) ? std::min(settings.k_global, kBentNormalPhotons) : settings.k_global;
+    const bool diffuse_but_bent = bent != Vec3(0.0f) && bsdf.reads_as_diffuse(lobes);
+    options.k = diffuse_but_bent ? std::min(settings.k_global, kBentNormalPhotons) : settings.k_global;
     options.max_radius = settings.max_radius;
-    options.shading_normal = bent;
-    options.both_sides = bsdf.transmits_non_delta();
     options.lobes = lobes;
-    return maps.global->estimate_radiance(si.p, n, bsdf, wo, options);
+    return maps.global->estimate_radiance(si.p, n, bsdf, wo, estimate_options_at(options, si, bsdf, front));
 }
 
 }  // namespace

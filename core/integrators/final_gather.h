@@ -34,6 +34,16 @@ struct GatherSettings {
     bool gather_diffuse_sky = false;
 };
 
+/// `options` for a photon estimate at `si`, seen from the side `front` says (surface_normal's
+/// when true): each photon weighted by a normal map's bent normal, and both sides counted where
+/// the BSDF transmits through a rough lobe.
+inline RadianceEstimateOptions estimate_options_at(RadianceEstimateOptions options, const SurfaceInteraction& si,
+                                                   const Bsdf& bsdf, bool front) {
+    options.shading_normal = bent_shading_normal(si, front);
+    options.both_sides = bsdf.transmits_non_delta();
+    return options;
+}
+
 /// Cosine-weighted irradiance and what an irradiance cache record needs.
 struct GatherResult {
     Color irradiance{0.0f};

@@ -89,12 +89,9 @@ Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_
         // their photons by the mapped normal (RadianceEstimateOptions::shading_normal; README).
         const bool front = glm::dot(si.surface_normal, wo) >= 0.0f;
         const Vec3 normal = front ? si.surface_normal : -si.surface_normal;
-        if (maps_->caustic) {
-            RadianceEstimateOptions caustic = caustic_options_;
-            caustic.shading_normal = bent_shading_normal(si, front);
-            caustic.both_sides = bsdf.transmits_non_delta();
-            radiance += maps_->caustic->estimate_radiance(si.p, normal, bsdf, wo, caustic);
-        }
+        if (maps_->caustic)
+            radiance += maps_->caustic->estimate_radiance(si.p, normal, bsdf, wo,
+                                                          estimate_options_at(caustic_options_, si, bsdf, front));
         if (gatherer_) {
             const Color rho = bsdf.diffuse_reflectance(wo);
             if (max_component(rho) > 0.0f) {
@@ -126,10 +123,8 @@ Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_
                 radiance += sum / static_cast<float>(glossy_rays);
             }
         } else if (maps_->global) {
-            RadianceEstimateOptions global = global_options_;
-            global.shading_normal = bent_shading_normal(si, front);
-            global.both_sides = bsdf.transmits_non_delta();
-            radiance += maps_->global->estimate_radiance(si.p, normal, bsdf, wo, global);
+            radiance += maps_->global->estimate_radiance(si.p, normal, bsdf, wo,
+                                                         estimate_options_at(global_options_, si, bsdf, front));
         }
     }
     if (bsdf.has_delta() && depth < settings_.max_specular_depth) {

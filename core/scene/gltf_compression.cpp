@@ -78,20 +78,20 @@ int add_view(tinygltf::Model& model, int buffer, size_t length, size_t stride) {
 
 }  // namespace
 
+std::string_view gltf_json_text(std::span<const uint8_t> file) {
+    if (!(file.size() >= 20 && std::memcmp(file.data(), "glTF", 4) == 0))
+        return {reinterpret_cast<const char*>(file.data()), file.size()};
+    const uint32_t json_length = read_le32(file.data() + 12);
+    if (std::memcmp(file.data() + 16, "JSON", 4) != 0 || json_length > file.size() - 20) return {};
+    return {reinterpret_cast<const char*>(file.data() + 20), json_length};
+}
+
 Expected<CompressedFilePatch> patch_compressed_file_for_tinygltf(std::span<const uint8_t> file) {
     CompressedFilePatch patch;
     const bool binary = file.size() >= 20 && std::memcmp(file.data(), "glTF", 4) == 0;
-    std::string_view json_text;
-    size_t json_end = file.size();
-    if (binary) {
-        const uint32_t json_length = read_le32(file.data() + 12);
-        if (std::memcmp(file.data() + 16, "JSON", 4) != 0 || json_length > file.size() - 20)
-            return patch;  // malformed: tinygltf reports it
-        json_text = {reinterpret_cast<const char*>(file.data() + 20), json_length};
-        json_end = 20 + size_t(json_length);
-    } else {
-        json_text = {reinterpret_cast<const char*>(file.data()), file.size()};
-    }
+    const std::string_view json_text = gltf_json_text(file);
+    if (binary && json_text.empty()) return patch;  // malformed: tinygltf reports it
+    const size_t json_end = binary ? 20 + json_text.size() : file.size();
     if (json_text.find(kMeshopt) == std::string_view::npos &&
         json_text.find(kDraco) == std::string_view::npos)
         return patch;

@@ -27,6 +27,10 @@ namespace photond {
 /// one-byte data: URI (only compressed views refer to it, and they are decoded into buffers of
 /// their own) and each Draco primitive has no "indices" (decode_draco_primitives makes them);
 /// returns nothing for any other file.
+/// The JSON text of a glTF file: all of a .gltf, a GLB's JSON chunk; empty for a GLB whose
+/// header is malformed (tinygltf then says what is wrong).
+std::string_view gltf_json_text(std::span<const uint8_t> file);
+
 struct CompressedFilePatch {
     std::vector<uint8_t> bytes;  // the patched file; empty: use the original
 };

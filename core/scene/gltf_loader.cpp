@@ -1700,16 +1700,8 @@ Expected<Scene> load_from_bytes(std::span<const uint8_t> bytes, const std::strin
 
     // tinygltf and the patching below recurse once per level of the JSON: refuse a deeper one
     // first (a GLB's JSON chunk only: its binary chunk is no text).
-    std::string_view json_part(reinterpret_cast<const char*>(bytes.data()), bytes.size());
-    if (binary) {
-        json_part = {};
-        if (bytes.size() >= 20 && std::memcmp(bytes.data() + 16, "JSON", 4) == 0) {
-            uint32_t length = 0;
-            std::memcpy(&length, bytes.data() + 12, 4);  // little-endian, as the GLB header checks
-            if (length <= bytes.size() - 20) json_part = {reinterpret_cast<const char*>(bytes.data() + 20), length};
-        }
-    }
-    if (json_nesting_depth(json_part) > kMaxJsonNesting) return Error{display_name + ": " + json_nesting_message()};
+    if (json_nesting_depth(gltf_json_text(bytes)) > kMaxJsonNesting)
+        return Error{display_name + ": " + json_nesting_message()};
 
     // Compressed files are patched where tinygltf would refuse them (gltf_compression.h).
     Expected<CompressedFilePatch> patched = patch_compressed_file_for_tinygltf(bytes);
