@@ -103,21 +103,46 @@ Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_
                 // Glossy and rough lobes: BSDF-sampled rays reading the photon maps where they land
                 // (caustics are the maps'), and the emitters they hit weighted by MIS against
                 // light sampling, which alone cannot see an emitter behind rough glass.
+                // The diffuse sky, which light sampling leaves to the gather, is light-sampled here
+                // too, weighted against these rays: a rough metal under a uniform sky saw it through
+                // one ray per sample alone, and stayed grainy at 16 spp.
+                const EnvironmentLight* sky = rs.lights_with_sky_peaks ? rs.diffuse_sky.get() : nullptr;
+                const float rays = static_cast<float>(glossy_rays);
                 Color sum(0.0f);
+                if (sky) {
+                    float pdf = 0.0f;
+                    const Vec3 wi = sky->sample(context.next_2d(), &pdf);
+                    const Color f = pdf > 0.0f ? bsdf.eval(wo, wi, TransportMode::Radiance, glossy_lobes) : Color(0.0f);
+                    if (!is_black(f)) {
+                        ++context.counters.shadow_rays;
+                        const Ray shadow{rs.tracer->offset_origin(si.p, si.geometric_normal, wi), wi};
+                        if (!rs.tracer->occluded(shadow)) {
+                            const float weight = power_heuristic(pdf, rays * bsdf.pdf(wo, wi, glossy_lobes));
+                            radiance += f * sky->radiance(wi) *
+                                        (std::abs(glm::dot(wi, si.shading_normal)) * weight / pdf);
+                        }
+                    }
+                }
                 for (int i = 0; i < glossy_rays; ++i) {
-                    const float u_lobe = context.rng.next_float();
-                    const Vec2 u = context.rng.next_vec2();
+                    // From the pixel's stratified dimensions, as light sampling's: the sky seen
+                    // through a rough lobe is smooth, and stratification takes most of its noise.
+                    const float u_lobe = context.next_1d();
+                    const Vec2 u = context.next_2d();
                     const std::optional<BsdfSample> s =
                         bsdf.sample(wo, u_lobe, u, TransportMode::Radiance, glossy_lobes);
                     if (!s || is_black(s->weight)) continue;
                     float distance = 0.0f;
                     FinalGatherer::FirstHitEmission emitted;
-                    sum += s->weight * gatherer_->gather_ray_radiance(spawn_ray(rs, si, s->wi), context.rng,
-                                                                      context.counters, &distance, &emitted);
+                    Color gathered = gatherer_->gather_ray_radiance(spawn_ray(rs, si, s->wi), context.rng,
+                                                                    context.counters, &distance, &emitted);
+                    // A ray that left the scene at once saw the diffuse sky alone: weighted against
+                    // the sky's light sample above.
+                    if (sky && !std::isfinite(distance) && s->kind != LobeKind::Delta)
+                        gathered *= power_heuristic(rays * s->pdf, sky->pdf(s->wi));
+                    sum += s->weight * gathered;
                     if (!is_black(emitted.radiance) && s->kind != LobeKind::Delta) {
                         const float light_pdf = direct_lights_->pdf_incident_triangle(emitted.triangle, si.p, emitted.point);
-                        sum += s->weight * emitted.radiance *
-                               power_heuristic(static_cast<float>(glossy_rays) * s->pdf, light_pdf);
+                        sum += s->weight * emitted.radiance * power_heuristic(rays * s->pdf, light_pdf);
                     }
                 }
                 radiance += sum / static_cast<float>(glossy_rays);
