@@ -120,6 +120,7 @@ json to_json(const JobStatus& s, bool links) {
     if (s.started_at_ms > 0) document["started_at"] = format_timestamp(s.started_at_ms);
     if (s.finished_at_ms > 0) document["finished_at"] = format_timestamp(s.finished_at_ms);
     if (!s.error.empty()) document["error"] = s.error;
+    if (s.crashes > 0) document["crashes"] = s.crashes;
     if (!s.plan.empty()) {
         json plan = json::array();
         for (const PlanEntry& e : s.plan)
@@ -166,6 +167,7 @@ Expected<JobStatus> job_status_from_json(const json& d) {
         s.started_at_ms = time_of("started_at");
         s.finished_at_ms = time_of("finished_at");
         s.error = d.value("error", std::string());
+        s.crashes = d.value("crashes", 0);
         if (const auto it = d.find("photons"); it != d.end() && it->is_object()) {
             s.photon_cache = it->value("cache", std::string());
             s.photon_map_key = it->value("key", std::string());
@@ -253,6 +255,12 @@ json job_status_json_schema() {
         {"started_at", timestamp_schema("when its render started")},
         {"finished_at", timestamp_schema("when it ended")},
         {"error", {{"type", "string"}, {"description", "why the job failed"}}},
+        {"crashes",
+         {{"type", "integer"},
+          {"minimum", 1},
+          {"description",
+           "how many times the daemon died while the job was running (absent: never); it resumes "
+           "from its finished tiles after each"}}},
         {"plan", {{"type", "array"}, {"items", plan_entry}}},
         {"warnings",
          {{"type", "array"},

@@ -68,6 +68,9 @@ struct JobStatus {
     int64_t finished_at_ms = 0;
     /// Why the job failed (or was cancelled by whom); empty otherwise.
     std::string error;
+    /// How many times the daemon died (a crash, kill -9, power loss) while this job was running;
+    /// the job resumes from its finished tiles after each, up to a limit (a poison job).
+    int crashes = 0;
     /// "hit" when the photon maps came from the cache, "miss" when traced, empty otherwise.
     std::string photon_cache;
     std::string photon_map_key;

@@ -18,6 +18,7 @@ nlohmann::json to_json(const RenderStatistics& s) {
         {"render_seconds", s.render_seconds},
         {"total_seconds", s.total_seconds},
         {"cancelled", s.cancelled},
+        {"tiles_restored", s.tiles_restored},
         {"warnings", s.warnings},
     };
     result["lighting"] = {{"lights", s.lighting.lights},

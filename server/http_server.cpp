@@ -1,6 +1,7 @@
 #include "server/http_server.h"
 
 #include <httplib.h>
+#include <sys/socket.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -17,6 +18,7 @@
 #include "protocol/job.h"
 #include "protocol/job_status.h"
 #include "protocol/json_text.h"
+#include "server/http_thread_pool.h"
 #include "server/job_manager.h"
 #include "server/metrics.h"
 #include "server/openapi.h"
@@ -33,6 +35,9 @@ using nlohmann::json;
 using Handler = std::function<void(const Request&, Response&)>;
 
 constexpr const char* kJsonType = "application/json";
+// HTTP threads kept waiting for the next burst of connections; the others end after the timeout.
+constexpr size_t kKeptHttpThreads = 8;
+constexpr std::chrono::milliseconds kHttpThreadIdleTimeout{10000};
 constexpr const char* kProblemType = "application/problem+json";
 constexpr const char* kExrType = "image/x-exr";
 constexpr std::string_view kIdPattern = "([A-Za-z0-9_-]{1,128})";
@@ -147,6 +152,17 @@ std::string rect_header(const PixelRect& r) {
            std::to_string(r.y1);
 }
 
+/// cpp-httplib's server with a longer queue of connections waiting to be accepted: it listens
+/// with a backlog of 5, so a burst of clients (a farm's submitters, a page's tile requests) had
+/// their SYNs dropped and waited a second for each retry.
+class ListeningServer : public httplib::Server {
+public:
+    /// Call after binding; listen() on a listening socket sets its backlog anew.
+    void widen_backlog() {
+        if (svr_sock_ != INVALID_SOCKET) ::listen(svr_sock_, SOMAXCONN);
+    }
+};
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -154,7 +170,7 @@ std::string rect_header(const PixelRect& r) {
 struct HttpServer::Impl {
     HttpServerOptions options;
     HttpServices services;
-    httplib::Server server;
+    ListeningServer server;
 
     struct Route {
         std::string method;
@@ -388,9 +404,11 @@ void HttpServer::Impl::install() {
     server.set_keep_alive_timeout(2);
     server.set_read_timeout(30);
     server.set_write_timeout(30);
-    const int threads = std::max(options.http_threads, 4);
+    // A thread per connection, started when one arrives, up to --http-threads at once: slow or
+    // idle clients and open streams then never make /healthz or anyone else wait.
+    const size_t threads = static_cast<size_t>(std::max(options.http_threads, 4));
     server.new_task_queue = [threads] {
-        return new httplib::ThreadPool(static_cast<size_t>(threads));
+        return new HttpThreadPool(threads, kKeptHttpThreads, kHttpThreadIdleTimeout);
     };
 }
 
@@ -710,11 +728,13 @@ Expected<int> HttpServer::bind() {
     if (impl_->options.port == 0) {
         const int port = impl_->server.bind_to_any_port(host);
         if (port <= 0) return Error{"cannot listen on " + host + " (any port)"};
+        impl_->server.widen_backlog();
         return port;
     }
     if (!impl_->server.bind_to_port(host, impl_->options.port))
         return Error{"cannot listen on " + host + ":" + std::to_string(impl_->options.port) +
                      " (in use, or not an address of this machine)"};
+    impl_->server.widen_backlog();
     return impl_->options.port;
 }
 

@@ -34,7 +34,7 @@ struct HttpServerOptions {
     std::string token;  // bearer token; empty: no authentication
     size_t max_body_bytes = size_t{256} << 20;
     uint64_t min_free_bytes = uint64_t{64} << 20;  // /readyz: not ready below this on the cache disk
-    int http_threads = 128;  // connections served at once (streams hold one each)
+    int http_threads = 1024;  // connections served at once, a thread each (HttpThreadPool)
     std::chrono::milliseconds keep_alive_interval{15000};  // SSE comment while nothing happens
     bool access_log = false;                               // one line per request to `log`
     std::function<void(const std::string&)> log;

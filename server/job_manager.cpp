@@ -17,6 +17,7 @@
 #include "server/atomic_file.h"
 #include "server/render_pipeline.h"
 #include "server/service_error.h"
+#include "server/tile_journal.h"
 
 namespace photond::service {
 
@@ -60,6 +61,10 @@ PixelRect rendered_area(const protocol::Job& job) {
 }
 
 json rect_json(const PixelRect& r) { return json::array({r.x0, r.y0, r.x1, r.y1}); }
+
+/// A job is not run again once the daemon died this many times while running it: it would
+/// most likely crash it again (a poison job).
+constexpr int kMaxCrashes = 3;
 
 std::vector<protocol::PlanEntry> plan_of(const RenderStatistics& statistics) {
     std::vector<protocol::PlanEntry> plan;
@@ -183,9 +188,23 @@ void JobManager::restore(StoredJob stored) {
     status.pass.clear();
     bool changed = false;
     if (status.state == JobState::Running) {
-        status.state = JobState::Failed;
-        status.error = "daemon restarted while the job was running";
-        status.finished_at_ms = now_ms();
+        // The daemon died while the job ran (a clean stop queues it again): it resumes from the
+        // tiles it kept, unless it has now been running at every one of the last deaths.
+        ++status.crashes;
+        if (status.crashes >= kMaxCrashes) {
+            status.state = JobState::Failed;
+            status.error = "the daemon died " + std::to_string(status.crashes) +
+                           " times while this job was running (a crash, kill -9 or power loss); it is "
+                           "not run again, since it may be what crashes the daemon (a poison job)";
+            status.finished_at_ms = now_ms();
+            std::error_code ignored;
+            fs::remove_all(store_.tiles_directory(entry->id()), ignored);
+        } else {
+            status.state = JobState::Queued;
+            status.started_at_ms = 0;
+            status.timings.clear();
+            status.progress.tiles_done = 0;
+        }
         changed = true;
     } else if (status.state == JobState::Done && !fs::exists(store_.image_path(entry->id()))) {
         status.state = JobState::Failed;
@@ -200,11 +219,15 @@ void JobManager::restore(StoredJob stored) {
     // The history of a restored job is rebuilt from its state: a client resuming or starting a
     // stream sees the same shape of events as during the render (tiles, then the last event).
     switch (e.status.state) {
-        case JobState::Queued:
+        case JobState::Queued: {
             e.status.progress.tiles_done = 0;
-            push_event_locked(e, JobEventType::State, {{"state", "queued"}});
+            json queued = {{"state", "queued"}};
+            if (changed)
+                queued["reason"] = "the daemon died while the job was running; it resumes from the tiles it had finished";
+            push_event_locked(e, JobEventType::State, std::move(queued));
             queue_.insert({{-e.submission.job.priority, e.submission.sequence}, e.id()});
             break;
+        }
         case JobState::Done:
             e.status.progress.tiles_done = e.status.progress.tiles_total;
             for (int ty = 0; ty < e.tiles_y; ++ty)
@@ -226,7 +249,7 @@ void JobManager::restore(StoredJob stored) {
             push_event_locked(e, JobEventType::Cancelled, protocol::to_json(e.status));
             break;
         case JobState::Running:
-            break;  // turned into failed above
+            break;  // turned into queued or failed above
     }
     if (!e.submission.idempotency_key.empty())
         idempotency_keys_[e.submission.idempotency_key] = e.id();
@@ -744,7 +767,35 @@ void JobManager::run(const std::shared_ptr<Entry>& entry) {
     Entry& e = *entry;
     PipelineOptions options = pipeline_options();
     options.callbacks.cancel = &e.cancel;
+    // Each finished tile is kept on disk until the job ends, and a run after a crash (or a clean
+    // stop) takes the tiles kept by the last one instead of rendering them again.
+    const TileJournal journal(store_.tiles_directory(e.id()), e.submission.request_digest);
+    std::mutex run_warnings_mutex;
+    std::vector<std::string> run_warnings;  // added to the statistics' warnings at the end
+    auto warn_once = [&](const std::string& warning) {
+        std::lock_guard lock(run_warnings_mutex);
+        if (std::find(run_warnings.begin(), run_warnings.end(), warning) != run_warnings.end()) return false;
+        run_warnings.push_back(warning);
+        return true;
+    };
+    options.callbacks.restore_tile = [&](const PixelRect& rect, Image& frame) {
+        std::string problem;
+        const TileJournal::Restored restored = journal.restore(rect, frame, &problem);
+        if (restored == TileJournal::Restored::Damaged) {
+            log("job " + e.id() + ": a kept tile is damaged: " + problem);
+            warn_once("a tile kept from the interrupted run was damaged and rendered again (" + problem + ")");
+        }
+        return restored == TileJournal::Restored::Restored;
+    };
     options.callbacks.on_tile = [&](const TileEvent& event, const Image& frame) {
+        if (!event.restored) {
+            if (const Status kept = journal.save(event.rect, frame); !kept) {
+                metrics_->record_store_failure();
+                if (warn_once("finished tiles could not be kept in the cache directory (" + kept.error().message +
+                              "): a crash now would render them again"))
+                    log("job " + e.id() + ": " + kept.error().message);
+            }
+        }
         // Only this tile's pixels are read: other threads write other tiles of the frame.
         auto pixels = std::make_shared<const Image>(frame.copy_rect(event.rect));
         const TileIndex index = e.index_of(event.rect);
@@ -770,6 +821,13 @@ void JobManager::run(const std::shared_ptr<Entry>& entry) {
     };
 
     auto result = run_job(e.submission.job, device_, options);
+    if (result) {
+        std::lock_guard lock(run_warnings_mutex);
+        for (const std::string& w : run_warnings) result->statistics.warnings.push_back(w);
+        if (result->statistics.tiles_restored > 0)
+            log("job " + e.id() + " resumed: " + std::to_string(result->statistics.tiles_restored) +
+                " tile(s) taken from the interrupted run");
+    }
 
     if (e.cancel) {
         bool by_user = false;
@@ -852,7 +910,11 @@ void JobManager::finish_locked(Entry& e, JobState state, std::string error,
     if (statistics) {
         e.status.statistics = protocol::to_json(*statistics);
         e.status.plan = plan_of(*statistics);
-        e.status.warnings = statistics->warnings;
+        // The render's warnings, then those raised while it ran (keep_status's).
+        std::vector<std::string> warnings = statistics->warnings;
+        for (const std::string& w : e.status.warnings)
+            if (std::find(warnings.begin(), warnings.end(), w) == warnings.end()) warnings.push_back(w);
+        e.status.warnings = std::move(warnings);
         e.status.photon_cache = statistics->photon_cache;
         e.status.photon_map_key = statistics->photon_map_key;
         e.status.timings.clear();
@@ -897,6 +959,8 @@ void JobManager::finish(const std::shared_ptr<Entry>& entry, JobState state, std
         status = entry->status;
     }
     keep_status(status);
+    // The job ended: nothing will resume it (a done job serves its image).
+    TileJournal(store_.tiles_directory(status.id), entry->submission.request_digest).clear();
     std::string line = "job " + status.id + " " + std::string(protocol::to_string(state));
     if (statistics) {
         char seconds[32];

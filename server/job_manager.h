@@ -13,10 +13,12 @@
 //
 // Restart: finished jobs (done, failed, cancelled) are loaded back from the cache directory with
 // their results. Jobs that were queued are queued again. A job that was running when the daemon
-// stopped cleanly (SIGINT/SIGTERM: its render is cancelled) is queued again too; one that was
-// running when the daemon died (a crash: status.json still says "running") fails with the reason
-// "daemon restarted while the job was running", so that a job that crashes the daemon cannot
-// crash it again and again.
+// stopped, cleanly (SIGINT/SIGTERM: its render is cancelled) or not (a crash, kill -9, power
+// loss: status.json still says "running"), is queued again and resumes from the tiles it had
+// finished: each is kept on disk as it finishes (server/tile_journal.h), the photon maps come
+// from the cache and the irradiance cache is rebuilt (it is deterministic), so the final image
+// is byte-identical to an uninterrupted run's. Its status counts the deaths ("crashes"); at the
+// third the job fails instead, so that a job that crashes the daemon cannot crash it forever.
 //
 // Thread safety: every public member may be called from any thread at once. One mutex guards
 // all job state; the renderer's tile callbacks take it briefly per tile, and the waiting calls

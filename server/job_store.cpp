@@ -50,6 +50,7 @@ fs::path JobStore::image_checksum_path(const std::string& id) const {
 fs::path JobStore::preview_path(const std::string& id) const {
     return directory_ / id / "preview.png";
 }
+fs::path JobStore::tiles_directory(const std::string& id) const { return directory_ / id / "tiles"; }
 
 Status JobStore::save_submission(const JobSubmission& s) {
     std::error_code error;

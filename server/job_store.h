@@ -4,6 +4,8 @@
 //   <cache-dir>/jobs/<id>/status.json  the last status document (protocol::to_json)
 //   <cache-dir>/jobs/<id>/image.exr    the final image (tiled OpenEXR, as `photond render`)
 //   <cache-dir>/jobs/<id>/preview.png  its sRGB preview, made on the first request
+//   <cache-dir>/jobs/<id>/tiles/       the finished tiles of a job while it runs, so that it
+//                                      resumes after a crash (server/tile_journal.h)
 // Every file is written to a temporary name and renamed, so a crash leaves the old or the new
 // version, never half of one.
 //
@@ -52,6 +54,8 @@ public:
     std::filesystem::path preview_path(const std::string& id) const;
     /// The SHA-256 (hex) of the final image as it was written, beside it.
     std::filesystem::path image_checksum_path(const std::string& id) const;
+    /// Where the tiles of a running job are kept (TileJournal).
+    std::filesystem::path tiles_directory(const std::string& id) const;
 
     struct Loaded {
         std::vector<StoredJob> jobs;

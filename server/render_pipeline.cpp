@@ -523,6 +523,7 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
         stats.irradiance_cache->misses = rendered.counters.irradiance_misses;
     }
     stats.cancelled = rendered.cancelled;
+    stats.tiles_restored = rendered.tiles_restored;
     stats.total_seconds = seconds_since(start);
     result.layers.beauty = std::move(rendered.image);
     return result;

@@ -2,6 +2,7 @@
 
 #include <arpa/inet.h>
 #include <signal.h>
+#include <sys/resource.h>
 
 #include <atomic>
 #include <cctype>
@@ -48,8 +49,8 @@ constexpr const char* kUsage =
     "  --max-bundle-mb N       largest unpacked size of an uploaded zip/tar scene bundle\n"
     "                          (default 1024)\n"
     "  --max-bundle-entries N  most entries of an uploaded scene bundle (default 4096)\n"
-    "  --http-threads N        connections served at once; each open stream holds one (default "
-    "128)\n"
+    "  --http-threads N        connections served at once, a thread each, started as they\n"
+    "                          arrive (default 1024); beyond it connections wait\n"
     "  --access-log            log every request on stderr\n"
     "Stops cleanly on SIGINT or SIGTERM: the running job is interrupted and runs again on the "
     "next\n"
@@ -67,7 +68,7 @@ struct Arguments {
     size_t max_body_mb = 256;
     uint64_t min_free_mb = 64;
     BundleLimits bundle_limits;
-    int http_threads = 128;
+    int http_threads = 1024;
     bool access_log = false;
 };
 
@@ -269,6 +270,12 @@ int run_serve_command(std::span<const std::string> args) {
     sigaddset(&stop_signals, SIGTERM);
     pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
     signal(SIGPIPE, SIG_IGN);  // a client that hangs up mid-stream is a failed write, not a death
+    // Each connection is a descriptor: the usual soft limit of 1024 would refuse connections
+    // well before --http-threads of them are open.
+    if (rlimit files{}; getrlimit(RLIMIT_NOFILE, &files) == 0 && files.rlim_cur < files.rlim_max) {
+        files.rlim_cur = std::min<rlim_t>(files.rlim_max, rlim_t{65536});
+        setrlimit(RLIMIT_NOFILE, &files);
+    }
 
     auto device = EmbreeDevice::create();
     if (!device) {

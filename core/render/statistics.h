@@ -28,6 +28,9 @@ struct RenderStatistics {
     double render_seconds = 0.0;  // the tile pass alone
     double total_seconds = 0.0;
     bool cancelled = false;
+    /// Tiles of the render pass taken from an interrupted earlier run of the same job (the
+    /// daemon's crash-resume) instead of being rendered; their rays are not counted.
+    size_t tiles_restored = 0;
     /// What lights the render: the lights of the light set (punctual lights, emissive
     /// triangles, the environment), how many the job added, and the environment's name (empty:
     /// none; "default": the white environment of a scene without light).

@@ -36,6 +36,7 @@ TileRenderResult render_tiles(const Integrator& integrator, const Camera& camera
     result.image = Image(width, height);
     result.tiles_total = tiles.size();
     std::atomic<size_t> tiles_done{0};
+    std::atomic<size_t> tiles_restored{0};
     std::atomic<bool> cancelled{false};
     tbb::enumerable_thread_specific<RayCounters> counters;
 
@@ -75,15 +76,20 @@ TileRenderResult render_tiles(const Integrator& integrator, const Camera& camera
                         cancelled = true;
                         return;
                     }
-                    render_tile(tiles[i]);
+                    const bool restored = callbacks.restore_tile && callbacks.restore_tile(tiles[i], result.image);
+                    if (restored)
+                        tiles_restored.fetch_add(1);
+                    else
+                        render_tile(tiles[i]);
                     const size_t done = tiles_done.fetch_add(1) + 1;
-                    if (callbacks.on_tile) callbacks.on_tile({tiles[i], done, tiles.size()}, result.image);
+                    if (callbacks.on_tile) callbacks.on_tile({tiles[i], done, tiles.size(), restored}, result.image);
                 }
             },
             tbb::simple_partitioner());
     });
     for (const RayCounters& c : counters) result.counters += c;
     result.tiles_done = tiles_done.load();
+    result.tiles_restored = tiles_restored.load();
     result.cancelled = cancelled.load();
     return result;
 }

@@ -31,12 +31,17 @@ struct TileEvent {
     PixelRect rect;
     size_t tiles_done = 0;
     size_t tiles_total = 0;
+    bool restored = false;  // filled by RenderCallbacks::restore_tile, not rendered
 };
 
 struct RenderCallbacks {
     /// Called after each tile, from the worker thread that finished it (calls may overlap);
     /// `frame` holds the finished tile's pixels (and other tiles' in any state).
     std::function<void(const TileEvent&, const Image& frame)> on_tile;
+    /// Called before each tile renders, from the worker thread that would render it (calls may
+    /// overlap): when it fills `rect` of `frame` with the tile's pixels from an earlier,
+    /// interrupted run of the same render and returns true, the tile is not rendered again.
+    std::function<bool(const PixelRect& rect, Image& frame)> restore_tile;
     /// Checked before each tile starts: when set, the remaining tiles are skipped.
     const std::atomic<bool>* cancel = nullptr;
 };
@@ -44,7 +49,8 @@ struct RenderCallbacks {
 struct TileRenderResult {
     Image image;
     RayCounters counters;
-    size_t tiles_done = 0;
+    size_t tiles_done = 0;      // rendered or restored
+    size_t tiles_restored = 0;  // of those, filled by RenderCallbacks::restore_tile
     size_t tiles_total = 0;
     bool cancelled = false;
 };

@@ -2,6 +2,9 @@
 // progress and cancellation.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <mutex>
+
 #include "core/image/exr_io.h"
 #include "core/integrators/path.h"
 #include "core/render/tile_renderer.h"
@@ -118,6 +121,36 @@ TEST(TileRenderer, ProgressReportsEveryTileAndCancelStops) {
     const TileRenderResult c = render_tiles(*f.integrator, f.camera, one_thread, cancelling);
     EXPECT_TRUE(c.cancelled);
     EXPECT_EQ(c.tiles_done, 2u);
+}
+
+TEST(TileRenderer, RestoredTilesAreNotRenderedAndTheImageIsBitIdentical) {
+    // What a resumed job does: tiles kept by an interrupted run are filled in, the rest rendered.
+    const auto& f = cornell();
+    const TileRenderResult whole = render_tiles(*f.integrator, f.camera, small_settings(2));
+    const std::vector<PixelRect> tiles = make_tiles(whole.image.bounds(), 16);
+    ASSERT_EQ(tiles.size(), 9u);
+    std::mutex mutex;
+    std::vector<PixelRect> restored_seen, rendered_seen;
+    RenderCallbacks callbacks;
+    callbacks.restore_tile = [&](const PixelRect& rect, Image& frame) {
+        const size_t index = static_cast<size_t>(std::find(tiles.begin(), tiles.end(), rect) - tiles.begin());
+        if (index % 2 != 0) return false;  // "not kept": rendered
+        frame.paste(whole.image.copy_rect(rect), rect.x0, rect.y0);
+        return true;
+    };
+    callbacks.on_tile = [&](const TileEvent& event, const Image&) {
+        std::lock_guard lock(mutex);
+        (event.restored ? restored_seen : rendered_seen).push_back(event.rect);
+    };
+    const TileRenderResult resumed = render_tiles(*f.integrator, f.camera, small_settings(2), callbacks);
+    EXPECT_TRUE(resumed.image == whole.image);
+    EXPECT_EQ(resumed.tiles_done, 9u);
+    EXPECT_EQ(resumed.tiles_restored, 5u);
+    EXPECT_EQ(restored_seen.size(), 5u);
+    EXPECT_EQ(rendered_seen.size(), 4u);
+    // Only the rendered tiles traced rays.
+    EXPECT_GT(resumed.counters.rays, 0u);
+    EXPECT_LT(resumed.counters.rays, whole.counters.rays * 6 / 10);
 }
 
 }  // namespace

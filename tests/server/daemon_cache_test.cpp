@@ -1,7 +1,8 @@
 // What the daemon keeps: the photon-map cache (a second view of a scene skips photon tracing;
 // maps move between daemons by export and import; a corrupt file on disk is set aside and
-// rebuilt), finished jobs across a restart, jobs interrupted by a clean shutdown, and uploaded
-// scenes rendered by content id.
+// rebuilt), finished jobs across a restart, jobs interrupted by a clean shutdown or killed
+// (resumed from their tiles, failed as poison after three deaths), and uploaded scenes rendered by
+// content id.
 #include <gtest/gtest.h>
 
 #include "core/image/exr_io.h"
@@ -267,35 +268,89 @@ TEST_F(DaemonCache, TwoDaemonsShareOneCacheDirectory) {
               std::string::npos);
 }
 
-TEST_F(DaemonCache, JobRunningWhenTheDaemonDiedFailsWithItsReason) {
-    // What a crash leaves behind: status.json still says "running".
+TEST_F(DaemonCache, AJobKilledMidRenderResumesFromItsTilesWithTheSameBytes) {
+    // kill -9 in the middle of the render pass: the restarted daemon takes the tiles finished
+    // before the kill, takes the photon maps from the cache, rebuilds the irradiance cache and
+    // renders the rest; the image is byte-identical to an uninterrupted run's.
+    const json job = {{"scene", {{"builtin", "cornell-box"}}},
+                      {"integrator", "photon-map"},
+                      {"image", {{"width", 256}, {"height", 192}, {"spp", 32}, {"tile_size", 16}}},
+                      {"output", {{"pixel_type", "float"}}}};
+    const fs::path cache = dir_.path() / "cache";
+    std::string id;
+    uint64_t done_before_kill = 0;
     {
-        Daemon daemon(dir_.path() / "cache");
-        ASSERT_TRUE(daemon.started());
-        const json job = {{"scene", {{"builtin", "cornell-box"}}},
-                          {"integrator", "path"},
-                          {"image", {{"width", 256}, {"height", 192}, {"spp", 64}}}};
-        const std::string id = daemon.client().post("/v1/jobs", job.dump()).json_body().at("id");
-        wait_for_status(daemon.client(), id,
-                        [](const json& s) { return s.value("state", "") == "running"; });
-        daemon.stop();
-        // Turn the clean "queued again" into the state a crash leaves.
-        const fs::path status_file = dir_.path() / "cache" / "jobs" / id / "status.json";
-        json status = json::parse(read_file(status_file));
-        ASSERT_EQ(status.at("state"), "queued");
-        status["state"] = "running";
-        write_file(status_file, status.dump());
+        Daemon daemon(cache);
+        ASSERT_TRUE(daemon.started()) << daemon.log();
+        id = daemon.client().post("/v1/jobs", job.dump()).json_body().at("id");
+        const json running = wait_for_status(daemon.client(), id, [](const json& s) {
+            return is_terminal_state(s) || s.at("progress").at("tiles_done").get<uint64_t>() >= 40;
+        });
+        ASSERT_EQ(running.at("state"), "running") << running.dump();
+        daemon.kill_hard();
+        done_before_kill = running.at("progress").at("tiles_done").get<uint64_t>();
     }
-    Daemon daemon(dir_.path() / "cache");
+    const fs::path tiles = cache / "jobs" / id / "tiles";
+    size_t kept = 0;
+    for (const auto& entry : fs::directory_iterator(tiles)) kept += entry.path().extension() == ".tile";
+    EXPECT_GE(kept, done_before_kill);
+    ASSERT_LT(kept, 192u);
+
+    Daemon restarted(cache);
+    ASSERT_TRUE(restarted.started()) << restarted.log();
+    const json resumed = wait_for_status(restarted.client(), id, is_terminal_state, std::chrono::seconds(60));
+    ASSERT_EQ(resumed.at("state"), "done") << resumed.dump();
+    EXPECT_EQ(resumed.at("crashes"), 1);
+    EXPECT_EQ(resumed.at("photons").at("cache"), "hit");  // traced before the kill, kept on disk
+    EXPECT_EQ(resumed.at("statistics").at("tiles_restored").get<size_t>(), kept);
+    EXPECT_FALSE(fs::exists(tiles));  // the job ended: its kept tiles are gone
+    EXPECT_NE(restarted.log().find("tile(s) taken from the interrupted run"), std::string::npos) << restarted.log();
+    const auto events = parse_sse(restarted.client().get("/v1/jobs/" + id + "/events").body);
+    ASSERT_FALSE(events.empty());
+    EXPECT_NE(events.front().data.dump().find("resumes from the tiles"), std::string::npos) << events.front().data.dump();
+    const std::string resumed_image = restarted.client().get("/v1/jobs/" + id + "/image.exr").body;
+
+    Daemon uninterrupted(dir_.path() / "fresh");
+    ASSERT_TRUE(uninterrupted.started());
+    const json reference = render(uninterrupted.client(), job);
+    ASSERT_EQ(reference.at("state"), "done") << reference.dump();
+    EXPECT_EQ(reference.at("statistics").at("tiles_restored"), 0);
+    const std::string reference_image =
+        uninterrupted.client().get("/v1/jobs/" + reference.at("id").get<std::string>() + "/image.exr").body;
+    ASSERT_GT(reference_image.size(), 100000u);  // a whole float image (compressed)
+    EXPECT_TRUE(resumed_image == reference_image) << "the resumed image differs from the uninterrupted one";
+}
+
+TEST_F(DaemonCache, AJobRunningAtThreeDeathsOfTheDaemonIsFailedAsPoison) {
+    const json job = {{"scene", {{"builtin", "cornell-box"}}},
+                      {"integrator", "path"},
+                      {"image", {{"width", 256}, {"height", 192}, {"spp", 256}}}};
+    const fs::path cache = dir_.path() / "cache";
+    std::string id;
+    for (int death = 1; death <= 3; ++death) {
+        Daemon daemon(cache);
+        ASSERT_TRUE(daemon.started()) << daemon.log();
+        if (id.empty()) id = daemon.client().post("/v1/jobs", job.dump()).json_body().at("id");
+        const json running = wait_for_status(daemon.client(), id, [](const json& s) {
+            return s.value("state", "") == "running" || is_terminal_state(s);
+        });
+        ASSERT_EQ(running.at("state"), "running") << "death " << death << ": " << running.dump();
+        EXPECT_EQ(running.value("crashes", 0), death - 1);
+        daemon.kill_hard();
+    }
+    Daemon daemon(cache);
     ASSERT_TRUE(daemon.started()) << daemon.log();
-    const json jobs = daemon.client().get("/v1/jobs").json_body().at("jobs");
-    ASSERT_EQ(jobs.size(), 1u);
-    EXPECT_EQ(jobs[0].at("state"), "failed");
-    EXPECT_NE(jobs[0].at("error").get<std::string>().find("daemon restarted"), std::string::npos);
-    EXPECT_EQ(daemon.client()
-                  .get("/v1/jobs/" + jobs[0].at("id").get<std::string>() + "/image.exr")
-                  .status,
-              409);
+    const json status = daemon.client().get("/v1/jobs/" + id).json_body();
+    EXPECT_EQ(status.at("state"), "failed") << status.dump();
+    EXPECT_EQ(status.at("crashes"), 3);
+    EXPECT_NE(status.at("error").get<std::string>().find("poison job"), std::string::npos) << status.dump();
+    EXPECT_FALSE(fs::exists(cache / "jobs" / id / "tiles"));
+    EXPECT_EQ(daemon.client().get("/v1/jobs/" + id + "/image.exr").status, 409);
+    // The daemon goes on serving other jobs.
+    const json next = render(daemon.client(), {{"scene", {{"builtin", "cornell-box"}}},
+                                               {"integrator", "direct"},
+                                               {"image", {{"width", 16}, {"height", 16}, {"spp", 1}}}});
+    EXPECT_EQ(next.at("state"), "done") << next.dump();
 }
 
 TEST_F(DaemonCache, WarningsOfAnUploadAreInItsInfoAndInTheJobStatus) {

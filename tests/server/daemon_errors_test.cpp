@@ -423,6 +423,59 @@ TEST_F(DaemonErrors, BearerTokenIsRequiredWhenConfigured) {
     EXPECT_EQ(daemon.stop(), 0) << daemon.log();
 }
 
+/// A connected socket to the daemon (closed by the caller); -1 on failure.
+int connect_to(int port) {
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_port = htons(static_cast<uint16_t>(port));
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (fd >= 0 && ::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0) return fd;
+    if (fd >= 0) ::close(fd);
+    return -1;
+}
+
+TEST_F(DaemonErrors, SlowAndIdleClientsDoNotStarveHealthChecks) {
+    // 300 connections that hold a thread each (half a request head, or nothing at all) and 40
+    // event streams whose readers never read, beyond the 128 threads the daemon once had for
+    // every connection: /healthz and the API still answer at once.
+    Daemon daemon(dir_.path() / "cache");
+    ASSERT_TRUE(daemon.started()) << daemon.log();
+    const HttpClient client = daemon.client();
+    const std::string id = client.post("/v1/jobs", kLongJob.dump()).json_body().at("id");
+    std::vector<int> held;
+    for (int i = 0; i < 300; ++i) {
+        const int fd = connect_to(daemon.port());
+        ASSERT_GE(fd, 0) << "connection " << i;
+        if (i % 2 == 0) {
+            const std::string partial = "GET /healthz HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: ";
+            ASSERT_EQ(::send(fd, partial.data(), partial.size(), 0), static_cast<ssize_t>(partial.size()));
+        }
+        held.push_back(fd);
+    }
+    for (int i = 0; i < 40; ++i) {
+        const int fd = connect_to(daemon.port());
+        ASSERT_GE(fd, 0);
+        const std::string request = "GET /v1/jobs/" + id + "/events HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n";
+        ASSERT_EQ(::send(fd, request.data(), request.size(), 0), static_cast<ssize_t>(request.size()));
+        held.push_back(fd);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // every connection accepted
+    double slowest_ms = 0.0;
+    for (int i = 0; i < 20; ++i) {
+        const auto start = std::chrono::steady_clock::now();
+        const HttpResponse health = client.request("GET", "/healthz", {}, {}, std::chrono::seconds(5));
+        slowest_ms = std::max(slowest_ms, std::chrono::duration<double, std::milli>(
+                                              std::chrono::steady_clock::now() - start).count());
+        ASSERT_EQ(health.status, 200) << "health check " << i << " with " << held.size() << " connections held";
+    }
+    EXPECT_EQ(client.get("/v1/jobs/" + id).status, 200);
+    std::printf("slowest of 20 /healthz with %zu connections held: %.1f ms\n", held.size(), slowest_ms);
+    for (int fd : held) ::close(fd);
+    EXPECT_EQ(client.request("DELETE", "/v1/jobs/" + id).status, 200);
+    EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+}
+
 TEST_F(DaemonErrors, RefusesToListenBeyondLoopbackWithoutAToken) {
     const auto [code, output] =
         run_command(kPhotondBinary + " serve --listen 0.0.0.0:0 --cache-dir " +

@@ -421,6 +421,18 @@ public:
     std::string log() const { return read_file(log_path_); }
     HttpClient client(const std::string& token = {}) const { return HttpClient(port_, token); }
 
+    /// SIGKILL (what a crash or power loss leaves behind: nothing cleaned up), then waits.
+    void kill_hard() {
+        if (pid_ <= 0) return;
+        ::kill(pid_, SIGKILL);
+        int status = 0;
+        ::waitpid(pid_, &status, 0);
+        pid_ = -1;
+        exit_status_ = -1;
+        if (stdout_fd_ >= 0) ::close(stdout_fd_);
+        stdout_fd_ = -1;
+    }
+
     /// SIGTERM, then waits; returns the exit status (-1 if it had to be killed).
     int stop(std::chrono::seconds patience = std::chrono::seconds(20)) {
         if (pid_ <= 0) return exit_status_;
