@@ -45,7 +45,7 @@ ASAN_TESTS := degenerate_geometry_test degenerate_light_test scale_invariance_te
 	scene_transform_test builtin_scenes_test gltf_loader_test emission_test analytic_lighting_test \
 	tile_renderer_test photon_test kd_tree_test photon_map_test photon_map_io_test photon_tracer_test \
 	final_gather_test exr_io_test png_preview_test environment_light_test material_textures_test alpha_test \
-	clearcoat_test
+	clearcoat_test gltf_loader_fuzz_test
 
 .PHONY: asan
 asan: deps
@@ -59,6 +59,76 @@ asan: deps
 		if [ $$rc -ne 0 ]; then failed="$$failed $$t"; fi; \
 	done; \
 	if [ -n "$$failed" ]; then echo "tests failed (no sanitizer report):$$failed"; exit 1; fi
+
+# libFuzzer targets (README.md, "Fuzzing"): clang 14, every library with ASan + UBSan and the
+# fuzzer's coverage, each target run FUZZ_SECONDS on a scratch copy of its committed corpus
+# (fuzz/corpus/<target>) with its dictionary. Any crash, hang (FUZZ_TIMEOUT seconds on one input),
+# sanitizer report or out-of-memory (FUZZ_RSS_MB) fails the run; the input lands in
+# $(FUZZ_BUILD)/runs/<target>/. `make fuzz-ci` is the same for 30 s per target (run by CI).
+# FUZZ_TARGETS="job gltf" runs some; FUZZ_CMAKE_ARGS=-DCMAKE_CXX_COMPILER_LAUNCHER=ccache.
+FUZZ_PACKAGES := clang-14 libfuzzer-14-dev lld-14
+FUZZ_BUILD ?= $(BUILD)-fuzz
+FUZZ_SECONDS ?= 600
+FUZZ_TIMEOUT ?= 25
+FUZZ_RSS_MB ?= 2048
+FUZZ_TARGETS ?= job gltf photon_map scene_bundle http_request
+FUZZ_CMAKE_ARGS ?=
+# Per target: the longest input and the dictionary (fuzz/dict; http_request takes both).
+FUZZ_MAX_LEN_job := 4096
+FUZZ_MAX_LEN_gltf := 65536
+FUZZ_MAX_LEN_photon_map := 16384
+FUZZ_MAX_LEN_scene_bundle := 65536
+FUZZ_MAX_LEN_http_request := 16384
+FUZZ_DICTS_job := json
+FUZZ_DICTS_gltf := gltf
+FUZZ_DICTS_scene_bundle := gltf
+FUZZ_DICTS_http_request := http json
+
+.PHONY: fuzz-deps fuzz-build fuzz fuzz-ci
+fuzz-deps: deps
+	@missing=$$(for p in $(FUZZ_PACKAGES); do \
+		dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q '^install ok installed' || echo $$p; \
+	done); \
+	if [ -n "$$missing" ]; then \
+		echo "installing Debian packages:" $$missing; \
+		$(SUDO) apt-get update -qq && \
+		DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends $$missing; \
+	fi
+
+fuzz-build: fuzz-deps
+	cmake -S . -B $(FUZZ_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++-14 \
+		-DCMAKE_EXE_LINKER_FLAGS=-fuse-ld=lld -DPHOTOND_FUZZ=ON \
+		-DBUILD_TESTING=OFF $(FUZZ_CMAKE_ARGS)
+	cmake --build $(FUZZ_BUILD) -j$(JOBS) --target fuzzers
+
+fuzz: fuzz-build
+	@for t in $(FUZZ_TARGETS); do \
+		run=$(FUZZ_BUILD)/runs/$$t; rm -rf $$run; mkdir -p $$run/corpus; \
+		cp fuzz/corpus/$$t/* $$run/corpus/; \
+		dict=""; \
+		case $$t in \
+			job) dicts="$(FUZZ_DICTS_job)"; len=$(FUZZ_MAX_LEN_job);; \
+			gltf) dicts="$(FUZZ_DICTS_gltf)"; len=$(FUZZ_MAX_LEN_gltf);; \
+			photon_map) dicts="$(FUZZ_DICTS_photon_map)"; len=$(FUZZ_MAX_LEN_photon_map);; \
+			scene_bundle) dicts="$(FUZZ_DICTS_scene_bundle)"; len=$(FUZZ_MAX_LEN_scene_bundle);; \
+			http_request) dicts="$(FUZZ_DICTS_http_request)"; len=$(FUZZ_MAX_LEN_http_request);; \
+			*) echo "unknown fuzz target $$t"; exit 1;; \
+		esac; \
+		if [ -n "$$dicts" ]; then \
+			for d in $$dicts; do cat fuzz/dict/$$d.dict; done > $$run/dictionary; dict=-dict=$$run/dictionary; \
+		fi; \
+		echo "== $${t}_fuzzer: $(FUZZ_SECONDS) s, corpus $$(ls $$run/corpus | wc -l) inputs, -max_len=$$len"; \
+		ASAN_OPTIONS=detect_leaks=0 \
+		UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
+			$(FUZZ_BUILD)/fuzz/$${t}_fuzzer $$run/corpus $$dict -max_len=$$len \
+			-max_total_time=$(FUZZ_SECONDS) -timeout=$(FUZZ_TIMEOUT) -rss_limit_mb=$(FUZZ_RSS_MB) \
+			-print_final_stats=1 -artifact_prefix=$$run/ > $$run/log 2>&1; rc=$$?; \
+		grep -E '^(stat::|#[0-9]+ *DONE)' $$run/log; \
+		if [ $$rc -ne 0 ]; then tail -n 60 $$run/log; echo "$${t}_fuzzer: finding (exit $$rc), see $$run"; exit 1; fi; \
+	done
+
+fuzz-ci:
+	$(MAKE) fuzz FUZZ_SECONDS=30
 
 demo: build
 	./deploy/demo.sh $(BUILD) $(OUT)

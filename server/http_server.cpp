@@ -152,15 +152,17 @@ std::string rect_header(const PixelRect& r) {
            std::to_string(r.y1);
 }
 
-/// cpp-httplib's server with a longer queue of connections waiting to be accepted: it listens
-/// with a backlog of 5, so a burst of clients (a farm's submitters, a page's tile requests) had
-/// their SYNs dropped and waited a second for each retry.
+/// cpp-httplib's server with two of its protected members put to use: a longer queue of
+/// connections waiting to be accepted (it listens with a backlog of 5, so a burst of clients had
+/// their SYNs dropped and waited a second for each retry), and process_request for
+/// handle_raw_request.
 class ListeningServer : public httplib::Server {
 public:
     /// Call after binding; listen() on a listening socket sets its backlog anew.
     void widen_backlog() {
         if (svr_sock_ != INVALID_SOCKET) ::listen(svr_sock_, SOMAXCONN);
     }
+    using httplib::Server::process_request;
 };
 
 }  // namespace
@@ -743,5 +745,65 @@ void HttpServer::serve() { impl_->server.listen_after_bind(); }
 void HttpServer::stop() { impl_->server.stop(); }
 
 bool HttpServer::running() const { return impl_->server.is_running(); }
+
+// ---------------------------------------------------------------------------------------------
+// Requests from memory (fuzz/http_request_fuzzer.cpp, tests/server/http_raw_request_test.cpp)
+
+namespace {
+
+/// A connection whose client sends `input` and then nothing, and whose output is kept (up to
+/// `max_output` bytes: a write beyond it fails, which ends a stream).
+class MemoryStream final : public httplib::Stream {
+public:
+    MemoryStream(std::string_view input, size_t max_output)
+        : input_(input), max_output_(max_output) {}
+
+    bool is_readable() const override { return position_ < input_.size(); }
+    bool is_writable() const override { return output_.size() < max_output_; }
+    ssize_t read(char* ptr, size_t size) override {
+        const size_t n = std::min(size, input_.size() - position_);
+        std::copy_n(input_.data() + position_, n, ptr);
+        position_ += n;
+        return static_cast<ssize_t>(n);
+    }
+    ssize_t write(const char* ptr, size_t size) override {
+        if (size > max_output_ - std::min(max_output_, output_.size())) return -1;
+        output_.append(ptr, size);
+        return static_cast<ssize_t>(size);
+    }
+    void get_remote_ip_and_port(std::string& ip, int& port) const override {
+        ip = "127.0.0.1";
+        port = 0;
+    }
+    void get_local_ip_and_port(std::string& ip, int& port) const override {
+        ip = "127.0.0.1";
+        port = 0;
+    }
+    socket_t socket() const override { return INVALID_SOCKET; }
+
+    std::string take_output() { return std::move(output_); }
+
+private:
+    std::string_view input_;
+    size_t position_ = 0;
+    size_t max_output_;
+    std::string output_;
+};
+
+}  // namespace
+
+std::string HttpServer::handle_raw_request(std::string_view bytes) {
+    constexpr int kMaxRequests = 5;  // cpp-httplib's keep-alive default per connection
+    constexpr size_t kMaxOutputBytes = size_t{8} << 20;
+    MemoryStream stream(bytes, kMaxOutputBytes);
+    for (int i = 0; i < kMaxRequests && stream.is_readable(); ++i) {
+        bool connection_closed = false;
+        const bool last = i + 1 == kMaxRequests;
+        if (!impl_->server.process_request(stream, last, connection_closed, nullptr) ||
+            connection_closed)
+            break;
+    }
+    return stream.take_output();
+}
 
 }  // namespace photond::service

@@ -18,6 +18,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include "core/util/expected.h"
 
@@ -60,6 +61,13 @@ public:
     void serve();
     void stop();
     bool running() const;
+
+    /// Serves the raw bytes of one or more HTTP/1.1 requests (keep-alive, at most 5, as on one
+    /// connection) through the same routes, handlers and error handling as serve(), without a
+    /// socket, and returns the raw bytes of the responses. Streamed responses (events, tiles) end
+    /// where the stream does or after 8 MiB. For the fuzzer (fuzz/http_request_fuzzer.cpp) and
+    /// tests; bind() is not needed.
+    std::string handle_raw_request(std::string_view bytes);
 
 private:
     struct Impl;

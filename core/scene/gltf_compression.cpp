@@ -5,6 +5,7 @@
 #include <tiny_gltf.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -38,6 +39,20 @@ std::optional<double> number_member(const tinygltf::Value& object, const char* k
     return v.GetNumberAsDouble();
 }
 
+// A JSON number for a message, as the file wrote it ("-1", "4344", "1e+300", "nan"): a negative,
+// huge or NaN double converted to an integer type to print it is undefined behaviour.
+std::string number_text(double value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.17g", value);
+    return text;
+}
+
+// A number member an extension object must have; nullopt when absent or of another type.
+std::optional<double> required_number(const tinygltf::Value& object, const char* key) {
+    if (!object.Has(key) || !object.Get(key).IsNumber()) return std::nullopt;
+    return object.Get(key).GetNumberAsDouble();
+}
+
 std::string string_member(const tinygltf::Value& object, const char* key, const char* fallback) {
     if (!object.Has(key) || !object.Get(key).IsString()) return fallback;
     return object.Get(key).Get<std::string>();
@@ -48,14 +63,12 @@ Expected<std::span<const uint8_t>> buffer_range(const tinygltf::Model& model, do
                                                 double offset, double length,
                                                 const std::string& what) {
     if (!(buffer >= 0.0) || buffer >= double(model.buffers.size()))
-        return Error{what + " uses buffer " + std::to_string(int64_t(buffer)) +
-                     ", which does not exist"};
+        return Error{what + " uses buffer " + number_text(buffer) + ", which does not exist"};
     const std::vector<unsigned char>& data = model.buffers[size_t(buffer)].data;
     if (!(offset >= 0.0) || !(length >= 0.0) || offset + length > double(data.size()))
-        return Error{what + " (bytes " + std::to_string(uint64_t(offset)) + " + " +
-                     std::to_string(uint64_t(length)) + ") reaches past the end of buffer " +
-                     std::to_string(int64_t(buffer)) + " (" + std::to_string(data.size()) +
-                     " bytes)"};
+        return Error{what + " (bytes " + number_text(offset) + " + " + number_text(length) +
+                     ") reaches past the end of buffer " + number_text(buffer) + " (" +
+                     std::to_string(data.size()) + " bytes)"};
     return std::span<const uint8_t>(data.data() + size_t(offset), size_t(length));
 }
 
@@ -156,31 +169,32 @@ Status decode_meshopt_buffer_views(tinygltf::Model& model, uint64_t max_bytes) {
         const std::string what = "bufferView " + std::to_string(v) + " (EXT_meshopt_compression)";
         const tinygltf::Value& m = ext->second;
         if (!m.IsObject()) return Error{what + " is not an object"};
-        const auto buffer = number_member(m, "buffer", -1.0);
+        const auto buffer = required_number(m, "buffer");
         const auto offset = number_member(m, "byteOffset", 0.0);
-        const auto length = number_member(m, "byteLength", -1.0);
-        const auto stride = number_member(m, "byteStride", -1.0);
-        const auto count = number_member(m, "count", -1.0);
+        const auto length = required_number(m, "byteLength");
+        const auto stride = required_number(m, "byteStride");
+        const auto count = required_number(m, "count");
         if (!buffer || !offset || !length || !stride || !count)
             return Error{what +
-                         ": buffer, byteOffset, byteLength, byteStride and count must be "
-                         "numbers"};
+                         ": buffer, byteLength, byteStride and count must be given as numbers "
+                         "(byteOffset too, when given)"};
         const std::string mode = string_member(m, "mode", "");
         const std::string filter = string_member(m, "filter", "NONE");
         Expected<std::span<const uint8_t>> source =
             buffer_range(model, *buffer, *offset, *length, what);
         if (!source) return source.error();
         if (!(*stride >= 1.0 && *stride <= 256.0) || !(*count >= 0.0))
-            return Error{what + " has byteStride " + std::to_string(int64_t(*stride)) +
-                         " and count " + std::to_string(int64_t(*count)) +
-                         " (the stride must be 1 to 256)"};
+            return Error{what + " has byteStride " + number_text(*stride) + " and count " +
+                         number_text(*count) + " (the stride must be 1 to 256)"};
+        // The count is bounded before it is converted (a double beyond size_t's range is not).
+        const std::string too_large =
+            what + " decodes to more than " + std::to_string(max_bytes) + " bytes in all";
+        if (*count > double(max_bytes)) return Error{too_large};
         const auto element_size = static_cast<size_t>(*stride);
         const auto element_count = static_cast<size_t>(*count);
         const uint64_t decoded_size = uint64_t(element_size) * element_count;
         decoded_total += decoded_size;
-        if (*count > double(max_bytes) || decoded_total > max_bytes)
-            return Error{what + " decodes to more than " + std::to_string(max_bytes) +
-                         " bytes in all"};
+        if (decoded_total > max_bytes) return Error{too_large};
         std::vector<unsigned char> decoded(decoded_size);
         int result = -1;
         if (mode == "ATTRIBUTES") {
@@ -296,12 +310,15 @@ Status decode_draco_primitives(tinygltf::Model& model, uint64_t max_bytes) {
                     static_cast<size_t>(target->second) >= model.accessors.size())
                     return Error{what + ": attribute " + name +
                                  " has no accessor in the primitive or no numeric id"};
+                // Only an id in uint32_t's range converts to one.
+                const double unique_id = id.GetNumberAsDouble();
                 const draco::PointAttribute* attribute =
-                    mesh->GetAttributeByUniqueId(uint32_t(id.GetNumberAsDouble()));
+                    unique_id >= 0.0 && unique_id < 4294967296.0
+                        ? mesh->GetAttributeByUniqueId(uint32_t(unique_id))
+                        : nullptr;
                 if (attribute == nullptr)
                     return Error{what + ": the Draco data has no attribute with id " +
-                                 std::to_string(int64_t(id.GetNumberAsDouble())) + " (" + name +
-                                 ")"};
+                                 number_text(unique_id) + " (" + name + ")"};
                 tinygltf::Accessor accessor = model.accessors[size_t(target->second)];
                 const int components =
                     tinygltf::GetNumComponentsInType(static_cast<uint32_t>(accessor.type));

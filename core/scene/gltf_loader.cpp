@@ -778,6 +778,17 @@ const AccessorRule kIndexRule{
 // ---------------------------------------------------------------------------------------------
 // Materials and textures.
 
+// A JSON number as an int: nullopt when it is not a number or lies beyond int's range (converting
+// such a double is undefined behaviour; tinygltf's Value::GetNumberAsInt converts any).
+std::optional<int> int_value(const tinygltf::Value& v) {
+    if (!v.IsNumber()) return std::nullopt;
+    const double value = v.GetNumberAsDouble();
+    if (!(value >= double(std::numeric_limits<int>::min()) &&
+          value <= double(std::numeric_limits<int>::max())))
+        return std::nullopt;
+    return static_cast<int>(value);
+}
+
 // A number from an extension object: the default when absent, an error when of the wrong type.
 Expected<double> extension_number(const tinygltf::ExtensionMap& extensions, const char* extension,
                                   const char* key, double fallback) {
@@ -871,7 +882,9 @@ Expected<TextureRef> GltfSceneReader::texture_ref(int index, int tex_coord,
         }
         if (t.Has("texCoord")) {
             if (!t.Get("texCoord").IsNumber()) return fail(what + ".texCoord is not a number");
-            set = static_cast<int>(t.Get("texCoord").GetNumberAsDouble());
+            const std::optional<int> tex_coord = int_value(t.Get("texCoord"));
+            if (!tex_coord) return fail(what + ".texCoord is not a TEXCOORD_ set");
+            set = *tex_coord;
         }
         const float c = std::cos(rotation), sn = std::sin(rotation);
         ref.transformed = true;
@@ -1010,14 +1023,20 @@ Expected<uint32_t> GltfSceneReader::scene_material(int material_index) {
                 const tinygltf::Value& info = it->second.Get(key);
                 if (!info.IsObject() || !info.Has("index") || !info.Get("index").IsNumber())
                     return fail(context + "KHR_materials_clearcoat." + key + " has no texture index");
-                const int tex_coord = info.Has("texCoord") && info.Get("texCoord").IsNumber()
-                                          ? info.Get("texCoord").GetNumberAsInt() : 0;
+                const std::optional<int> index = int_value(info.Get("index"));
+                if (!index) return fail(context + "KHR_materials_clearcoat." + key + " has no texture index");
+                const std::optional<int> tex_coord =
+                    info.Has("texCoord") && info.Get("texCoord").IsNumber()
+                        ? int_value(info.Get("texCoord"))
+                        : std::optional<int>(0);
+                if (!tex_coord)
+                    return fail(context + "KHR_materials_clearcoat." + key + ".texCoord is not a TEXCOORD_ set");
                 tinygltf::ExtensionMap info_extensions;
                 if (info.Has("extensions") && info.Get("extensions").IsObject()) {
                     const tinygltf::Value& e = info.Get("extensions");
                     for (const std::string& name : e.Keys()) info_extensions[name] = e.Get(name);
                 }
-                Expected<TextureRef> ref = texture_ref(info.Get("index").GetNumberAsInt(), tex_coord, info_extensions,
+                Expected<TextureRef> ref = texture_ref(*index, *tex_coord, info_extensions,
                                                        context, key, false, sets);
                 if (!ref) return ref.error();
                 *target = *ref;
