@@ -145,6 +145,15 @@ bench: build
 	python3 bench/run_benchmark.py --photond $(BUILD)/server/photond $(BENCH_ARGS)
 	python3 bench/gltf_samples.py --photond $(BUILD)/server/photond
 
+# 200 concurrent clients (submitters, event and tile streams, slow readers, slowloris) on a real
+# daemon for LOAD_SECONDS, with the /healthz p99 goal of 50 ms (bench/load_test.py). ctest runs a
+# short version without the latency goal.
+LOAD_SECONDS ?= 60
+.PHONY: load
+load: build
+	python3 bench/load_test.py --photond $(BUILD)/server/photond --clients 200 \
+		--seconds $(LOAD_SECONDS) --latency-goal-ms 50 --json bench/results/load_test.json
+
 format:
 	find core protocol server clients tests bench -name '*.h' -o -name '*.cpp' | xargs clang-format -i
 
