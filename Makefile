@@ -13,8 +13,8 @@ OUT ?= out
 
 all: build
 
-deps:
-	@missing=$$(for p in $(DEBIAN_PACKAGES); do \
+# $(call install_missing,PACKAGES): apt-get installs those of PACKAGES not installed yet.
+install_missing = @missing=$$(for p in $(1); do \
 		dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q '^install ok installed' || echo $$p; \
 	done); \
 	if [ -n "$$missing" ]; then \
@@ -22,6 +22,9 @@ deps:
 		$(SUDO) apt-get update -qq && \
 		DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends $$missing; \
 	fi
+
+deps:
+	$(call install_missing,$(DEBIAN_PACKAGES))
 
 configure: deps
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
@@ -86,14 +89,7 @@ FUZZ_DICTS_http_request := http json
 
 .PHONY: fuzz-deps fuzz-build fuzz fuzz-ci
 fuzz-deps: deps
-	@missing=$$(for p in $(FUZZ_PACKAGES); do \
-		dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q '^install ok installed' || echo $$p; \
-	done); \
-	if [ -n "$$missing" ]; then \
-		echo "installing Debian packages:" $$missing; \
-		$(SUDO) apt-get update -qq && \
-		DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends $$missing; \
-	fi
+	$(call install_missing,$(FUZZ_PACKAGES))
 
 fuzz-build: fuzz-deps
 	cmake -S . -B $(FUZZ_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++-14 \
@@ -101,31 +97,25 @@ fuzz-build: fuzz-deps
 		-DBUILD_TESTING=OFF $(FUZZ_CMAKE_ARGS)
 	cmake --build $(FUZZ_BUILD) -j$(JOBS) --target fuzzers
 
-fuzz: fuzz-build
-	@for t in $(FUZZ_TARGETS); do \
-		run=$(FUZZ_BUILD)/runs/$$t; rm -rf $$run; mkdir -p $$run/corpus; \
-		cp fuzz/corpus/$$t/* $$run/corpus/; \
+fuzz: $(addprefix fuzz-run-,$(FUZZ_TARGETS))
+
+# One target's run (not .PHONY: make skips pattern rules for phony targets; no such file exists).
+fuzz-run-%: fuzz-build
+	$(if $(FUZZ_MAX_LEN_$*),,$(error unknown fuzz target '$*' (FUZZ_TARGETS: job gltf photon_map scene_bundle http_request)))
+	@run=$(FUZZ_BUILD)/runs/$*; rm -rf $$run; mkdir -p $$run/corpus; \
+		cp fuzz/corpus/$*/* $$run/corpus/; \
 		dict=""; \
-		case $$t in \
-			job) dicts="$(FUZZ_DICTS_job)"; len=$(FUZZ_MAX_LEN_job);; \
-			gltf) dicts="$(FUZZ_DICTS_gltf)"; len=$(FUZZ_MAX_LEN_gltf);; \
-			photon_map) dicts="$(FUZZ_DICTS_photon_map)"; len=$(FUZZ_MAX_LEN_photon_map);; \
-			scene_bundle) dicts="$(FUZZ_DICTS_scene_bundle)"; len=$(FUZZ_MAX_LEN_scene_bundle);; \
-			http_request) dicts="$(FUZZ_DICTS_http_request)"; len=$(FUZZ_MAX_LEN_http_request);; \
-			*) echo "unknown fuzz target $$t"; exit 1;; \
-		esac; \
-		if [ -n "$$dicts" ]; then \
-			for d in $$dicts; do cat fuzz/dict/$$d.dict; done > $$run/dictionary; dict=-dict=$$run/dictionary; \
+		if [ -n "$(FUZZ_DICTS_$*)" ]; then \
+			cat $(foreach d,$(FUZZ_DICTS_$*),fuzz/dict/$(d).dict) > $$run/dictionary; dict=-dict=$$run/dictionary; \
 		fi; \
-		echo "== $${t}_fuzzer: $(FUZZ_SECONDS) s, corpus $$(ls $$run/corpus | wc -l) inputs, -max_len=$$len"; \
+		echo "== $*_fuzzer: $(FUZZ_SECONDS) s, corpus $$(ls $$run/corpus | wc -l) inputs, -max_len=$(FUZZ_MAX_LEN_$*)"; \
 		ASAN_OPTIONS=detect_leaks=0 \
 		UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
-			$(FUZZ_BUILD)/fuzz/$${t}_fuzzer $$run/corpus $$dict -max_len=$$len \
+			$(FUZZ_BUILD)/fuzz/$*_fuzzer $$run/corpus $$dict -max_len=$(FUZZ_MAX_LEN_$*) \
 			-max_total_time=$(FUZZ_SECONDS) -timeout=$(FUZZ_TIMEOUT) -rss_limit_mb=$(FUZZ_RSS_MB) \
 			-print_final_stats=1 -artifact_prefix=$$run/ > $$run/log 2>&1; rc=$$?; \
 		grep -E '^(stat::|#[0-9]+ *DONE)' $$run/log; \
-		if [ $$rc -ne 0 ]; then tail -n 60 $$run/log; echo "$${t}_fuzzer: finding (exit $$rc), see $$run"; exit 1; fi; \
-	done
+		if [ $$rc -ne 0 ]; then tail -n 60 $$run/log; echo "$*_fuzzer: finding (exit $$rc), see $$run"; exit 1; fi
 
 fuzz-ci:
 	$(MAKE) fuzz FUZZ_SECONDS=30

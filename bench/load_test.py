@@ -45,6 +45,7 @@ class Tally:
         self.counts = {}
         self.errors = []
         self.accepted = []
+        self.five_xx = 0
 
     def add(self, key, n=1):
         with self.lock:
@@ -53,6 +54,8 @@ class Tally:
     def status(self, role, status):
         self.add(f"{role} {status}")
         if status >= 500:
+            with self.lock:
+                self.five_xx += 1
             self.error(f"{role}: HTTP {status}")
 
     def error(self, text):
@@ -279,7 +282,7 @@ def main():
         with open(probe_out) as f:
             probed = json.load(f)
         latencies = probed["latencies_ms"]
-        five_xx = sum(v for k, v in tally.counts.items() if k.split()[-1].isdigit() and int(k.split()[-1]) >= 500)
+        five_xx = tally.five_xx
 
         figures = {
             "clients": n,

@@ -35,11 +35,11 @@ using nlohmann::json;
 using Handler = std::function<void(const Request&, Response&)>;
 
 constexpr const char* kJsonType = "application/json";
+constexpr const char* kProblemType = "application/problem+json";
+constexpr const char* kExrType = "image/x-exr";
 // HTTP threads kept waiting for the next burst of connections; the others end after the timeout.
 constexpr size_t kKeptHttpThreads = 8;
 constexpr std::chrono::milliseconds kHttpThreadIdleTimeout{10000};
-constexpr const char* kProblemType = "application/problem+json";
-constexpr const char* kExrType = "image/x-exr";
 constexpr std::string_view kIdPattern = "([A-Za-z0-9_-]{1,128})";
 
 // ---------------------------------------------------------------------------------------------

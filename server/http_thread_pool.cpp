@@ -23,7 +23,6 @@ void HttpThreadPool::enqueue(std::function<void()> task) {
     threads_.emplace_back();
     const auto self = std::prev(threads_.end());
     *self = std::thread([this, self] { work(self); });
-    peak_ = std::max(peak_, threads_.size());
 }
 
 void HttpThreadPool::work(std::list<std::thread>::iterator self) {
@@ -69,16 +68,6 @@ void HttpThreadPool::shutdown() {
     task_available_.notify_all();
     for (std::thread& thread : threads)
         if (thread.joinable()) thread.join();
-}
-
-size_t HttpThreadPool::threads() const {
-    std::lock_guard lock(mutex_);
-    return threads_.size() - finished_.size();
-}
-
-size_t HttpThreadPool::peak_threads() const {
-    std::lock_guard lock(mutex_);
-    return peak_;
 }
 
 }  // namespace photond::service

@@ -35,10 +35,6 @@ public:
     /// Runs the queued tasks to their end and joins every thread.
     void shutdown() override;
 
-    /// Threads alive now, and the most there were at once (for tests and /metrics).
-    size_t threads() const;
-    size_t peak_threads() const;
-
 private:
     void work(std::list<std::thread>::iterator self);
     void join_finished_locked();
@@ -47,13 +43,12 @@ private:
     const size_t kept_threads_;
     const std::chrono::milliseconds idle_timeout_;
 
-    mutable std::mutex mutex_;
+    std::mutex mutex_;
     std::condition_variable task_available_;
     std::deque<std::function<void()>> tasks_;
     std::list<std::thread> threads_;
     std::vector<std::list<std::thread>::iterator> finished_;  // ended on idle, to be joined
     size_t idle_ = 0;
-    size_t peak_ = 0;
     bool stopping_ = false;
 };
 

@@ -17,7 +17,6 @@
 #include "server/atomic_file.h"
 #include "server/render_pipeline.h"
 #include "server/service_error.h"
-#include "server/tile_journal.h"
 
 namespace photond::service {
 
@@ -169,6 +168,10 @@ std::optional<uint64_t> JobManager::cache_dir_free_bytes() const {
     return space.available;
 }
 
+TileJournal JobManager::kept_tiles(const Entry& entry) const {
+    return TileJournal(store_.tiles_directory(entry.id()), entry.submission.request_digest);
+}
+
 void JobManager::log(const std::string& line) const {
     if (options_.log) options_.log(line);
 }
@@ -197,8 +200,7 @@ void JobManager::restore(StoredJob stored) {
                            " times while this job was running (a crash, kill -9 or power loss); it is "
                            "not run again, since it may be what crashes the daemon (a poison job)";
             status.finished_at_ms = now_ms();
-            std::error_code ignored;
-            fs::remove_all(store_.tiles_directory(entry->id()), ignored);
+            kept_tiles(*entry).clear();
         } else {
             status.state = JobState::Queued;
             status.started_at_ms = 0;
@@ -769,7 +771,7 @@ void JobManager::run(const std::shared_ptr<Entry>& entry) {
     options.callbacks.cancel = &e.cancel;
     // Each finished tile is kept on disk until the job ends, and a run after a crash (or a clean
     // stop) takes the tiles kept by the last one instead of rendering them again.
-    const TileJournal journal(store_.tiles_directory(e.id()), e.submission.request_digest);
+    const TileJournal journal = kept_tiles(e);
     std::mutex run_warnings_mutex;
     std::vector<std::string> run_warnings;  // added to the statistics' warnings at the end
     auto warn_once = [&](const std::string& warning) {
@@ -960,7 +962,7 @@ void JobManager::finish(const std::shared_ptr<Entry>& entry, JobState state, std
     }
     keep_status(status);
     // The job ended: nothing will resume it (a done job serves its image).
-    TileJournal(store_.tiles_directory(status.id), entry->submission.request_digest).clear();
+    kept_tiles(*entry).clear();
     std::string line = "job " + status.id + " " + std::string(protocol::to_string(state));
     if (statistics) {
         char seconds[32];

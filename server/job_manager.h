@@ -51,6 +51,7 @@
 #include "server/metrics.h"
 #include "server/photon_map_cache.h"
 #include "server/scene_store.h"
+#include "server/tile_journal.h"
 
 namespace photond::service {
 
@@ -174,6 +175,8 @@ private:
     std::shared_ptr<const ImageLayers> final_image(const std::shared_ptr<Entry>& entry);
     void remember_image_locked(const std::shared_ptr<Entry>& entry);
     void restore(StoredJob stored);
+    /// The tiles a job keeps on disk while it runs (crash-resume).
+    TileJournal kept_tiles(const Entry& entry) const;
     void log(const std::string& line) const;
 
     JobManagerOptions options_;
