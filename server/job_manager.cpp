@@ -904,37 +904,44 @@ void JobManager::run(const std::shared_ptr<Entry>& entry) {
     finish(entry, JobState::Done, "", &result->statistics);
 }
 
-void JobManager::finish_locked(Entry& e, JobState state, std::string error,
-                               const RenderStatistics* statistics) {
-    e.status.state = state;
-    e.status.error = std::move(error);
-    e.status.finished_at_ms = now_ms();
+protocol::JobStatus JobManager::ended_status_locked(const Entry& e, JobState state, std::string error,
+                                                   const RenderStatistics* statistics) const {
+    protocol::JobStatus s = e.status;
+    s.state = state;
+    s.error = std::move(error);
+    s.finished_at_ms = now_ms();
     if (statistics) {
-        e.status.statistics = protocol::to_json(*statistics);
-        e.status.plan = plan_of(*statistics);
+        s.statistics = protocol::to_json(*statistics);
+        s.plan = plan_of(*statistics);
         // The render's warnings, then those raised while it ran (keep_status's).
         std::vector<std::string> warnings = statistics->warnings;
-        for (const std::string& w : e.status.warnings)
+        for (const std::string& w : s.warnings)
             if (std::find(warnings.begin(), warnings.end(), w) == warnings.end()) warnings.push_back(w);
-        e.status.warnings = std::move(warnings);
-        e.status.photon_cache = statistics->photon_cache;
-        e.status.photon_map_key = statistics->photon_map_key;
-        e.status.timings.clear();
-        for (const PassTiming& p : statistics->passes)
-            e.status.timings.push_back({p.name, p.seconds});
-    } else if (!e.status.pass.empty()) {
-        e.status.timings.push_back(
-            {e.status.pass, std::chrono::duration<double>(Clock::now() - e.pass_started).count()});
+        s.warnings = std::move(warnings);
+        s.photon_cache = statistics->photon_cache;
+        s.photon_map_key = statistics->photon_map_key;
+        s.timings.clear();
+        for (const PassTiming& p : statistics->passes) s.timings.push_back({p.name, p.seconds});
+    } else if (!s.pass.empty()) {
+        s.timings.push_back({s.pass, std::chrono::duration<double>(Clock::now() - e.pass_started).count()});
     }
-    e.status.pass.clear();
+    s.pass.clear();
+    if (state == JobState::Done) s.progress.tiles_done = s.progress.tiles_total;
+    return s;
+}
+
+void JobManager::announce_end_locked(Entry& e, protocol::JobStatus ended) {
+    // Warnings given to the job since its ended status was made (a refused status write).
+    for (const std::string& w : e.status.warnings)
+        if (std::find(ended.warnings.begin(), ended.warnings.end(), w) == ended.warnings.end())
+            ended.warnings.push_back(w);
+    e.status = std::move(ended);
+    const JobState state = e.status.state;
+    e.tiles.clear();
     if (state != JobState::Done) {
         // Nothing can be fetched from a cancelled or failed job: free its pixels.
-        e.tiles.clear();
         e.finished_order.clear();
         e.finished_order.shrink_to_fit();
-    } else {
-        e.tiles.clear();
-        e.status.progress.tiles_done = e.status.progress.tiles_total;
     }
     json reason = {{"state", std::string(protocol::to_string(state))}};
     if (!e.status.error.empty()) reason["reason"] = e.status.error;
@@ -947,6 +954,11 @@ void JobManager::finish_locked(Entry& e, JobState state, std::string error,
     e.changed.notify_all();
 }
 
+void JobManager::finish_locked(Entry& e, JobState state, std::string error,
+                               const RenderStatistics* statistics) {
+    announce_end_locked(e, ended_status_locked(e, state, std::move(error), statistics));
+}
+
 void JobManager::finish(const std::shared_ptr<Entry>& entry, JobState state, std::string error,
                         const RenderStatistics* statistics) {
     // Metrics first: a client that sees the job end and then scrapes /metrics finds it counted.
@@ -954,15 +966,21 @@ void JobManager::finish(const std::shared_ptr<Entry>& entry, JobState state, std
         metrics_->record_rays(statistics->rays + statistics->shadow_rays);
         for (const PassTiming& p : statistics->passes) metrics_->record_pass(p.name, p.seconds);
     }
+    // The end is written to disk and the kept tiles are removed before it is announced: a client
+    // that hears of it finds both done, and a daemon dying before the write resumes the job from
+    // its tiles (nothing will resume it after: a done job serves its image).
     protocol::JobStatus status;
     {
         std::lock_guard lock(mutex_);
-        finish_locked(*entry, state, std::move(error), statistics);
-        status = entry->status;
+        status = ended_status_locked(*entry, state, std::move(error), statistics);
     }
     keep_status(status);
-    // The job ended: nothing will resume it (a done job serves its image).
     kept_tiles(*entry).clear();
+    {
+        std::lock_guard lock(mutex_);
+        announce_end_locked(*entry, status);
+        status = entry->status;
+    }
     std::string line = "job " + status.id + " " + std::string(protocol::to_string(state));
     if (statistics) {
         char seconds[32];

@@ -168,6 +168,11 @@ private:
                 const RenderStatistics* statistics);
     void finish_locked(Entry& entry, protocol::JobState state, std::string error,
                        const RenderStatistics* statistics);
+    /// The status a job ends with (its entry unchanged).
+    protocol::JobStatus ended_status_locked(const Entry& entry, protocol::JobState state, std::string error,
+                                            const RenderStatistics* statistics) const;
+    /// Makes `ended` the job's status: its pixels freed, its last events, its waiters woken.
+    void announce_end_locked(Entry& entry, protocol::JobStatus ended);
     /// Whether a done job's image file matches the checksum written with it (once per process);
     /// a damaged one is moved aside and the job failed with the reason.
     bool verify_image(const std::shared_ptr<Entry>& entry);
