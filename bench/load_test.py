@@ -14,7 +14,8 @@ Starts `photond serve` on a free port with a fresh cache directory and runs, at 
 and, in a separate process so that this one's threads do not delay it, a prober that times
 GET /healthz on a new connection every 20 ms. After the load: every accepted job must finish
 `done` with its image retrievable, no answer may be a 5xx, the daemon must still run; the
-daemon's RSS is read before, at the end of the load and after it settled. Prints the figures;
+daemon's RSS is read before, at the end of the load and after it settled; --rounds N repeats the
+load and its checks on the same daemon. Prints the figures;
 exits 1 when a check fails (the /healthz p99 only with --latency-goal-ms). Standard library only.
 """
 import argparse
@@ -199,6 +200,91 @@ def percentile(values, p):
     return ordered[min(len(ordered) - 1, int(round(p / 100.0 * (len(ordered) - 1))))]
 
 
+def load_round(args, port, daemon, work):
+    """One round of load on the running daemon, then its checks; returns (figures, failures)."""
+    tally, stop = Tally(), threading.Event()
+    seeds_lock, counter = threading.Lock(), [0]
+
+    def seeds():
+        while True:
+            with seeds_lock:
+                counter[0] += 1
+                yield counter[0]
+
+    seed_source = seeds()
+    n = args.clients
+    roles = ([("submit", lambda: submitter(port, tally, stop, seed_source))] * int(n * 0.3) +
+             [("events", lambda: streamer(port, tally, stop, "events"))] * int(n * 0.25) +
+             [("tiles", lambda: streamer(port, tally, stop, "tiles"))] * int(n * 0.2) +
+             [("slow", lambda: slow_reader(port, tally, stop))] * int(n * 0.15))
+    roles += [("slowloris", lambda: slowloris(port, tally, stop))] * (n - len(roles))
+    probe_out = os.path.join(work, "probe.json")
+    prober = subprocess.Popen([sys.executable, __file__, "--probe", str(port), str(args.seconds), probe_out])
+    threads = [threading.Thread(target=target, daemon=True) for _, target in roles]
+    started = time.monotonic()
+    for t in threads:
+        t.start()
+    time.sleep(args.seconds)
+    rss_load = resident_kb(daemon.pid)
+    stop.set()
+    prober.wait()
+    for t in threads:
+        t.join(timeout=130)
+    load_seconds = time.monotonic() - started
+
+    # Every accepted job ends done, with its image.
+    deadline = time.monotonic() + 300
+    not_done = []
+    for job_id in tally.accepted:
+        while True:
+            status, _, body = request(port, "GET", f"/v1/jobs/{job_id}")
+            state = json.loads(body).get("state") if status == 200 else f"HTTP {status}"
+            if state not in ("queued", "running") or time.monotonic() > deadline:
+                break
+            time.sleep(0.05)
+        if state != "done":
+            not_done.append(f"{job_id}: {state}")
+            continue
+        status, _, image = request(port, "GET", f"/v1/jobs/{job_id}/image.exr")
+        if status != 200 or not image.startswith(EXR_MAGIC):
+            not_done.append(f"{job_id}: image HTTP {status}")
+    time.sleep(5)
+    rss_after = resident_kb(daemon.pid)
+    with open(probe_out) as f:
+        probed = json.load(f)
+    latencies = probed["latencies_ms"]
+    five_xx = tally.five_xx
+
+    figures = {
+        "clients": n,
+        "roles": {r: sum(1 for x, _ in roles if x == r) for r, _ in roles},
+        "load_seconds": round(load_seconds, 1),
+        "jobs_accepted": len(tally.accepted),
+        "jobs_not_done": len(not_done),
+        "answers": dict(sorted(tally.counts.items())),
+        "answers_5xx": five_xx,
+        "healthz_probes": len(latencies),
+        "healthz_failures": probed["failures"],
+        "healthz_ms": {"p50": round(statistics.median(latencies), 2),
+                       "p99": round(percentile(latencies, 99), 2),
+                       "max": round(max(latencies), 2)},
+        "rss_kb": {"end_of_load": rss_load, "settled": rss_after},
+    }
+    failures = []
+    if five_xx:
+        failures.append(f"{five_xx} answers were 5xx")
+    failures += [f"error: {e}" for e in tally.errors[:10]]
+    if not_done:
+        failures.append(f"{len(not_done)} accepted job(s) not done: {not_done[:5]}")
+    if probed["failures"]:
+        failures.append(f"{probed['failures']} /healthz probes failed")
+    if not tally.accepted:
+        failures.append("no job was accepted")
+    if args.latency_goal_ms > 0 and figures["healthz_ms"]["p99"] > args.latency_goal_ms:
+        failures.append(f"/healthz p99 {figures['healthz_ms']['p99']} ms > {args.latency_goal_ms} ms")
+    return figures, failures
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--photond", default="build/server/photond")
@@ -207,6 +293,9 @@ def main():
     parser.add_argument("--threads", type=int, default=2, help="render threads of the daemon")
     parser.add_argument("--latency-goal-ms", type=float, default=0.0,
                         help="fail when the /healthz p99 exceeds this (0: report only)")
+    parser.add_argument("--rounds", type=int, default=1,
+                        help="rounds of load on the same daemon (its RSS settled after each shows "
+                             "whether what stays grows)")
     parser.add_argument("--json", help="write the figures to this file")
     parser.add_argument("--probe", nargs=3, metavar=("PORT", "SECONDS", "OUT"), help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -231,92 +320,20 @@ def main():
             request(port, "GET", f"/v1/jobs/{json.loads(body)['id']}/image.exr?wait=true")
         rss_before = resident_kb(daemon.pid)
 
-        tally, stop = Tally(), threading.Event()
-        seeds_lock, counter = threading.Lock(), [0]
-
-        def seeds():
-            while True:
-                with seeds_lock:
-                    counter[0] += 1
-                    yield counter[0]
-
-        seed_source = seeds()
-        n = args.clients
-        roles = ([("submit", lambda: submitter(port, tally, stop, seed_source))] * int(n * 0.3) +
-                 [("events", lambda: streamer(port, tally, stop, "events"))] * int(n * 0.25) +
-                 [("tiles", lambda: streamer(port, tally, stop, "tiles"))] * int(n * 0.2) +
-                 [("slow", lambda: slow_reader(port, tally, stop))] * int(n * 0.15))
-        roles += [("slowloris", lambda: slowloris(port, tally, stop))] * (n - len(roles))
-        probe_out = os.path.join(work, "probe.json")
-        prober = subprocess.Popen([sys.executable, __file__, "--probe", str(port), str(args.seconds), probe_out])
-        threads = [threading.Thread(target=target, daemon=True) for _, target in roles]
-        started = time.monotonic()
-        for t in threads:
-            t.start()
-        time.sleep(args.seconds)
-        rss_load = resident_kb(daemon.pid)
-        stop.set()
-        prober.wait()
-        for t in threads:
-            t.join(timeout=130)
-        load_seconds = time.monotonic() - started
-
-        # Every accepted job ends done, with its image.
-        deadline = time.monotonic() + 300
-        not_done = []
-        for job_id in tally.accepted:
-            while True:
-                status, _, body = request(port, "GET", f"/v1/jobs/{job_id}")
-                state = json.loads(body).get("state") if status == 200 else f"HTTP {status}"
-                if state not in ("queued", "running") or time.monotonic() > deadline:
-                    break
-                time.sleep(0.05)
-            if state != "done":
-                not_done.append(f"{job_id}: {state}")
-                continue
-            status, _, image = request(port, "GET", f"/v1/jobs/{job_id}/image.exr")
-            if status != 200 or not image.startswith(EXR_MAGIC):
-                not_done.append(f"{job_id}: image HTTP {status}")
-        time.sleep(5)
-        rss_after = resident_kb(daemon.pid)
-        with open(probe_out) as f:
-            probed = json.load(f)
-        latencies = probed["latencies_ms"]
-        five_xx = tally.five_xx
-
-        figures = {
-            "clients": n,
-            "roles": {r: sum(1 for x, _ in roles if x == r) for r, _ in roles},
-            "load_seconds": round(load_seconds, 1),
-            "jobs_accepted": len(tally.accepted),
-            "jobs_not_done": len(not_done),
-            "answers": dict(sorted(tally.counts.items())),
-            "answers_5xx": five_xx,
-            "healthz_probes": len(latencies),
-            "healthz_failures": probed["failures"],
-            "healthz_ms": {"p50": round(statistics.median(latencies), 2),
-                           "p99": round(percentile(latencies, 99), 2),
-                           "max": round(max(latencies), 2)},
-            "rss_kb": {"before": rss_before, "end_of_load": rss_load, "settled": rss_after},
-            "daemon_running": daemon.poll() is None,
-        }
+        rounds = []
+        for _ in range(args.rounds):
+            figures, round_failures = load_round(args, port, daemon, work)
+            rounds.append(figures)
+            failures += round_failures
+        figures = dict(rounds[0]) if len(rounds) == 1 else {"rounds": rounds}
+        figures["rss_kb_before"] = rss_before
+        figures["daemon_running"] = daemon.poll() is None
         print(json.dumps(figures, indent=2))
         if args.json:
             with open(args.json, "w") as f:
                 json.dump(figures, f, indent=2)
-        if five_xx:
-            failures.append(f"{five_xx} answers were 5xx")
-        failures += [f"error: {e}" for e in tally.errors[:10]]
-        if not_done:
-            failures.append(f"{len(not_done)} accepted job(s) not done: {not_done[:5]}")
-        if probed["failures"]:
-            failures.append(f"{probed['failures']} /healthz probes failed")
-        if not tally.accepted:
-            failures.append("no job was accepted")
         if daemon.poll() is not None:
             failures.append("the daemon died")
-        if args.latency_goal_ms > 0 and figures["healthz_ms"]["p99"] > args.latency_goal_ms:
-            failures.append(f"/healthz p99 {figures['healthz_ms']['p99']} ms > {args.latency_goal_ms} ms")
     finally:
         if daemon.poll() is None:
             daemon.terminate()

@@ -147,18 +147,35 @@ JobManager::JobManager(JobManagerOptions options, std::shared_ptr<EmbreeDevice> 
 
 JobManager::~JobManager() { shutdown(); }
 
-void JobManager::keep_status(const protocol::JobStatus& status) {
-    const Status saved = store_.save_status(status);
-    if (saved) return;
+std::optional<std::string> JobManager::write_status(const protocol::JobStatus& status) {
+    Status saved = Error{"an exception"};
+    try {
+        saved = store_.save_status(status);
+    } catch (const std::exception& e) {
+        saved = Error{e.what()};
+    }
+    if (saved) return std::nullopt;
     metrics_->record_store_failure();
     const std::string warning = "the job's state could not be written to the cache directory (" +
                                 saved.error().message + "): a restart may find it as it was before";
     log("job " + status.id + ": " + warning);
+    return warning;
+}
+
+void JobManager::add_warning_locked(Entry& entry, const std::string& warning) {
+    std::vector<std::string>& warnings = entry.status.warnings;
+    if (std::find(warnings.begin(), warnings.end(), warning) == warnings.end()) warnings.push_back(warning);
+}
+
+void JobManager::keep_status(const protocol::JobStatus& status) {
+    const std::optional<std::string> warning = write_status(status);
+    if (!warning) return;
     std::lock_guard lock(mutex_);
-    if (const auto it = jobs_.find(status.id); it != jobs_.end()) {
-        std::vector<std::string>& warnings = it->second->status.warnings;
-        if (std::find(warnings.begin(), warnings.end(), warning) == warnings.end()) warnings.push_back(warning);
-    }
+    if (const auto it = jobs_.find(status.id); it != jobs_.end()) add_warning_locked(*it->second, *warning);
+}
+
+void JobManager::keep_status_locked(Entry& entry) {
+    if (const std::optional<std::string> warning = write_status(entry.status)) add_warning_locked(entry, *warning);
 }
 
 std::optional<uint64_t> JobManager::cache_dir_free_bytes() const {
@@ -176,19 +193,57 @@ void JobManager::log(const std::string& line) const {
     if (options_.log) options_.log(line);
 }
 
-void JobManager::push_event_locked(Entry& entry, JobEventType type, json data) {
+void JobManager::push_event_locked(Entry& entry, JobEventType type, json data) const {
     entry.events.push_back({entry.events.size() + 1, type, std::move(data)});
 }
 
 // ---------------------------------------------------------------------------------------------
 // Start, restore, shutdown
 
-void JobManager::restore(StoredJob stored) {
+std::shared_ptr<JobManager::Entry> JobManager::make_entry(StoredJob stored) const {
     auto entry = std::make_shared<Entry>(std::move(stored.submission));
     protocol::JobStatus status = std::move(stored.status);
     status.job = entry->submission.job;
     status.progress.tiles_total = entry->status.progress.tiles_total;
     status.pass.clear();
+    entry->status = std::move(status);
+    return entry;
+}
+
+void JobManager::push_history_locked(Entry& e) const {
+    // The history of a job read back from disk is rebuilt from its state: a client resuming or
+    // starting a stream sees the same shape of events as during the render (tiles, then the last
+    // event), though not the same event ids.
+    switch (e.status.state) {
+        case JobState::Queued:
+        case JobState::Running:
+            push_event_locked(e, JobEventType::State, {{"state", "queued"}});
+            break;
+        case JobState::Done:
+            e.status.progress.tiles_done = e.status.progress.tiles_total;
+            for (int ty = 0; ty < e.tiles_y; ++ty)
+                for (int tx = 0; tx < e.tiles_x; ++tx) {
+                    e.finished_order.push_back({tx, ty});
+                    push_event_locked(e, JobEventType::Tile, e.tile_event({tx, ty}));
+                }
+            push_event_locked(e, JobEventType::Progress, e.progress_event());
+            push_event_locked(e, JobEventType::State, {{"state", "done"}});
+            push_event_locked(e, JobEventType::Done, protocol::to_json(e.status));
+            break;
+        case JobState::Failed:
+            push_event_locked(e, JobEventType::State, {{"state", "failed"}, {"reason", e.status.error}});
+            push_event_locked(e, JobEventType::Failed, protocol::to_json(e.status));
+            break;
+        case JobState::Cancelled:
+            push_event_locked(e, JobEventType::State, {{"state", "cancelled"}});
+            push_event_locked(e, JobEventType::Cancelled, protocol::to_json(e.status));
+            break;
+    }
+}
+
+void JobManager::restore(StoredJob stored, std::vector<std::pair<uint64_t, std::string>>& arrivals) {
+    const auto entry = make_entry(std::move(stored));
+    protocol::JobStatus& status = entry->status;
     bool changed = false;
     if (status.state == JobState::Running) {
         // The daemon died while the job ran (a clean stop queues it again): it resumes from the
@@ -213,65 +268,40 @@ void JobManager::restore(StoredJob stored) {
         status.error = "the result image is missing from the cache directory";
         changed = true;
     }
-    entry->status = std::move(status);
-    if (changed) keep_status(entry->status);
+    if (changed) keep_status(status);
 
     std::lock_guard lock(mutex_);
     Entry& e = *entry;
-    // The history of a restored job is rebuilt from its state: a client resuming or starting a
-    // stream sees the same shape of events as during the render (tiles, then the last event).
-    switch (e.status.state) {
-        case JobState::Queued: {
-            e.status.progress.tiles_done = 0;
-            json queued = {{"state", "queued"}};
-            if (changed)
-                queued["reason"] = "the daemon died while the job was running; it resumes from the tiles it had finished";
-            push_event_locked(e, JobEventType::State, std::move(queued));
-            queue_.insert({{-e.submission.job.priority, e.submission.sequence}, e.id()});
-            break;
-        }
-        case JobState::Done:
-            e.status.progress.tiles_done = e.status.progress.tiles_total;
-            for (int ty = 0; ty < e.tiles_y; ++ty)
-                for (int tx = 0; tx < e.tiles_x; ++tx) {
-                    e.finished_order.push_back({tx, ty});
-                    push_event_locked(e, JobEventType::Tile, e.tile_event({tx, ty}));
-                }
-            push_event_locked(e, JobEventType::Progress, e.progress_event());
-            push_event_locked(e, JobEventType::State, {{"state", "done"}});
-            push_event_locked(e, JobEventType::Done, protocol::to_json(e.status));
-            break;
-        case JobState::Failed:
-            push_event_locked(e, JobEventType::State,
-                              {{"state", "failed"}, {"reason", e.status.error}});
-            push_event_locked(e, JobEventType::Failed, protocol::to_json(e.status));
-            break;
-        case JobState::Cancelled:
-            push_event_locked(e, JobEventType::State, {{"state", "cancelled"}});
-            push_event_locked(e, JobEventType::Cancelled, protocol::to_json(e.status));
-            break;
-        case JobState::Running:
-            break;  // turned into queued or failed above
+    if (e.status.state == JobState::Queued) {
+        json queued = {{"state", "queued"}};
+        if (changed)
+            queued["reason"] = "the daemon died while the job was running; it resumes from the tiles it had finished";
+        push_event_locked(e, JobEventType::State, std::move(queued));
+        queue_.insert({{-e.submission.job.priority, e.submission.sequence}, e.id()});
+        jobs_[e.id()] = entry;
+    } else {
+        on_disk_only_[e.id()] = e.status.state;  // read back when asked for
     }
     if (!e.submission.idempotency_key.empty())
         idempotency_keys_[e.submission.idempotency_key] = e.id();
     next_sequence_ = std::max(next_sequence_, e.submission.sequence + 1);
-    jobs_[e.id()] = entry;
-    arrival_order_.push_back(entry);
+    arrivals.emplace_back(e.submission.sequence, e.id());
 }
 
 void JobManager::start() {
-    JobStore::Loaded loaded = store_.load_all();
-    for (const std::string& problem : loaded.problems) log("skipping a stored job: " + problem);
-    size_t requeued = 0;
-    for (StoredJob& stored : loaded.jobs) {
-        if (stored.status.state == JobState::Queued || stored.status.state == JobState::Running)
-            ++requeued;
-        restore(std::move(stored));
+    std::vector<std::pair<uint64_t, std::string>> arrivals;
+    const std::vector<std::string> problems =
+        store_.load_each([&](StoredJob stored) { restore(std::move(stored), arrivals); });
+    for (const std::string& problem : problems) log("skipping a stored job: " + problem);
+    std::sort(arrivals.begin(), arrivals.end());
+    {
+        std::lock_guard lock(mutex_);
+        for (auto& [sequence, id] : arrivals) arrival_order_.push_back(std::move(id));
     }
-    if (!loaded.jobs.empty())
-        log("restored " + std::to_string(loaded.jobs.size()) + " job(s) from " +
-            store_.job_directory("").string() + " (" + std::to_string(queue_.size()) + " queued)");
+    if (!arrivals.empty())
+        log("restored " + std::to_string(arrivals.size()) + " job(s) from " + store_.job_directory("").string() +
+            " (" + std::to_string(queue_.size()) + " queued)");
+    malloc_trim(0);  // the records read are freed: hand their memory back
     worker_running_ = true;
     worker_ = std::thread([this] { worker_loop(); });
 }
@@ -367,11 +397,11 @@ JobManager::Submitted JobManager::submit(const protocol::Job& job,
         sha256_hex({reinterpret_cast<const uint8_t*>(normalized.data()), normalized.size()});
     JobSubmission submission;
     {
-        std::lock_guard lock(mutex_);
+        std::unique_lock lock(mutex_);
         if (!idempotency_key.empty()) {
             if (const auto it = idempotency_keys_.find(idempotency_key);
                 it != idempotency_keys_.end()) {
-                const auto& entry = jobs_.at(it->second);
+                const auto entry = find_locked(lock, std::string(it->second));
                 if (entry->submission.request_digest != digest)
                     throw ServiceError(ErrorKind::Conflict, "Idempotency-Key '" + idempotency_key +
                                                                 "' was used for job " +
@@ -412,7 +442,7 @@ JobManager::Submitted JobManager::submit(const protocol::Job& job,
         std::lock_guard lock(mutex_);
         push_event_locked(*entry, JobEventType::State, {{"state", "queued"}});
         jobs_[entry->id()] = entry;
-        arrival_order_.push_back(entry);
+        arrival_order_.push_back(entry->id());
         queue_.insert({{-job.priority, submission.sequence}, entry->id()});
         if (!idempotency_key.empty()) idempotency_keys_[idempotency_key] = entry->id();
         status = entry->status;
@@ -422,26 +452,94 @@ JobManager::Submitted JobManager::submit(const protocol::Job& job,
     return {status, true};
 }
 
-std::shared_ptr<JobManager::Entry> JobManager::find_locked(const std::string& id) const {
-    const auto it = jobs_.find(id);
-    if (it == jobs_.end()) throw ServiceError(ErrorKind::NotFound, "no job '" + id + "'");
-    return it->second;
+std::shared_ptr<JobManager::Entry> JobManager::find_locked(std::unique_lock<std::mutex>& lock,
+                                                           const std::string& id) const {
+    for (;;) {
+        if (const auto it = jobs_.find(id); it != jobs_.end()) {
+            if (protocol::is_terminal(it->second->status.state)) remember_record_locked(it->second);
+            return it->second;
+        }
+        if (!on_disk_only_.contains(id)) throw ServiceError(ErrorKind::NotFound, "no job '" + id + "'");
+        // A finished job whose record left memory: read back outside the lock.
+        lock.unlock();
+        Expected<StoredJob> stored = store_.load(id);
+        lock.lock();
+        const auto kept = on_disk_only_.find(id);
+        if (kept == on_disk_only_.end()) continue;  // another call read it back meanwhile
+        std::shared_ptr<Entry> entry;
+        if (stored) {
+            entry = make_entry(std::move(stored).value());
+        } else {
+            JobSubmission lost;
+            lost.id = id;
+            entry = std::make_shared<Entry>(std::move(lost));
+            entry->status.state = JobState::Failed;
+            entry->status.error = "the job's record cannot be read back from the cache directory: " +
+                                  stored.error().message;
+            log("job " + id + ": " + entry->status.error);
+        }
+        push_history_locked(*entry);
+        on_disk_only_.erase(kept);
+        jobs_[id] = std::move(entry);
+    }
+}
+
+void JobManager::remember_record_locked(const std::shared_ptr<Entry>& entry) const {
+    std::erase(records_in_memory_, entry->id());
+    records_in_memory_.push_back(entry->id());
+    // The oldest beyond the limit leave memory, except those a call is using now (it holds the
+    // entry): their records are on disk and read back when asked for again.
+    for (size_t i = 0; records_in_memory_.size() > options_.finished_jobs_in_memory && i < records_in_memory_.size();) {
+        const auto it = jobs_.find(records_in_memory_[i]);
+        if (it != jobs_.end() && it->second.use_count() > 1) {
+            ++i;
+            continue;
+        }
+        if (it != jobs_.end()) {
+            on_disk_only_[it->first] = it->second->status.state;
+            std::erase(images_in_memory_, it->first);
+            jobs_.erase(it);
+        }
+        records_in_memory_.erase(records_in_memory_.begin() + static_cast<std::ptrdiff_t>(i));
+    }
 }
 
 protocol::JobStatus JobManager::status(const std::string& id) const {
-    std::lock_guard lock(mutex_);
-    return find_locked(id)->status;
+    std::unique_lock lock(mutex_);
+    return find_locked(lock, id)->status;
 }
 
 std::vector<protocol::JobStatus> JobManager::list(std::optional<JobState> state,
                                                   size_t limit) const {
+    // Newest first. The statuses of jobs whose records are on disk only are read outside the lock
+    // (and not kept: a listing does not push the records clients are using out of memory).
+    std::vector<std::pair<std::string, std::optional<protocol::JobStatus>>> found;
+    {
+        std::lock_guard lock(mutex_);
+        for (auto it = arrival_order_.rbegin(); it != arrival_order_.rend() && found.size() < limit; ++it) {
+            if (const auto in_memory = jobs_.find(*it); in_memory != jobs_.end()) {
+                if (state && in_memory->second->status.state != *state) continue;
+                found.emplace_back(*it, in_memory->second->status);
+            } else if (const auto on_disk = on_disk_only_.find(*it); on_disk != on_disk_only_.end()) {
+                if (state && on_disk->second != *state) continue;
+                found.emplace_back(*it, std::nullopt);
+            }
+        }
+    }
     std::vector<protocol::JobStatus> result;
-    std::lock_guard lock(mutex_);
-    for (auto it = arrival_order_.rbegin(); it != arrival_order_.rend() && result.size() < limit;
-         ++it) {
-        const protocol::JobStatus& s = (*it)->status;
-        if (state && s.state != *state) continue;
-        result.push_back(s);
+    result.reserve(found.size());
+    for (auto& [id, status] : found) {
+        if (status) {
+            result.push_back(std::move(*status));
+        } else if (Expected<StoredJob> stored = store_.load(id)) {
+            result.push_back(std::move(stored->status));
+        } else {
+            protocol::JobStatus lost;
+            lost.id = id;
+            lost.state = JobState::Failed;
+            lost.error = "the job's record cannot be read back from the cache directory: " + stored.error().message;
+            result.push_back(std::move(lost));
+        }
         result.back().statistics.reset();
     }
     return result;
@@ -449,7 +547,7 @@ std::vector<protocol::JobStatus> JobManager::list(std::optional<JobState> state,
 
 protocol::JobStatus JobManager::cancel(const std::string& id, std::chrono::milliseconds wait) {
     std::unique_lock lock(mutex_);
-    const auto entry = find_locked(id);
+    const auto entry = find_locked(lock, id);
     switch (entry->status.state) {
         case JobState::Queued: {
             queue_.erase({{-entry->submission.job.priority, entry->submission.sequence}, id});
@@ -483,7 +581,7 @@ protocol::JobStatus JobManager::cancel(const std::string& id, std::chrono::milli
 protocol::JobStatus JobManager::wait_finished(const std::string& id,
                                               std::chrono::milliseconds timeout) const {
     std::unique_lock lock(mutex_);
-    const auto entry = find_locked(id);
+    const auto entry = find_locked(lock, id);
     entry->changed.wait_for(
         lock, timeout, [&] { return stopping_ || protocol::is_terminal(entry->status.state); });
     return entry->status;
@@ -492,7 +590,7 @@ protocol::JobStatus JobManager::wait_finished(const std::string& id,
 JobManager::EventBatch JobManager::wait_events(const std::string& id, uint64_t after_id,
                                                std::chrono::milliseconds timeout) const {
     std::unique_lock lock(mutex_);
-    const auto entry = find_locked(id);
+    const auto entry = find_locked(lock, id);
     const auto has_news = [&] {
         return stopping_ || entry->events.size() > after_id ||
                protocol::is_terminal(entry->status.state);
@@ -508,7 +606,7 @@ JobManager::EventBatch JobManager::wait_events(const std::string& id, uint64_t a
 JobManager::TileBatch JobManager::wait_tiles(const std::string& id, size_t from,
                                              std::chrono::milliseconds timeout) const {
     std::unique_lock lock(mutex_);
-    const auto entry = find_locked(id);
+    const auto entry = find_locked(lock, id);
     entry->changed.wait_for(lock, timeout, [&] {
         return stopping_ || entry->finished_order.size() > from ||
                protocol::is_terminal(entry->status.state);
@@ -523,8 +621,8 @@ JobManager::TileBatch JobManager::wait_tiles(const std::string& id, size_t from,
 
 std::optional<JobManager::TileGeometry> JobManager::tile_geometry(const std::string& id,
                                                                   TileIndex tile) const {
-    std::lock_guard lock(mutex_);
-    const auto entry = find_locked(id);
+    std::unique_lock lock(mutex_);
+    const auto entry = find_locked(lock, id);
     const auto rect = entry->rect_of(tile);
     if (!rect) return std::nullopt;
     return TileGeometry{*rect, entry->submission.job.image.width,
@@ -536,8 +634,8 @@ std::optional<std::vector<uint8_t>> JobManager::tile_exr(const std::string& id, 
     std::shared_ptr<const Image> pixels;
     bool done = false;
     {
-        std::lock_guard lock(mutex_);
-        entry = find_locked(id);
+        std::unique_lock lock(mutex_);
+        entry = find_locked(lock, id);
         if (!entry->rect_of(tile)) return std::nullopt;
         done = entry->status.state == JobState::Done;
         if (!done) {
@@ -628,8 +726,8 @@ fs::path JobManager::image_file(const std::string& id) {
     std::shared_ptr<Entry> entry;
     bool done = false;
     {
-        std::lock_guard lock(mutex_);
-        entry = find_locked(id);
+        std::unique_lock lock(mutex_);
+        entry = find_locked(lock, id);
         done = entry->status.state == JobState::Done;
     }
     // Checked against its checksum outside the lock (hashing a large file takes a while); a
@@ -658,8 +756,8 @@ std::vector<uint8_t> JobManager::preview_png(const std::string& id) {
     std::shared_ptr<Entry> entry;
     std::vector<std::pair<TileIndex, std::shared_ptr<const Image>>> tiles;
     {
-        std::lock_guard lock(mutex_);
-        entry = find_locked(id);
+        std::unique_lock lock(mutex_);
+        entry = find_locked(lock, id);
         const JobState state = entry->status.state;
         if (state == JobState::Queued || state == JobState::Failed || state == JobState::Cancelled)
             throw ServiceError(ErrorKind::Conflict, "job " + id + " is " +
@@ -703,6 +801,7 @@ void JobManager::fill_metrics(MetricsSnapshot& snapshot) const {
         snapshot.jobs_by_state[std::string(name)] = 0;
     for (const auto& [id, entry] : jobs_)
         ++snapshot.jobs_by_state[std::string(protocol::to_string(entry->status.state))];
+    for (const auto& [id, state] : on_disk_only_) ++snapshot.jobs_by_state[std::string(protocol::to_string(state))];
     snapshot.queue_depth = queue_.size();
 }
 
@@ -723,6 +822,9 @@ void JobManager::worker_loop() {
             entry->status.state = JobState::Running;
             entry->status.started_at_ms = now_ms();
             entry->pass_started = Clock::now();
+            // On disk before anyone hears of it: a daemon that dies from now on counts the death
+            // against this job (the poison-job limit), whatever a client saw.
+            keep_status_locked(*entry);
             push_event_locked(*entry, JobEventType::State, {{"state", "running"}});
             entry->changed.notify_all();
         }
@@ -730,7 +832,6 @@ void JobManager::worker_loop() {
         // the daemon through std::terminate).
         std::string thrown;
         try {
-            keep_status(status(entry->id()));
             log("job " + entry->id() + " started");
             run(entry);
         } catch (const std::exception& error) {
@@ -952,6 +1053,7 @@ void JobManager::announce_end_locked(Entry& e, protocol::JobStatus ended) {
                                                           : JobEventType::Cancelled;
     push_event_locked(e, last, protocol::to_json(e.status));
     e.changed.notify_all();
+    if (const auto it = jobs_.find(e.id()); it != jobs_.end()) remember_record_locked(it->second);
 }
 
 void JobManager::finish_locked(Entry& e, JobState state, std::string error,

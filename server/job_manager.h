@@ -11,8 +11,14 @@
 // last few jobs, else read back from <cache-dir>/jobs/<id>/image.exr); a cancelled or failed
 // job's pixels are freed.
 //
-// Restart: finished jobs (done, failed, cancelled) are loaded back from the cache directory with
-// their results. Jobs that were queued are queued again. A job that was running when the daemon
+// Records: a finished job's whole record (its status with statistics, its event history, its
+// description) stays in memory while it is among the finished_jobs_in_memory most recently used;
+// the others keep only their id and state in memory and are read back from the cache directory
+// when a client asks for them, so that the daemon's memory does not grow with the jobs it has
+// run. A job read back has its event history rebuilt from its state (as after a restart).
+//
+// Restart: finished jobs (done, failed, cancelled) are found in the cache directory with their
+// results (their records are read back when asked for). Jobs that were queued are queued again. A job that was running when the daemon
 // stopped, cleanly (SIGINT/SIGTERM: its render is cancelled) or not (a crash, kill -9, power
 // loss: status.json still says "running"), is queued again and resumes from the tiles it had
 // finished: each is kept on disk as it finishes (server/tile_journal.h), the photon maps come
@@ -61,6 +67,10 @@ struct JobManagerOptions {
     int threads = 0;                              // render threads; 0 = every core
     size_t max_queued = 64;                       // queued jobs beyond this are refused (429)
     size_t final_images_in_memory = 4;            // finished images kept decoded for tile requests
+    // Finished jobs whose whole record (status with statistics, event history, description)
+    // stays in memory, the most recently used; the others keep only their state and are read
+    // back from the cache directory when asked for. At least 1.
+    size_t finished_jobs_in_memory = 64;
     std::function<void(const std::string&)> log;  // one line per job event; may be empty
 };
 
@@ -149,18 +159,32 @@ private:
     struct Entry;
     using Clock = std::chrono::steady_clock;
 
-    std::shared_ptr<Entry> find_locked(const std::string& id) const;  // throws NotFound
+    /// The job `id`, its record read back from disk if it had left memory (the lock is released
+    /// while the files are read). Throws NotFound.
+    std::shared_ptr<Entry> find_locked(std::unique_lock<std::mutex>& lock, const std::string& id) const;
+    /// Marks a finished job's record the most recently used; the oldest beyond
+    /// finished_jobs_in_memory leave memory.
+    void remember_record_locked(const std::shared_ptr<Entry>& entry) const;
+    /// An entry for a job read from disk: its status as kept, no events yet.
+    std::shared_ptr<Entry> make_entry(StoredJob stored) const;
+    /// The event history of a job read from disk, rebuilt from its state.
+    void push_history_locked(Entry& entry) const;
     /// Checks the job's scene and its lighting (throws InvalidField naming the field).
     void check_scene(const protocol::Job& job) const;
     /// The pipeline's options for this daemon's jobs (no callbacks).
     PipelineOptions pipeline_options() const;
     int retry_after_seconds_locked() const;
-    void push_event_locked(Entry& entry, protocol::JobEventType type, nlohmann::json data);
+    void push_event_locked(Entry& entry, protocol::JobEventType type, nlohmann::json data) const;
     void worker_loop();
     void run(const std::shared_ptr<Entry>& entry);
     /// Writes a job's status; a refusal is logged, counted in /metrics and becomes a warning of
     /// the job. Call without holding mutex_.
     void keep_status(const protocol::JobStatus& status);
+    /// The same for a job whose status is written under mutex_ (a small file, no sync).
+    void keep_status_locked(Entry& entry);
+    /// Writes a status; a refusal is logged and counted, and the warning for the job returned.
+    std::optional<std::string> write_status(const protocol::JobStatus& status);
+    static void add_warning_locked(Entry& entry, const std::string& warning);
     /// Fails a job whose run threw, with the exception's message, whatever else throws.
     void fail_after_exception(const std::shared_ptr<Entry>& entry, const std::string& what);
     /// Ends a job: state, statistics, events, files, metrics. Takes the mutex itself.
@@ -179,7 +203,8 @@ private:
     /// The final image of a done job, from memory or from its EXR on disk.
     std::shared_ptr<const ImageLayers> final_image(const std::shared_ptr<Entry>& entry);
     void remember_image_locked(const std::shared_ptr<Entry>& entry);
-    void restore(StoredJob stored);
+    /// Takes a job found on disk at start; adds (sequence, id) to `arrivals`.
+    void restore(StoredJob stored, std::vector<std::pair<uint64_t, std::string>>& arrivals);
     /// The tiles a job keeps on disk while it runs (crash-resume).
     TileJournal kept_tiles(const Entry& entry) const;
     void log(const std::string& line) const;
@@ -193,14 +218,17 @@ private:
 
     mutable std::mutex mutex_;
     std::condition_variable work_available_;
-    std::unordered_map<std::string, std::shared_ptr<Entry>> jobs_;
-    std::vector<std::shared_ptr<Entry>> arrival_order_;  // oldest first
+    // Queued and running jobs, and the finished ones whose records are in memory.
+    mutable std::unordered_map<std::string, std::shared_ptr<Entry>> jobs_;
+    // The other finished jobs: their state, the rest is on disk.
+    mutable std::unordered_map<std::string, protocol::JobState> on_disk_only_;
+    mutable std::vector<std::string> records_in_memory_;  // ids of finished jobs in jobs_, oldest use first
+    std::vector<std::string> arrival_order_;              // every job's id, oldest first
     // Queued jobs by (-priority, sequence): begin() runs next.
     std::set<std::pair<std::pair<int, uint64_t>, std::string>> queue_;
     std::unordered_map<std::string, std::string> idempotency_keys_;  // key -> job id
     std::shared_ptr<Entry> running_;
-    std::vector<std::string>
-        images_in_memory_;  // ids of done jobs holding their image, oldest first
+    mutable std::vector<std::string> images_in_memory_;  // ids of done jobs holding their image, oldest first
     uint64_t next_sequence_ = 1;
     std::mutex submit_mutex_;  // serialises submissions (checks, disk write, insertion)
 

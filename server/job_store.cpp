@@ -72,53 +72,47 @@ Status JobStore::save_status(const protocol::JobStatus& status) {
                                  protocol::json_text(protocol::to_json(status, false), 2) + "\n");
 }
 
-JobStore::Loaded JobStore::load_all() const {
-    Loaded loaded;
-    std::error_code error;
-    for (fs::directory_iterator it(directory_, error), end; !error && it != end;
-         it.increment(error)) {
-        if (!it->is_directory()) continue;
-        const fs::path dir = it->path();
-        auto submission_json = read_json(dir / "job.json");
-        auto status_json = read_json(dir / "status.json");
-        if (!submission_json || !status_json) {
-            loaded.problems.push_back(!submission_json ? submission_json.error().message
-                                                       : status_json.error().message);
-            continue;
-        }
-        StoredJob stored;
-        try {
-            JobSubmission& s = stored.submission;
-            s.id = submission_json->at("id").get<std::string>();
-            auto job = protocol::parse_job(submission_json->at("job"));
-            if (!job) throw std::runtime_error("job: " + job.error().message);
-            s.job = std::move(job).value();
-            s.sequence = submission_json->at("sequence").get<uint64_t>();
-            s.created_at_ms =
-                protocol::parse_timestamp(submission_json->value("created_at", std::string()))
-                    .value_or(0);
-            s.idempotency_key = submission_json->value("idempotency_key", std::string());
-            s.request_digest = submission_json->value("request_digest", std::string());
-            if (s.id != dir.filename().string())
-                throw std::runtime_error("id does not match the directory");
-        } catch (const std::exception& e) {
-            loaded.problems.push_back((dir / "job.json").string() + ": " + e.what());
-            continue;
-        }
-        auto status = protocol::job_status_from_json(*status_json);
-        if (!status) {
-            loaded.problems.push_back((dir / "status.json").string() + ": " +
-                                      status.error().message);
-            continue;
-        }
-        stored.status = std::move(status).value();
-        stored.status.job = stored.submission.job;
-        loaded.jobs.push_back(std::move(stored));
+Expected<StoredJob> JobStore::load(const std::string& id) const {
+    const fs::path dir = job_directory(id);
+    auto submission_json = read_json(dir / "job.json");
+    if (!submission_json) return submission_json.error();
+    auto status_json = read_json(dir / "status.json");
+    if (!status_json) return status_json.error();
+    StoredJob stored;
+    try {
+        JobSubmission& s = stored.submission;
+        s.id = submission_json->at("id").get<std::string>();
+        auto job = protocol::parse_job(submission_json->at("job"));
+        if (!job) throw std::runtime_error("job: " + job.error().message);
+        s.job = std::move(job).value();
+        s.sequence = submission_json->at("sequence").get<uint64_t>();
+        s.created_at_ms =
+            protocol::parse_timestamp(submission_json->value("created_at", std::string())).value_or(0);
+        s.idempotency_key = submission_json->value("idempotency_key", std::string());
+        s.request_digest = submission_json->value("request_digest", std::string());
+        if (s.id != id) throw std::runtime_error("id does not match the directory");
+    } catch (const std::exception& e) {
+        return Error{(dir / "job.json").string() + ": " + e.what()};
     }
-    std::sort(loaded.jobs.begin(), loaded.jobs.end(), [](const StoredJob& a, const StoredJob& b) {
-        return a.submission.sequence < b.submission.sequence;
-    });
-    return loaded;
+    auto status = protocol::job_status_from_json(*status_json);
+    if (!status) return Error{(dir / "status.json").string() + ": " + status.error().message};
+    stored.status = std::move(status).value();
+    stored.status.job = stored.submission.job;
+    return stored;
+}
+
+std::vector<std::string> JobStore::load_each(const std::function<void(StoredJob)>& take) const {
+    std::vector<std::string> problems;
+    std::error_code error;
+    for (fs::directory_iterator it(directory_, error), end; !error && it != end; it.increment(error)) {
+        if (!it->is_directory()) continue;
+        auto stored = load(it->path().filename().string());
+        if (stored)
+            take(std::move(stored).value());
+        else
+            problems.push_back(stored.error().message);
+    }
+    return problems;
 }
 
 bool JobStore::writable() const {

@@ -15,6 +15,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -57,12 +58,12 @@ public:
     /// Where the tiles of a running job are kept (TileJournal).
     std::filesystem::path tiles_directory(const std::string& id) const;
 
-    struct Loaded {
-        std::vector<StoredJob> jobs;
-        std::vector<std::string> problems;  // directories that could not be read, and why
-    };
-    /// Every job on disk, in arrival order.
-    Loaded load_all() const;
+    /// One job as it was kept.
+    Expected<StoredJob> load(const std::string& id) const;
+    /// Hands every job on disk to `take`, one at a time and in no particular order (a daemon
+    /// that has run many jobs never holds all their records at once); returns the directories
+    /// that could not be read, and why.
+    std::vector<std::string> load_each(const std::function<void(StoredJob)>& take) const;
 
     /// True when a file can be created in the directory now (for /readyz).
     bool writable() const;

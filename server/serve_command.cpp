@@ -39,6 +39,10 @@ constexpr const char* kUsage =
     "  --photon-cache-mb N     memory for photon maps, least recently used dropped first\n"
     "                          (default 1024; the maps stay on disk)\n"
     "  --max-queued N          queued jobs beyond this are refused with 429 (default 64)\n"
+    "  --finished-jobs-in-memory N\n"
+    "                          finished jobs whose whole record stays in memory, the most\n"
+    "                          recently used (default 64); the others are read back from the\n"
+    "                          cache directory when asked for\n"
     "  --token-file FILE       clients must send 'Authorization: Bearer <the file's content>';\n"
     "                          required to listen on an address other than loopback\n"
     "  --scene-root DIR        the only directory {\"path\": ...} scenes may be read from\n"
@@ -63,6 +67,7 @@ struct Arguments {
     fs::path cache_dir;
     size_t photon_cache_mb = 1024;
     size_t max_queued = 64;
+    size_t finished_jobs_in_memory = 64;
     fs::path token_file;
     fs::path scene_root;
     size_t max_body_mb = 256;
@@ -131,6 +136,10 @@ Expected<Arguments> parse_arguments(std::span<const std::string> args) {
             auto n = parse_count<size_t>(arg, *v, 1, 1'000'000);
             if (!n) return n.error();
             a.max_queued = *n;
+        } else if (arg == "--finished-jobs-in-memory") {
+            auto n = parse_count<size_t>(arg, *v, 1, 1'000'000);
+            if (!n) return n.error();
+            a.finished_jobs_in_memory = *n;
         } else if (arg == "--token-file") {
             a.token_file = *v;
         } else if (arg == "--scene-root") {
@@ -290,6 +299,7 @@ int run_serve_command(std::span<const std::string> args) {
     job_options.scene_root = a.scene_root;
     job_options.threads = a.threads;
     job_options.max_queued = a.max_queued;
+    job_options.finished_jobs_in_memory = a.finished_jobs_in_memory;
     job_options.log = log_line;
     JobManager jobs(job_options, *device, &photon_maps, &scenes, &metrics);
 
