@@ -84,7 +84,8 @@ struct JobManager::Entry {
     std::atomic<bool> cancel{false};  // read by the renderer before each tile
 
     protocol::JobStatus status;
-    std::vector<protocol::JobEvent> events;
+    std::vector<protocol::JobEvent> events;  // ids first_event_id, first_event_id + 1, ...
+    uint64_t first_event_id = 1;  // above 1 for a history rebuilt shorter than it was
     std::map<TileIndex, std::shared_ptr<const Image>> tiles;  // finished, while rendering
     std::vector<TileIndex> finished_order;
     std::shared_ptr<const ImageLayers> image;  // a done job's final image, while in memory
@@ -147,35 +148,23 @@ JobManager::JobManager(JobManagerOptions options, std::shared_ptr<EmbreeDevice> 
 
 JobManager::~JobManager() { shutdown(); }
 
-std::optional<std::string> JobManager::write_status(const protocol::JobStatus& status) {
+void JobManager::keep_status(const protocol::JobStatus& status) {
     Status saved = Error{"an exception"};
     try {
         saved = store_.save_status(status);
-    } catch (const std::exception& e) {
+    } catch (const std::exception& e) {  // called outside the worker's catch too
         saved = Error{e.what()};
     }
-    if (saved) return std::nullopt;
+    if (saved) return;
     metrics_->record_store_failure();
     const std::string warning = "the job's state could not be written to the cache directory (" +
                                 saved.error().message + "): a restart may find it as it was before";
     log("job " + status.id + ": " + warning);
-    return warning;
-}
-
-void JobManager::add_warning_locked(Entry& entry, const std::string& warning) {
-    std::vector<std::string>& warnings = entry.status.warnings;
-    if (std::find(warnings.begin(), warnings.end(), warning) == warnings.end()) warnings.push_back(warning);
-}
-
-void JobManager::keep_status(const protocol::JobStatus& status) {
-    const std::optional<std::string> warning = write_status(status);
-    if (!warning) return;
     std::lock_guard lock(mutex_);
-    if (const auto it = jobs_.find(status.id); it != jobs_.end()) add_warning_locked(*it->second, *warning);
-}
-
-void JobManager::keep_status_locked(Entry& entry) {
-    if (const std::optional<std::string> warning = write_status(entry.status)) add_warning_locked(entry, *warning);
+    if (const auto it = jobs_.find(status.id); it != jobs_.end()) {
+        std::vector<std::string>& warnings = it->second->status.warnings;
+        if (std::find(warnings.begin(), warnings.end(), warning) == warnings.end()) warnings.push_back(warning);
+    }
 }
 
 std::optional<uint64_t> JobManager::cache_dir_free_bytes() const {
@@ -194,7 +183,7 @@ void JobManager::log(const std::string& line) const {
 }
 
 void JobManager::push_event_locked(Entry& entry, JobEventType type, json data) const {
-    entry.events.push_back({entry.events.size() + 1, type, std::move(data)});
+    entry.events.push_back({entry.first_event_id + entry.events.size(), type, std::move(data)});
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -210,10 +199,17 @@ std::shared_ptr<JobManager::Entry> JobManager::make_entry(StoredJob stored) cons
     return entry;
 }
 
-void JobManager::push_history_locked(Entry& e) const {
+void JobManager::push_history_locked(Entry& e, const std::optional<JobStore::StreamHistory>& kept) const {
     // The history of a job read back from disk is rebuilt from its state: a client resuming or
     // starting a stream sees the same shape of events as during the render (tiles, then the last
-    // event), though not the same event ids.
+    // event). Where the job's stream history was kept, the tiles come in the order they finished
+    // and the last event has the id it had, so that resumed streams go on where they were.
+    if (kept && kept->tiles.size() == e.status.progress.tiles_total && e.status.state == JobState::Done) {
+        for (const auto& [tx, ty] : kept->tiles) e.finished_order.push_back({tx, ty});
+    } else if (e.status.state == JobState::Done) {
+        for (int ty = 0; ty < e.tiles_y; ++ty)
+            for (int tx = 0; tx < e.tiles_x; ++tx) e.finished_order.push_back({tx, ty});
+    }
     switch (e.status.state) {
         case JobState::Queued:
         case JobState::Running:
@@ -221,11 +217,7 @@ void JobManager::push_history_locked(Entry& e) const {
             break;
         case JobState::Done:
             e.status.progress.tiles_done = e.status.progress.tiles_total;
-            for (int ty = 0; ty < e.tiles_y; ++ty)
-                for (int tx = 0; tx < e.tiles_x; ++tx) {
-                    e.finished_order.push_back({tx, ty});
-                    push_event_locked(e, JobEventType::Tile, e.tile_event({tx, ty}));
-                }
+            for (const TileIndex& t : e.finished_order) push_event_locked(e, JobEventType::Tile, e.tile_event(t));
             push_event_locked(e, JobEventType::Progress, e.progress_event());
             push_event_locked(e, JobEventType::State, {{"state", "done"}});
             push_event_locked(e, JobEventType::Done, protocol::to_json(e.status));
@@ -238,6 +230,10 @@ void JobManager::push_history_locked(Entry& e) const {
             push_event_locked(e, JobEventType::State, {{"state", "cancelled"}});
             push_event_locked(e, JobEventType::Cancelled, protocol::to_json(e.status));
             break;
+    }
+    if (kept && kept->events > e.events.size()) {
+        e.first_event_id = kept->events - e.events.size() + 1;
+        for (size_t i = 0; i < e.events.size(); ++i) e.events[i].id = e.first_event_id + i;
     }
 }
 
@@ -456,8 +452,9 @@ std::shared_ptr<JobManager::Entry> JobManager::find_locked(std::unique_lock<std:
                                                            const std::string& id) const {
     for (;;) {
         if (const auto it = jobs_.find(id); it != jobs_.end()) {
-            if (protocol::is_terminal(it->second->status.state)) remember_record_locked(it->second);
-            return it->second;
+            std::shared_ptr<Entry> found = it->second;  // held: never evicted while returned
+            if (protocol::is_terminal(found->status.state)) remember_record_locked(found);
+            return found;
         }
         if (!on_disk_only_.contains(id)) throw ServiceError(ErrorKind::NotFound, "no job '" + id + "'");
         // A finished job whose record left memory: read back outside the lock.
@@ -466,19 +463,15 @@ std::shared_ptr<JobManager::Entry> JobManager::find_locked(std::unique_lock<std:
         lock.lock();
         const auto kept = on_disk_only_.find(id);
         if (kept == on_disk_only_.end()) continue;  // another call read it back meanwhile
-        std::shared_ptr<Entry> entry;
-        if (stored) {
-            entry = make_entry(std::move(stored).value());
-        } else {
-            JobSubmission lost;
-            lost.id = id;
-            entry = std::make_shared<Entry>(std::move(lost));
-            entry->status.state = JobState::Failed;
-            entry->status.error = "the job's record cannot be read back from the cache directory: " +
-                                  stored.error().message;
-            log("job " + id + ": " + entry->status.error);
+        if (!stored) {
+            // Perhaps for a moment (no file handle free): the job stays as it is on disk.
+            const std::string problem = "job " + id + ": its record cannot be read back from the cache directory (" +
+                                        stored.error().message + ")";
+            log(problem);
+            throw ServiceError(ErrorKind::Unavailable, problem);
         }
-        push_history_locked(*entry);
+        std::shared_ptr<Entry> entry = make_entry(std::move(stored).value());
+        push_history_locked(*entry, store_.load_history(id));
         on_disk_only_.erase(kept);
         jobs_[id] = std::move(entry);
     }
@@ -488,8 +481,8 @@ void JobManager::remember_record_locked(const std::shared_ptr<Entry>& entry) con
     std::erase(records_in_memory_, entry->id());
     records_in_memory_.push_back(entry->id());
     // The oldest beyond the limit leave memory, except those a call is using now (it holds the
-    // entry): their records are on disk and read back when asked for again.
-    for (size_t i = 0; records_in_memory_.size() > options_.finished_jobs_in_memory && i < records_in_memory_.size();) {
+    // entry) and this one: their records are on disk and read back when asked for again.
+    for (size_t i = 0; records_in_memory_.size() > options_.finished_jobs_in_memory && i + 1 < records_in_memory_.size();) {
         const auto it = jobs_.find(records_in_memory_[i]);
         if (it != jobs_.end() && it->second.use_count() > 1) {
             ++i;
@@ -534,11 +527,9 @@ std::vector<protocol::JobStatus> JobManager::list(std::optional<JobState> state,
         } else if (Expected<StoredJob> stored = store_.load(id)) {
             result.push_back(std::move(stored->status));
         } else {
-            protocol::JobStatus lost;
-            lost.id = id;
-            lost.state = JobState::Failed;
-            lost.error = "the job's record cannot be read back from the cache directory: " + stored.error().message;
-            result.push_back(std::move(lost));
+            log("job " + id + " left out of a job list: its record cannot be read back from the cache directory (" +
+                stored.error().message + ")");
+            continue;
         }
         result.back().statistics.reset();
     }
@@ -549,17 +540,26 @@ protocol::JobStatus JobManager::cancel(const std::string& id, std::chrono::milli
     std::unique_lock lock(mutex_);
     const auto entry = find_locked(lock, id);
     switch (entry->status.state) {
-        case JobState::Queued: {
-            queue_.erase({{-entry->submission.job.priority, entry->submission.sequence}, id});
-            entry->cancelled_by_user = true;
-            entry->cancel = true;
-            finish_locked(*entry, JobState::Cancelled, "", nullptr);
-            const protocol::JobStatus status = entry->status;
-            lock.unlock();
-            keep_status(status);
-            log("job " + id + " cancelled while queued");
-            return status;
-        }
+        case JobState::Queued:
+            // Still waiting (not taken by the worker, not being cancelled): it ends here, on disk
+            // before it is announced, as every job's end.
+            if (entry != running_ && !entry->cancel) {
+                queue_.erase({{-entry->submission.job.priority, entry->submission.sequence}, id});
+                entry->cancelled_by_user = true;
+                entry->cancel = true;
+                const protocol::JobStatus ended = ended_status_locked(*entry, JobState::Cancelled, "", nullptr);
+                lock.unlock();
+                keep_status(ended);
+                kept_tiles(*entry).clear();  // a job resumed after a restart may have some
+                lock.lock();
+                announce_end_locked(*entry, ended);
+                const protocol::JobStatus status = entry->status;
+                lock.unlock();
+                keep_stream_history(entry);
+                log("job " + id + " cancelled while queued");
+                return status;
+            }
+            [[fallthrough]];
         case JobState::Running:
             entry->cancelled_by_user = true;
             entry->cancel = true;
@@ -592,13 +592,13 @@ JobManager::EventBatch JobManager::wait_events(const std::string& id, uint64_t a
     std::unique_lock lock(mutex_);
     const auto entry = find_locked(lock, id);
     const auto has_news = [&] {
-        return stopping_ || entry->events.size() > after_id ||
+        return stopping_ || entry->first_event_id + entry->events.size() > after_id + 1 ||
                protocol::is_terminal(entry->status.state);
     };
     entry->changed.wait_for(lock, timeout, has_news);
     EventBatch batch;
-    for (size_t i = after_id; i < entry->events.size(); ++i)
-        batch.events.push_back(entry->events[i]);
+    const size_t first = after_id >= entry->first_event_id ? static_cast<size_t>(after_id + 1 - entry->first_event_id) : 0;
+    for (size_t i = first; i < entry->events.size(); ++i) batch.events.push_back(entry->events[i]);
     batch.ended = stopping_ || protocol::is_terminal(entry->status.state);
     return batch;
 }
@@ -811,6 +811,7 @@ void JobManager::fill_metrics(MetricsSnapshot& snapshot) const {
 void JobManager::worker_loop() {
     for (;;) {
         std::shared_ptr<Entry> entry;
+        protocol::JobStatus starting;
         {
             std::unique_lock lock(mutex_);
             work_available_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
@@ -818,13 +819,19 @@ void JobManager::worker_loop() {
             const auto next = queue_.begin();
             entry = jobs_.at(next->second);
             queue_.erase(next);
-            running_ = entry;
+            running_ = entry;  // from now on a cancel() asks the render to stop
+            starting = entry->status;
+        }
+        // On disk before anyone hears of it: a daemon that dies from now on counts the death
+        // against this job (the poison-job limit), whatever a client saw.
+        starting.state = JobState::Running;
+        starting.started_at_ms = now_ms();
+        keep_status(starting);
+        {
+            std::lock_guard lock(mutex_);
             entry->status.state = JobState::Running;
-            entry->status.started_at_ms = now_ms();
+            entry->status.started_at_ms = starting.started_at_ms;
             entry->pass_started = Clock::now();
-            // On disk before anyone hears of it: a daemon that dies from now on counts the death
-            // against this job (the poison-job limit), whatever a client saw.
-            keep_status_locked(*entry);
             push_event_locked(*entry, JobEventType::State, {{"state", "running"}});
             entry->changed.notify_all();
         }
@@ -973,9 +980,7 @@ void JobManager::run(const std::shared_ptr<Entry>& entry) {
     // as soon as a client hears of it. (The PNG preview is made on its first request.)
     options.on_pass("writing");
     const protocol::Job& job = e.submission.job;
-    ExrWriteOptions exr;
-    exr.pixel_type = job.output.pixel_type == "float" ? ExrPixelType::Float : ExrPixelType::Half;
-    exr.tile_size = job.image.tile_size;
+    const ExrWriteOptions exr = exr_options(job);
     const Clock::time_point writing_started = Clock::now();
     if (Status written = write_exr(store_.image_path(e.id()), result->layers, exr); !written) {
         finish(entry, JobState::Failed, written.error().message, &result->statistics);
@@ -1056,6 +1061,17 @@ void JobManager::announce_end_locked(Entry& e, protocol::JobStatus ended) {
     if (const auto it = jobs_.find(e.id()); it != jobs_.end()) remember_record_locked(it->second);
 }
 
+void JobManager::keep_stream_history(const std::shared_ptr<Entry>& entry) {
+    JobStore::StreamHistory history;
+    {
+        std::lock_guard lock(mutex_);
+        history.events = entry->first_event_id - 1 + entry->events.size();
+        for (const TileIndex& t : entry->finished_order) history.tiles.emplace_back(t.tx, t.ty);
+    }
+    if (Status kept = store_.save_history(entry->id(), history); !kept)
+        log("job " + entry->id() + ": where its streams ended is not kept (" + kept.error().message + ")");
+}
+
 void JobManager::finish_locked(Entry& e, JobState state, std::string error,
                                const RenderStatistics* statistics) {
     announce_end_locked(e, ended_status_locked(e, state, std::move(error), statistics));
@@ -1083,6 +1099,7 @@ void JobManager::finish(const std::shared_ptr<Entry>& entry, JobState state, std
         announce_end_locked(*entry, status);
         status = entry->status;
     }
+    keep_stream_history(entry);
     std::string line = "job " + status.id + " " + std::string(protocol::to_string(state));
     if (statistics) {
         char seconds[32];

@@ -167,8 +167,9 @@ private:
     void remember_record_locked(const std::shared_ptr<Entry>& entry) const;
     /// An entry for a job read from disk: its status as kept, no events yet.
     std::shared_ptr<Entry> make_entry(StoredJob stored) const;
-    /// The event history of a job read from disk, rebuilt from its state.
-    void push_history_locked(Entry& entry) const;
+    /// The event history of a job read from disk, rebuilt from its state and, where it was kept,
+    /// where its streams ended.
+    void push_history_locked(Entry& entry, const std::optional<JobStore::StreamHistory>& kept) const;
     /// Checks the job's scene and its lighting (throws InvalidField naming the field).
     void check_scene(const protocol::Job& job) const;
     /// The pipeline's options for this daemon's jobs (no callbacks).
@@ -180,11 +181,6 @@ private:
     /// Writes a job's status; a refusal is logged, counted in /metrics and becomes a warning of
     /// the job. Call without holding mutex_.
     void keep_status(const protocol::JobStatus& status);
-    /// The same for a job whose status is written under mutex_ (a small file, no sync).
-    void keep_status_locked(Entry& entry);
-    /// Writes a status; a refusal is logged and counted, and the warning for the job returned.
-    std::optional<std::string> write_status(const protocol::JobStatus& status);
-    static void add_warning_locked(Entry& entry, const std::string& warning);
     /// Fails a job whose run threw, with the exception's message, whatever else throws.
     void fail_after_exception(const std::shared_ptr<Entry>& entry, const std::string& what);
     /// Ends a job: state, statistics, events, files, metrics. Takes the mutex itself.
@@ -192,6 +188,9 @@ private:
                 const RenderStatistics* statistics);
     void finish_locked(Entry& entry, protocol::JobState state, std::string error,
                        const RenderStatistics* statistics);
+    /// Writes where an ended job's event and tile streams ended (JobStore::StreamHistory), after
+    /// its end was announced: a daemon dying before the write rebuilds a history of its own.
+    void keep_stream_history(const std::shared_ptr<Entry>& entry);
     /// The status a job ends with (its entry unchanged).
     protocol::JobStatus ended_status_locked(const Entry& entry, protocol::JobState state, std::string error,
                                             const RenderStatistics* statistics) const;

@@ -72,6 +72,31 @@ Status JobStore::save_status(const protocol::JobStatus& status) {
                                  protocol::json_text(protocol::to_json(status, false), 2) + "\n");
 }
 
+Status JobStore::save_history(const std::string& id, const StreamHistory& history) {
+    json tiles = json::array();
+    for (const auto& [tx, ty] : history.tiles) {
+        tiles.push_back(tx);
+        tiles.push_back(ty);
+    }
+    const json document = {{"events", history.events}, {"tiles", std::move(tiles)}};
+    return write_file_atomically(job_directory(id) / "history.json", protocol::json_text(document) + "\n");
+}
+
+std::optional<JobStore::StreamHistory> JobStore::load_history(const std::string& id) const {
+    auto document = read_json(job_directory(id) / "history.json");
+    if (!document) return std::nullopt;
+    try {
+        StreamHistory history;
+        history.events = document->at("events").get<uint64_t>();
+        const json& tiles = document->at("tiles");
+        if (tiles.size() % 2 != 0) return std::nullopt;
+        for (size_t i = 0; i < tiles.size(); i += 2) history.tiles.emplace_back(tiles[i].get<int>(), tiles[i + 1].get<int>());
+        return history;
+    } catch (const std::exception&) {
+        return std::nullopt;
+    }
+}
+
 Expected<StoredJob> JobStore::load(const std::string& id) const {
     const fs::path dir = job_directory(id);
     auto submission_json = read_json(dir / "job.json");

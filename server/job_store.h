@@ -2,6 +2,7 @@
 //   <cache-dir>/jobs/<id>/job.json     the description with every default filled, and how it
 //                                      was submitted (sequence, Idempotency-Key, digest)
 //   <cache-dir>/jobs/<id>/status.json  the last status document (protocol::to_json)
+//   <cache-dir>/jobs/<id>/history.json where a finished job's event and tile streams ended
 //   <cache-dir>/jobs/<id>/image.exr    the final image (tiled OpenEXR, as `photond render`)
 //   <cache-dir>/jobs/<id>/preview.png  its sRGB preview, made on the first request
 //   <cache-dir>/jobs/<id>/tiles/       the finished tiles of a job while it runs, so that it
@@ -16,6 +17,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -57,6 +59,16 @@ public:
     std::filesystem::path image_checksum_path(const std::string& id) const;
     /// Where the tiles of a running job are kept (TileJournal).
     std::filesystem::path tiles_directory(const std::string& id) const;
+
+    /// Where a finished job's event and tile streams ended: how many events it had and the
+    /// order its tiles finished in, so that streams resumed after its record was read back go
+    /// on from where they were (history.json).
+    struct StreamHistory {
+        uint64_t events = 0;
+        std::vector<std::pair<int, int>> tiles;  // (tx, ty) in finishing order
+    };
+    Status save_history(const std::string& id, const StreamHistory& history);
+    std::optional<StreamHistory> load_history(const std::string& id) const;
 
     /// One job as it was kept.
     Expected<StoredJob> load(const std::string& id) const;
