@@ -4,9 +4,11 @@
 #include <cstdio>
 #include <string>
 
+#include "core/image/exr_assemble.h"
 #include "core/image/exr_io.h"
 #include "core/image/image_metrics.h"
 #include "core/image/png_preview.h"
+#include "server/atomic_file.h"
 
 namespace photond::service {
 
@@ -160,6 +162,44 @@ int run_average_command(std::span<const std::string> args) {
     options.pixel_type = half ? ExrPixelType::Half : ExrPixelType::Float;
     if (Status st = write_exr(output, layers, options); !st) {
         std::fprintf(stderr, "photond average: %s\n", st.error().message.c_str());
+        return 1;
+    }
+    return 0;
+}
+
+int run_assemble_command(std::span<const std::string> args) {
+    constexpr const char* kUsage =
+        "usage: photond assemble -o FRAME.exr PART.exr [PART.exr ...]\n"
+        "joins the EXRs of regions of one frame (renders with image.region) into the frame's EXR,\n"
+        "byte for byte the EXR of the whole frame rendered at once; parts that overlap, leave\n"
+        "pixels uncovered or belong to other frames are refused by name\n";
+    std::string output;
+    std::vector<std::filesystem::path> parts;
+    for (size_t i = 0; i < args.size(); ++i) {
+        if ((args[i] == "-o" || args[i] == "--output") && i + 1 < args.size()) {
+            output = args[++i];
+        } else if (args[i] == "-h" || args[i] == "--help") {
+            std::fputs(kUsage, stdout);
+            return 0;
+        } else if (!args[i].empty() && args[i][0] == '-') {
+            std::fprintf(stderr, "photond assemble: unknown option '%s'\n%s", args[i].c_str(), kUsage);
+            return 2;
+        } else {
+            parts.emplace_back(args[i]);
+        }
+    }
+    if (output.empty() || parts.empty()) {
+        std::fputs(kUsage, stderr);
+        return 2;
+    }
+    auto assembled = assemble_exr_parts(parts);
+    if (!assembled) {
+        std::fprintf(stderr, "photond assemble: %s\n", assembled.error().message.c_str());
+        return 1;
+    }
+    const std::string_view bytes(reinterpret_cast<const char*>(assembled->bytes.data()), assembled->bytes.size());
+    if (Status written = write_file_atomically(output, bytes); !written) {
+        std::fprintf(stderr, "photond assemble: %s\n", written.error().message.c_str());
         return 1;
     }
     return 0;

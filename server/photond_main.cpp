@@ -16,6 +16,7 @@ constexpr const char* kUsage =
     "  serve     run the render daemon: HTTP API v1 (photond serve --help)\n"
     "  compare   error of an EXR against a reference EXR (relMSE, RMSE, p99, bias)\n"
     "  average   mean of several EXRs (independent renders), for converged references\n"
+    "  assemble  join the EXRs of a frame's regions into the frame's EXR\n"
     "  version   print the version\n";
 
 }  // namespace
@@ -32,6 +33,7 @@ int main(int argc, char** argv) {
     if (command == "serve") return photond::service::run_serve_command(rest);
     if (command == "compare") return photond::service::run_compare_command(rest);
     if (command == "average") return photond::service::run_average_command(rest);
+    if (command == "assemble") return photond::service::run_assemble_command(rest);
     if (command == "version" || command == "--version") {
         std::puts("photond 0.1.0");
         return 0;

@@ -300,9 +300,7 @@ int run_render_command(std::span<const std::string> args) {
         for (const std::filesystem::path& file : written) std::filesystem::remove(file, ignored);
         return 1;
     };
-    ExrWriteOptions exr;
-    exr.pixel_type = job->output.pixel_type == "float" ? ExrPixelType::Float : ExrPixelType::Half;
-    exr.tile_size = job->image.tile_size;
+    const ExrWriteOptions exr = exr_options(*job);
     if (Status st = write_exr(a.output, result->layers, exr); !st) return fail(st.error().message);
     written.push_back(a.output);
     if (png) {

@@ -184,10 +184,8 @@ Expected<std::unique_ptr<Integrator>> make_integrator(const protocol::Job& job,
         settings.cache.seed = job.seed;
         settings.cache.threads = options.threads;
         settings.cache.cancel = options.callbacks.cancel;
-        if (job.image.region) {
-            const auto& r = *job.image.region;
-            settings.cache.region = PixelRect{r[0], r[1], r[2], r[3]};
-        }
+        // A region render builds the whole frame's irradiance cache: its pixels are then those of
+        // the frame rendered at once, and regions rendered apart assemble without seams.
         return std::unique_ptr<Integrator>(new PhotonMapIntegrator(scene, *maps, settings));
     }
     return Error{"integrator: unknown integrator '" + job.integrator + "'"};
@@ -527,6 +525,17 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     stats.total_seconds = seconds_since(start);
     result.layers.beauty = std::move(rendered.image);
     return result;
+}
+
+ExrWriteOptions exr_options(const protocol::Job& job) {
+    ExrWriteOptions exr;
+    exr.pixel_type = job.output.pixel_type == "float" ? ExrPixelType::Float : ExrPixelType::Half;
+    exr.tile_size = job.image.tile_size;
+    if (job.image.region) {
+        const auto& r = *job.image.region;
+        exr.data_window = PixelRect{r[0], r[1], r[2], r[3]}.intersect({0, 0, job.image.width, job.image.height});
+    }
+    return exr;
 }
 
 Expected<std::vector<uint8_t>> encode_job_preview(const protocol::Job& job, const Image& image) {

@@ -13,6 +13,7 @@
 
 #include "core/accel/ray_tracer.h"
 #include "core/photon/photon_tracer.h"
+#include "core/image/exr_io.h"
 #include "core/image/image.h"
 #include "core/render/render_plan.h"
 #include "core/render/statistics.h"
@@ -89,6 +90,10 @@ Expected<CameraDesc> resolve_camera(const protocol::Job& job, const Scene& scene
 /// Renders a validated job.
 Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<EmbreeDevice> device,
                                  const PipelineOptions& options);
+
+/// How a job's EXR is written: its pixel type and tile size, and a region render's region as
+/// the data window (so that `photond assemble` can join the regions of a frame).
+ExrWriteOptions exr_options(const protocol::Job& job);
 
 /// The PNG preview of a job's image (encode_render_preview with the job's output.exposure_ev):
 /// every preview, `photond render --preview` and the daemon's preview.png (finished, or the

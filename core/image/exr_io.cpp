@@ -11,6 +11,7 @@
 #include <ImfLineOrder.h>
 #include <ImfOutputFile.h>
 #include <ImfTileDescription.h>
+#include <ImfTiledInputFile.h>
 #include <ImfTiledOutputFile.h>
 #include <half.h>
 
@@ -144,16 +145,22 @@ public:
         }
     }
 
-    Imf::FrameBuffer frame_buffer(const Imath::Box2i& data_window, int width) const {
+    /// The slices for writing `data_window` (frame pixels) from layers that hold the pixels of
+    /// `held` (frame pixels, rows of `width`).
+    Imf::FrameBuffer frame_buffer(const PixelRect& held, const Imath::Box2i& data_window, int width) const {
         const size_t component_size = type_ == Imf::HALF ? sizeof(Imath::half) : sizeof(float);
         const size_t pixel_size = 3 * component_size;
+        const size_t row_size = pixel_size * size_t(width);
+        // Slice::Make takes the address of the data window's first pixel.
+        const size_t offset = size_t(data_window.min.y - held.y0) * row_size +
+                              size_t(data_window.min.x - held.x0) * pixel_size;
         Imf::FrameBuffer frame_buffer;
         for (const Layer& layer : layers_) {
             for (size_t c = 0; c < 3; ++c) {
                 frame_buffer.insert(
                     layer.prefix + kComponentNames[c],
-                    Imf::Slice::Make(type_, layer.first + c * component_size, data_window,
-                                     pixel_size, pixel_size * size_t(width)));
+                    Imf::Slice::Make(type_, layer.first + offset + c * component_size, data_window,
+                                     pixel_size, row_size));
             }
         }
         return frame_buffer;
@@ -332,11 +339,18 @@ Expected<std::vector<uint8_t>> encode_exr(const ImageLayers& layers,
         return exr_error(kSource, "tile_size " + std::to_string(options.tile_size) +
                                       " is outside 1.." + std::to_string(kMaxTileSize));
     }
+    const int width = layers.beauty.width();
+    const int height = layers.beauty.height();
+    const PixelRect frame{0, 0, width, height};
+    const PixelRect window = options.data_window.value_or(frame);
+    if (window.empty() || !frame.contains(window))
+        return exr_error(kSource, "data window [" + std::to_string(window.x0) + "," + std::to_string(window.x1) +
+                                      ")x[" + std::to_string(window.y0) + "," + std::to_string(window.y1) +
+                                      ") is empty or outside the " + std::to_string(width) + "x" +
+                                      std::to_string(height) + " frame");
     try {
-        const int width = layers.beauty.width();
-        const int height = layers.beauty.height();
         OutputPixels pixels(layers, options.pixel_type);
-        Imf::Header header(width, height);
+        Imf::Header header(to_box(frame), to_box(window));
         header.compression() = Imf::ZIP_COMPRESSION;
         // Increasing-y keeps the tile order in the file independent of thread scheduling.
         header.lineOrder() = Imf::INCREASING_Y;
@@ -346,7 +360,7 @@ Expected<std::vector<uint8_t>> encode_exr(const ImageLayers& layers,
         VectorOStream stream;
         {
             Imf::TiledOutputFile file(stream, header);
-            file.setFrameBuffer(pixels.frame_buffer(header.dataWindow(), width));
+            file.setFrameBuffer(pixels.frame_buffer(frame, header.dataWindow(), width));
             file.writeTiles(0, file.numXTiles() - 1, 0, file.numYTiles() - 1);
         }  // the destructor writes the tile offset table
         return stream.take();
@@ -411,7 +425,7 @@ Expected<std::vector<uint8_t>> encode_tile_exr(const ImageLayers& tile, PixelRec
         VectorOStream stream;
         {
             Imf::OutputFile file(stream, header);
-            file.setFrameBuffer(pixels.frame_buffer(data_window, rect.width()));
+            file.setFrameBuffer(pixels.frame_buffer(rect, data_window, rect.width()));
             file.writePixels(rect.height());
         }  // the destructor writes the line offset table
         return stream.take();
@@ -462,6 +476,48 @@ Expected<DecodedExrTile> decode_tile_exr(std::span<const uint8_t> bytes) {
     decoded.frame_width = display.max.x + 1;
     decoded.frame_height = display.max.y + 1;
     return decoded;
+}
+
+Expected<ExrLayout> read_exr_layout(std::span<const uint8_t> bytes, std::string_view source) {
+    try {
+        SpanIStream stream(bytes);
+        Imf::InputFile file(stream);
+        const Imf::Header& header = file.header();
+        const auto rect_of = [](const Imath::Box2i& box) {
+            return PixelRect{box.min.x, box.min.y, box.max.x + 1, box.max.y + 1};
+        };
+        if (auto problem = check_box(header.dataWindow(), "data window")) return exr_error(source, *problem);
+        if (auto problem = check_box(header.displayWindow(), "display window")) return exr_error(source, *problem);
+        ExrLayout layout;
+        layout.data_window = rect_of(header.dataWindow());
+        layout.display_window = rect_of(header.displayWindow());
+        std::optional<Imf::PixelType> type;
+        bool mixed = false;
+        for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+            layout.channels.push_back(it.name());
+            if (type && *type != it.channel().type) mixed = true;
+            type = it.channel().type;
+        }
+        if (!mixed && type == Imf::HALF) layout.pixel_type = ExrPixelType::Half;
+        if (!mixed && type == Imf::FLOAT) layout.pixel_type = ExrPixelType::Float;
+        if (header.hasTileDescription()) {
+            const Imf::TileDescription& tiles = header.tileDescription();
+            if (tiles.mode == Imf::ONE_LEVEL && tiles.xSize == tiles.ySize && tiles.xSize <= unsigned(kMaxTileSize))
+                layout.tile_size = int(tiles.xSize);
+        }
+        switch (header.compression()) {
+            case Imf::NO_COMPRESSION: layout.compression = "none"; break;
+            case Imf::ZIP_COMPRESSION: layout.compression = "zip"; break;
+            case Imf::ZIPS_COMPRESSION: layout.compression = "zips"; break;
+            case Imf::PIZ_COMPRESSION: layout.compression = "piz"; break;
+            default: layout.compression = "compression " + std::to_string(int(header.compression())); break;
+        }
+        return layout;
+    } catch (const std::exception& e) {
+        return exr_error(source, e.what());
+    } catch (...) {
+        return exr_error(source, "unknown error while reading the header");
+    }
 }
 
 }  // namespace photond

@@ -9,7 +9,10 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <span>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/image/image.h"
@@ -25,6 +28,9 @@ struct ExrWriteOptions {
     ExrPixelType pixel_type = ExrPixelType::Half;
     /// Edge of the square EXR tiles, in pixels (1..4096).
     int tile_size = 32;
+    /// Only this part of the frame is written (the file's data window; its display window is the
+    /// whole frame): a region render. Must be non-empty and inside the frame.
+    std::optional<PixelRect> data_window;
 };
 
 /// Writes a tiled, ZIP-compressed EXR: first to `path` + ".tmp", then renamed onto `path`, so
@@ -65,5 +71,19 @@ struct DecodedExrTile {
 /// Decodes a tile EXR; an error when the data window leaves the display window or when the
 /// display window does not start at (0, 0).
 Expected<DecodedExrTile> decode_tile_exr(std::span<const uint8_t> bytes);
+
+/// How an EXR is stored, from its header.
+struct ExrLayout {
+    PixelRect data_window;
+    PixelRect display_window;
+    std::vector<std::string> channels;  // sorted, as EXR keeps them
+    /// Every channel's type; nullopt when they differ or one is neither half nor float.
+    std::optional<ExrPixelType> pixel_type;
+    std::optional<int> tile_size;  // square single-level tiles; nullopt for scanline files
+    std::string compression;       // "zip" (what photond writes), "none", "zips", "piz", ...
+};
+
+/// Reads an EXR's header; errors name `source`.
+Expected<ExrLayout> read_exr_layout(std::span<const uint8_t> bytes, std::string_view source);
 
 }  // namespace photond
