@@ -74,12 +74,13 @@ FUZZ_BUILD ?= $(BUILD)-fuzz
 FUZZ_SECONDS ?= 600
 FUZZ_TIMEOUT ?= 25
 FUZZ_RSS_MB ?= 2048
-FUZZ_TARGETS ?= job gltf photon_map scene_bundle http_request
+FUZZ_TARGETS ?= job gltf photon_map render_cache scene_bundle http_request
 FUZZ_CMAKE_ARGS ?=
 # Per target: the longest input and the dictionary (fuzz/dict; http_request takes both).
 FUZZ_MAX_LEN_job := 4096
 FUZZ_MAX_LEN_gltf := 65536
 FUZZ_MAX_LEN_photon_map := 16384
+FUZZ_MAX_LEN_render_cache := 16384
 FUZZ_MAX_LEN_scene_bundle := 65536
 FUZZ_MAX_LEN_http_request := 16384
 FUZZ_DICTS_job := json
@@ -101,7 +102,7 @@ fuzz: $(addprefix fuzz-run-,$(FUZZ_TARGETS))
 
 # One target's run (not .PHONY: make skips pattern rules for phony targets; no such file exists).
 fuzz-run-%: fuzz-build
-	$(if $(FUZZ_MAX_LEN_$*),,$(error unknown fuzz target '$*' (FUZZ_TARGETS: job gltf photon_map scene_bundle http_request)))
+	$(if $(FUZZ_MAX_LEN_$*),,$(error unknown fuzz target '$*' (FUZZ_TARGETS: job gltf photon_map render_cache scene_bundle http_request)))
 	@run=$(FUZZ_BUILD)/runs/$*; rm -rf $$run; mkdir -p $$run/corpus; \
 		cp fuzz/corpus/$*/* $$run/corpus/; \
 		dict=""; \

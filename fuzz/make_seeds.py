@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Candidate seed inputs for the fuzz targets (README.md, "Fuzzing"), written to OUT/<target>/.
 
-    python3 fuzz/make_seeds.py OUT [--photon-maps DIR]
+    python3 fuzz/make_seeds.py OUT [--photon-maps DIR] [--render-caches DIR]
 
 From tests/data/gltf (the loader's test files), tests/data/gltf-samples (Khronos sample models,
 each with its LICENSE.md) and hand-written inputs:
@@ -13,6 +13,8 @@ each with its LICENSE.md) and hand-written inputs:
   http_request  raw requests for every route, with the fuzzer's token
   photon_map    with --photon-maps: the .pm files a daemon wrote (photon-maps/ of its cache
                 directory), as "checksum appended" inputs (first byte 1) and as they are (0)
+  render_cache  with --render-caches: the irradiance-cache files in DIR (any name; those that start
+                with the "IRRCACHE" magic), as the photon maps
 
 The committed corpus (fuzz/corpus) is what libFuzzer's -merge=1 kept of these: see README.md.
 """
@@ -276,10 +278,22 @@ def photon_map_seeds(out: pathlib.Path, directory: pathlib.Path) -> None:
     write(out, "magic-appended.bin", b"\x01PHOTONMP\x02\0\0\0\x04\x03\x02\x01\x18\0\0\0")
 
 
+def render_cache_seeds(out: pathlib.Path, directory: pathlib.Path) -> None:
+    for source in sorted(p for p in directory.iterdir() if p.is_file()):
+        data = source.read_bytes()
+        if not data.startswith(b"IRRCACHE") or len(data) >= 16 * 1024:  # FUZZ_MAX_LEN_render_cache
+            continue
+        write(out, source.stem[:24] + "-appended.bin", b"\x01" + data[:-32])
+        write(out, source.stem[:24] + "-whole.bin", b"\x00" + data)
+    write(out, "empty-appended.bin", b"\x01")
+    write(out, "magic-appended.bin", b"\x01IRRCACHE\x01\0\0\0\x04\x03\x02\x01\x70\0\0\0")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("out", type=pathlib.Path)
     parser.add_argument("--photon-maps", type=pathlib.Path)
+    parser.add_argument("--render-caches", type=pathlib.Path)
     args = parser.parse_args()
     sample_seeds(args.out / "gltf")
     test_file_seeds(args.out / "gltf")
@@ -288,6 +302,8 @@ def main() -> None:
     http_seeds(args.out / "http_request", jobs)
     if args.photon_maps:
         photon_map_seeds(args.out / "photon_map", args.photon_maps)
+    if args.render_caches:
+        render_cache_seeds(args.out / "render_cache", args.render_caches)
 
 
 if __name__ == "__main__":

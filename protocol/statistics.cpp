@@ -59,6 +59,8 @@ nlohmann::json to_json(const RenderStatistics& s) {
             {"interpolated_share", c.interpolated_share()},
             {"seconds", c.seconds},
         };
+        if (!c.cache.empty()) result["irradiance_cache"]["cache"] = c.cache;
+        if (!c.key.empty()) result["irradiance_cache"]["key"] = c.key;
     }
     return result;
 }

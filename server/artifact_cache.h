@@ -28,8 +28,8 @@
 // and the table of builds in flight; building, file reads and writes run outside it. Concurrent
 // get_or_build calls for one key build once: the first caller builds, the others wait for it and
 // then take its artifact (a failed build is not cached: the next waiter tries itself). Across
-// processes nothing is locked: two may both build a missing key, and the second rename wins with
-// identical content.
+// processes the same holds through a lock file per key (<key>.lock, server/file_lock.h): a
+// process that finds the key being built elsewhere waits, then reads the file.
 #pragma once
 
 #include <condition_variable>
@@ -50,6 +50,7 @@
 
 #include "core/util/expected.h"
 #include "server/atomic_file.h"
+#include "server/file_lock.h"
 
 namespace photond::service {
 
@@ -98,6 +99,12 @@ public:
             }
         } release{*this, key};
 
+        // Other processes sharing the directory: one builds, the others wait here and then read
+        // its file.
+        const FileLock other_processes(directory_ / (key + ".lock"));
+        if (!other_processes.held())
+            log(std::string(Traits::kName) + " cache: cannot lock " + key + ".lock in " + directory_.string() +
+                "; another process sharing the directory may build this key too");
         if (auto found = read_disk(key)) {
             std::lock_guard lock(mutex_);
             insert_locked(key, *found);

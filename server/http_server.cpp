@@ -23,6 +23,7 @@
 #include "server/metrics.h"
 #include "server/openapi.h"
 #include "server/photon_map_cache.h"
+#include "server/render_cache_directory.h"
 #include "server/scene_store.h"
 #include "server/service_error.h"
 
@@ -231,6 +232,13 @@ struct HttpServer::Impl {
     void list_photon_maps(const Request& req, Response& res);
     void export_photon_maps(const Request& req, Response& res);
     void import_photon_maps(const Request& req, Response& res);
+    void list_render_caches(const Request& req, Response& res);
+    void export_render_cache(const Request& req, Response& res);
+    void import_render_cache(const Request& req, Response& res);
+    RenderCacheDirectory& render_caches() const {
+        if (!services.render_caches) throw ServiceError(ErrorKind::NotFound, "this daemon keeps no render caches");
+        return *services.render_caches;
+    }
     void healthz(const Request& req, Response& res);
     void readyz(const Request& req, Response& res);
     void metrics(const Request& req, Response& res);
@@ -264,6 +272,9 @@ void HttpServer::Impl::register_routes() {
     route("GET", "/v1/photon-maps", bind_handler(&Impl::list_photon_maps));
     route("GET", "/v1/photon-maps/([^/]+)", bind_handler(&Impl::export_photon_maps));
     route("PUT", "/v1/photon-maps/([^/]+)", bind_handler(&Impl::import_photon_maps));
+    route("GET", "/v1/render-caches", bind_handler(&Impl::list_render_caches));
+    route("GET", "/v1/render-caches/([^/]+)", bind_handler(&Impl::export_render_cache));
+    route("PUT", "/v1/render-caches/([^/]+)", bind_handler(&Impl::import_render_cache));
     route("GET", "/healthz", bind_handler(&Impl::healthz), /*open=*/true);
     route("GET", "/readyz", bind_handler(&Impl::readyz), /*open=*/true);
     route("GET", "/metrics", bind_handler(&Impl::metrics));
@@ -646,34 +657,62 @@ void HttpServer::Impl::delete_scene(const Request& req, Response& res) {
     res.status = 204;
 }
 
-void HttpServer::Impl::list_photon_maps(const Request&, Response& res) {
-    send_json(res, {{"keys", services.photon_maps.keys()}});
+namespace {
+
+// The routes of a cache of artifacts (photon maps, render caches): list, export, import.
+
+template <class Traits>
+void list_artifacts(const ArtifactCache<Traits>& cache, Response& res) {
+    send_json(res, {{"keys", cache.keys()}});
 }
 
-void HttpServer::Impl::export_photon_maps(const Request& req, Response& res) {
-    const std::string key = req.matches[1];
-    auto bytes = services.photon_maps.export_maps(key);
+template <class Traits>
+void export_artifact(ArtifactCache<Traits>& cache, const std::string& key, Response& res) {
+    auto bytes = cache.export_bytes(key);
     if (!bytes)
-        throw ServiceError(ErrorKind::NotFound,
-                           PhotonMapCache::is_valid_key(key)
-                               ? "no photon maps for key " + key + " here"
-                               : "'" + key + "' is not a photon-map key (pm1-<64 hex digits>)");
-    res.set_header("Content-Disposition", "attachment; filename=\"" + key + ".pm\"");
+        throw ServiceError(ErrorKind::NotFound, Traits::is_valid_key(key)
+                                                    ? "no " + std::string(Traits::kName) + " for key " + key + " here"
+                                                    : "'" + key + "' is not a " + Traits::kName + " key (" +
+                                                          Traits::kKeyForm + ")");
+    res.set_header("Content-Disposition", "attachment; filename=\"" + key + Traits::kExtension + "\"");
     send_bytes(res, std::move(*bytes), "application/octet-stream");
 }
 
-void HttpServer::Impl::import_photon_maps(const Request& req, Response& res) {
-    const std::string key = req.matches[1];
-    if (!PhotonMapCache::is_valid_key(key))
+template <class Traits>
+void import_artifact(ArtifactCache<Traits>& cache, const std::string& key, const std::string& body, Response& res) {
+    if (!Traits::is_valid_key(key))
         throw ServiceError(ErrorKind::NotFound,
-                           "'" + key + "' is not a photon-map key (pm1-<64 hex digits>)");
-    const std::span<const uint8_t> bytes(reinterpret_cast<const uint8_t*>(req.body.data()),
-                                         req.body.size());
+                           "'" + key + "' is not a " + Traits::kName + " key (" + Traits::kKeyForm + ")");
+    const std::span<const uint8_t> bytes(reinterpret_cast<const uint8_t*>(body.data()), body.size());
     bool conflict = false;
-    auto imported = services.photon_maps.import_maps(key, bytes, &conflict);
+    auto imported = cache.import_bytes(key, bytes, &conflict);
     if (!imported)
         throw ServiceError(conflict ? ErrorKind::Conflict : ErrorKind::InvalidField, imported.error().message);
     send_json(res, {{"key", key}, {"created", *imported}}, *imported ? 201 : 200);
+}
+
+}  // namespace
+
+void HttpServer::Impl::list_photon_maps(const Request&, Response& res) { list_artifacts(services.photon_maps, res); }
+
+void HttpServer::Impl::export_photon_maps(const Request& req, Response& res) {
+    export_artifact(services.photon_maps, req.matches[1], res);
+}
+
+void HttpServer::Impl::import_photon_maps(const Request& req, Response& res) {
+    import_artifact(services.photon_maps, req.matches[1], req.body, res);
+}
+
+void HttpServer::Impl::list_render_caches(const Request&, Response& res) {
+    list_artifacts(render_caches(), res);
+}
+
+void HttpServer::Impl::export_render_cache(const Request& req, Response& res) {
+    export_artifact(render_caches(), req.matches[1], res);
+}
+
+void HttpServer::Impl::import_render_cache(const Request& req, Response& res) {
+    import_artifact(render_caches(), req.matches[1], req.body, res);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -708,6 +747,13 @@ void HttpServer::Impl::metrics(const Request&, Response& res) {
     snapshot.photon_cache_misses = cache.misses;
     snapshot.photon_cache_bytes = cache.memory_bytes;
     snapshot.photon_cache_entries = cache.memory_entries;
+    if (services.render_caches) {
+        const auto render = services.render_caches->counters();
+        snapshot.render_cache_hits = render.hits;
+        snapshot.render_cache_misses = render.misses;
+        snapshot.render_cache_bytes = render.memory_bytes;
+        snapshot.render_cache_entries = render.memory_entries;
+    }
     res.set_content(services.metrics.render(snapshot), "text/plain; version=0.0.4; charset=utf-8");
 }
 

@@ -27,6 +27,7 @@ namespace photond::service {
 class JobManager;
 class SceneStore;
 class PhotonMapCache;
+class RenderCacheDirectory;
 class Metrics;
 
 struct HttpServerOptions {
@@ -46,6 +47,7 @@ struct HttpServices {
     SceneStore& scenes;
     PhotonMapCache& photon_maps;
     Metrics& metrics;
+    RenderCacheDirectory* render_caches = nullptr;  // null: /v1/render-caches answers 404
 };
 
 class HttpServer {

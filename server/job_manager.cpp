@@ -322,6 +322,7 @@ PipelineOptions JobManager::pipeline_options() const {
     options.threads = options_.threads;
     options.scene_root = options_.scene_root;
     options.photon_maps = photon_maps_;
+    options.render_caches = options_.render_caches;
     options.scene_lookup = [this](const std::string& id) { return scenes_->lookup(id); };
     options.bundle_lookup = [this](const std::string& id) { return scenes_->bundle_root(id); };
     return options;

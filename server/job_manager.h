@@ -71,6 +71,7 @@ struct JobManagerOptions {
     // stays in memory, the most recently used; the others keep only their state and are read
     // back from the cache directory when asked for. At least 1.
     size_t finished_jobs_in_memory = 64;
+    RenderCacheStore* render_caches = nullptr;    // irradiance caches by key; null: built per job
     std::function<void(const std::string&)> log;  // one line per job event; may be empty
 };
 

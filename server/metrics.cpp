@@ -61,6 +61,15 @@ std::string Metrics::render(const MetricsSnapshot& s) const {
     sample(out, "photond_photon_cache_bytes", s.photon_cache_bytes);
     header(out, "photond_photon_cache_entries", "gauge", "Photon-map sets held in memory.");
     sample(out, "photond_photon_cache_entries", s.photon_cache_entries);
+    header(out, "photond_render_cache_hits_total", "counter",
+           "Jobs whose irradiance cache came from the render-cache store (memory or disk).");
+    sample(out, "photond_render_cache_hits_total", s.render_cache_hits);
+    header(out, "photond_render_cache_misses_total", "counter", "Irradiance caches built by a prepass.");
+    sample(out, "photond_render_cache_misses_total", s.render_cache_misses);
+    header(out, "photond_render_cache_bytes", "gauge", "Bytes of irradiance caches held in memory.");
+    sample(out, "photond_render_cache_bytes", s.render_cache_bytes);
+    header(out, "photond_render_cache_entries", "gauge", "Irradiance caches held in memory.");
+    sample(out, "photond_render_cache_entries", s.render_cache_entries);
     header(out, "photond_http_responses_total", "counter", "HTTP responses by status class.");
     for (size_t i = 1; i < responses_.size(); ++i)
         sample(out, "photond_http_responses_total{code=\"" + std::to_string(i) + "xx\"}",

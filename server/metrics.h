@@ -21,6 +21,10 @@ struct MetricsSnapshot {
     uint64_t photon_cache_misses = 0;
     uint64_t photon_cache_bytes = 0;
     uint64_t photon_cache_entries = 0;
+    uint64_t render_cache_hits = 0;
+    uint64_t render_cache_misses = 0;
+    uint64_t render_cache_bytes = 0;
+    uint64_t render_cache_entries = 0;
 };
 
 class Metrics {

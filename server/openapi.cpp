@@ -253,36 +253,45 @@ json openapi_document() {
         {"delete", operation("deleteScene", "Remove an uploaded scene",
                              {{"204", response("removed")}, {"404", problem("unknown scene")}},
                              json::array({scene_id}))}};
-    paths["/v1/photon-maps"] = {
-        {"get",
-         operation(
-             "listPhotonMaps", "Keys of the photon maps cached here",
-             {{"200", response("the keys", content("application/json",
-                                                   {{"type", "object"},
-                                                    {"properties",
-                                                     {{"keys",
-                                                       {{"type", "array"},
-                                                        {"items", {{"type", "string"}}}}}}}}))}})}};
-    const json key = path_parameter("key", "pm1-<64 hex digits> (photons.key in a job's status)");
-    paths["/v1/photon-maps/{key}"] = {
-        {"get", operation("exportPhotonMaps",
-                          "Export built photon maps (the photond photon-map file format)",
-                          {{"200", binary_response("the maps", "application/octet-stream")},
-                           {"404", problem("unknown key")}},
-                          json::array({key}))},
-        {"put", operation("importPhotonMaps",
-                          "Import photon maps exported by another node (checked against the key)",
-                          {{"201", response("imported")},
-                           {"200", response("already cached; the bytes were checked")},
-                           {"404", problem("not a photon-map key")},
-                           {"413", problem("request body too large")},
-                           {"422", problem("corrupt, truncated, or for another key")}},
-                          json::array({key}))}};
-    paths["/v1/photon-maps/{key}"]["put"]["requestBody"] = {
-        {"required", true},
-        {"content",
-         {{"application/octet-stream",
-           {{"schema", {{"type", "string"}, {"contentMediaType", "application/octet-stream"}}}}}}}};
+    // The routes of a cache of artifacts: list, export, import.
+    const auto artifact_paths = [&](const std::string& base, const std::string& name, const std::string& plural,
+                                    const std::string& operation_suffix, const std::string& list_suffix,
+                                    const std::string& key_form) {
+        paths[base] = {
+            {"get",
+             operation(
+                 "list" + list_suffix, "Keys of the " + plural + " cached here",
+                 {{"200", response("the keys", content("application/json",
+                                                       {{"type", "object"},
+                                                        {"properties",
+                                                         {{"keys",
+                                                           {{"type", "array"},
+                                                            {"items", {{"type", "string"}}}}}}}}))}})}};
+        const json key = path_parameter("key", key_form);
+        paths[base + "/{key}"] = {
+            {"get", operation("export" + operation_suffix, "Export " + plural + " (the photond " + name + " file format)",
+                              {{"200", binary_response("the file", "application/octet-stream")},
+                               {"404", problem("unknown key")}},
+                              json::array({key}))},
+            {"put", operation("import" + operation_suffix,
+                              "Import " + plural + " exported by another node (checked against the key)",
+                              {{"201", response("imported")},
+                               {"200", response("already cached; the bytes were checked")},
+                               {"404", problem("not a " + name + " key")},
+                               {"409", problem("a different valid " + name + " is kept under the key")},
+                               {"413", problem("request body too large")},
+                               {"422", problem("corrupt, truncated, or for another key")}},
+                              json::array({key}))}};
+        paths[base + "/{key}"]["put"]["requestBody"] = {
+            {"required", true},
+            {"content",
+             {{"application/octet-stream",
+               {{"schema", {{"type", "string"}, {"contentMediaType", "application/octet-stream"}}}}}}}};
+    };
+    artifact_paths("/v1/photon-maps", "photon-map", "photon maps", "PhotonMaps", "PhotonMaps",
+                   "pm1-<64 hex digits> (photons.key in a job's status)");
+    artifact_paths("/v1/render-caches", "render-cache", "irradiance caches", "RenderCache", "RenderCaches",
+                   "rc1-<64 hex digits> (statistics.irradiance_cache.key in a job's status)");
     paths["/v1/jobs"]["post"]["requestBody"] = {
         {"required", true}, {"content", {{"application/json", {{"schema", ref("Job")}}}}}};
     paths["/healthz"] = {

@@ -485,16 +485,37 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     if (!integrator) return integrator.error();
     stats.plan.insert(stats.plan.begin(), environment_decision);
 
-    if (auto* photon_map = dynamic_cast<PhotonMapIntegrator*>(integrator->get())) {
+    if (auto* photon_map = dynamic_cast<PhotonMapIntegrator*>(integrator->get());
+        photon_map && photon_map->uses_irradiance_cache()) {
         if (options.on_pass) options.on_pass("irradiance_cache");
+        pass_start = Clock::now();
         CacheBuildStatistics cache_stats;
-        photon_map->prepare(*camera, &cache_stats);
+        RenderStatistics::IrradianceCacheFigures figures;
+        if (options.render_caches && !stats.photon_map_key.empty()) {
+            // Built once per key: other views' jobs, other regions of the frame and other nodes
+            // sharing the cache directory take it instead of running the prepass.
+            figures.key = photon_map->render_cache_key(stats.photon_map_key, *camera_desc, job.image.width,
+                                                       job.image.height);
+            const auto build = [&]() -> Expected<std::shared_ptr<const IrradianceCache>> {
+                photon_map->prepare(*camera, &cache_stats);
+                if (options.callbacks.cancel && options.callbacks.cancel->load())
+                    return Error{"cancelled during the irradiance-cache prepass"};  // incomplete: not kept
+                return photon_map->shared_cache();
+            };
+            bool hit = false;
+            auto cache = options.render_caches->get_or_build(figures.key, build, &hit);
+            if (cache) photon_map->use_cache(*cache);
+            else if (!(options.callbacks.cancel && options.callbacks.cancel->load())) return cache.error();
+            figures.cache = hit ? "hit" : "miss";
+        } else {
+            photon_map->prepare(*camera, &cache_stats);
+        }
         if (photon_map->cache()) {
-            stats.irradiance_cache = RenderStatistics::IrradianceCacheFigures{};
-            stats.irradiance_cache->records = cache_stats.records;
-            stats.irradiance_cache->waves = cache_stats.waves;
-            stats.irradiance_cache->seconds = cache_stats.seconds;
-            stats.passes.push_back({"irradiance_cache", cache_stats.seconds});
+            figures.records = photon_map->cache()->size();
+            figures.waves = cache_stats.waves;
+            figures.seconds = seconds_since(pass_start);
+            stats.irradiance_cache = figures;
+            stats.passes.push_back({"irradiance_cache", figures.seconds});
             stats.rays += cache_stats.counters.rays;
             stats.shadow_rays += cache_stats.counters.shadow_rays;
         }

@@ -15,6 +15,7 @@
 #include "core/photon/photon_tracer.h"
 #include "core/image/exr_io.h"
 #include "core/image/image.h"
+#include "core/integrators/irradiance_cache.h"
 #include "core/render/render_plan.h"
 #include "core/render/statistics.h"
 #include "core/render/tile_renderer.h"
@@ -34,6 +35,16 @@ public:
         const std::string& key, const std::function<Expected<PhotonMaps>()>& build, bool* cache_hit) = 0;
 };
 
+/// Where irradiance caches (render caches) are kept between jobs, by render-cache key
+/// (PhotonMapIntegrator::render_cache_key): as PhotonMapStore.
+class RenderCacheStore {
+public:
+    virtual ~RenderCacheStore() = default;
+    virtual Expected<std::shared_ptr<const IrradianceCache>> get_or_build(
+        const std::string& key, const std::function<Expected<std::shared_ptr<const IrradianceCache>>()>& build,
+        bool* cache_hit) = 0;
+};
+
 /// Resolves {"id": "sha256:..."} scenes (uploaded to the daemon).
 using SceneLookup = std::function<Expected<std::shared_ptr<const Scene>>(const std::string& id)>;
 
@@ -48,6 +59,7 @@ struct PipelineOptions {
     std::filesystem::path scene_root;   // {"path": ...} scenes are read below this directory only
     RenderCallbacks callbacks;          // per-tile progress and cancellation
     PhotonMapStore* photon_maps = nullptr;  // null: photon maps are built for this job only
+    RenderCacheStore* render_caches = nullptr;  // null: irradiance caches are built for this job only
     SceneLookup scene_lookup;               // null: {"id": ...} scenes are refused
     SceneBundleLookup bundle_lookup;        // null: uploaded scenes have no files for the job
     PassCallback on_pass;

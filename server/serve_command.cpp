@@ -21,6 +21,8 @@
 #include "server/job_manager.h"
 #include "server/metrics.h"
 #include "server/photon_map_cache.h"
+#include "server/render_cache_directory.h"
+#include "server/render_cache_directory.h"
 #include "server/scene_store.h"
 
 namespace photond::service {
@@ -34,10 +36,12 @@ constexpr const char* kUsage =
     "                          port); the first line on stdout is \"listening on "
     "http://HOST:PORT\"\n"
     "  --threads N             render threads (default: every core)\n"
-    "  --cache-dir DIR         photon maps, uploaded scenes and job results\n"
+    "  --cache-dir DIR         photon maps, render caches, uploaded scenes and job results\n"
     "                          (default: $XDG_CACHE_HOME/photond or ~/.cache/photond)\n"
     "  --photon-cache-mb N     memory for photon maps, least recently used dropped first\n"
     "                          (default 1024; the maps stay on disk)\n"
+    "  --render-cache-mb N     memory for irradiance caches (render caches) by view, least\n"
+    "                          recently used dropped first (default 256; they stay on disk)\n"
     "  --max-queued N          queued jobs beyond this are refused with 429 (default 64)\n"
     "  --finished-jobs-in-memory N\n"
     "                          finished jobs whose whole record stays in memory, the most\n"
@@ -66,6 +70,7 @@ struct Arguments {
     int threads = 0;
     fs::path cache_dir;
     size_t photon_cache_mb = 1024;
+    size_t render_cache_mb = 256;
     size_t max_queued = 64;
     size_t finished_jobs_in_memory = 64;
     fs::path token_file;
@@ -128,6 +133,10 @@ Expected<Arguments> parse_arguments(std::span<const std::string> args) {
             a.threads = *n;
         } else if (arg == "--cache-dir") {
             a.cache_dir = *v;
+        } else if (arg == "--render-cache-mb") {
+            auto n = parse_count<size_t>(arg, *v, 0, size_t{1} << 24);
+            if (!n) return n.error();
+            a.render_cache_mb = *n;
         } else if (arg == "--photon-cache-mb") {
             auto n = parse_count<size_t>(arg, *v, 0, size_t{1} << 24);
             if (!n) return n.error();
@@ -293,6 +302,7 @@ int run_serve_command(std::span<const std::string> args) {
     }
     Metrics metrics;
     PhotonMapCache photon_maps(a.cache_dir / "photon-maps", a.photon_cache_mb << 20, log_line);
+    RenderCacheDirectory render_caches(a.cache_dir / "render-caches", a.render_cache_mb << 20, log_line);
     SceneStore scenes(a.cache_dir / "scenes", a.bundle_limits);
     JobManagerOptions job_options;
     job_options.cache_dir = a.cache_dir;
@@ -300,6 +310,7 @@ int run_serve_command(std::span<const std::string> args) {
     job_options.threads = a.threads;
     job_options.max_queued = a.max_queued;
     job_options.finished_jobs_in_memory = a.finished_jobs_in_memory;
+    job_options.render_caches = &render_caches;
     job_options.log = log_line;
     JobManager jobs(job_options, *device, &photon_maps, &scenes, &metrics);
 
@@ -312,7 +323,7 @@ int run_serve_command(std::span<const std::string> args) {
     http_options.http_threads = a.http_threads;
     http_options.access_log = a.access_log;
     http_options.log = log_line;
-    HttpServer server(http_options, {jobs, scenes, photon_maps, metrics});
+    HttpServer server(http_options, {jobs, scenes, photon_maps, metrics, &render_caches});
     auto port = server.bind();
     if (!port) {
         std::fprintf(stderr, "photond serve: %s\n", port.error().message.c_str());

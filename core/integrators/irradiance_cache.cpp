@@ -1,7 +1,9 @@
 #include "core/integrators/irradiance_cache.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <limits>
+#include <string>
 
 namespace photond {
 namespace {
@@ -10,6 +12,41 @@ namespace {
 constexpr float kFrontTolerance = 0.01f;
 /// Smallest eps used in the weight, so that a record exactly at P has a finite weight.
 constexpr float kMinEpsilon = 1e-4f;
+
+/// The centre of a node's child in `octant` (x, y, z bits: the upper half on that axis).
+Vec3 octant_center(const Vec3& center, float half_size, int octant) {
+    const float h = 0.5f * half_size;
+    return center + Vec3(octant & 1 ? h : -h, octant & 2 ? h : -h, octant & 4 ? h : -h);
+}
+
+bool finite(float x) { return std::isfinite(x); }
+
+std::string describe(float x) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "%g", double(x));
+    return text;
+}
+
+std::string describe(const Vec3& v) {
+    char text[96];
+    std::snprintf(text, sizeof(text), "(%g, %g, %g)", double(v.x), double(v.y), double(v.z));
+    return text;
+}
+
+/// Empty when the record can be interpolated from; otherwise what is wrong with it.
+std::string record_problem(const IrradianceRecord& r) {
+    if (!is_finite(r.position)) return "position " + describe(r.position) + " is not finite";
+    if (!is_finite(r.normal)) return "normal " + describe(r.normal) + " is not finite";
+    if (!finite(r.radius) || !(r.radius > 0.0f)) return "radius " + describe(r.radius) + " is not finite and positive";
+    if (!is_finite(r.irradiance)) return "irradiance " + describe(r.irradiance) + " is not finite";
+    for (const Vec3& g : r.rotation_gradient) {
+        if (!is_finite(g)) return "rotation gradient " + describe(g) + " is not finite";
+    }
+    for (const Vec3& g : r.translation_gradient) {
+        if (!is_finite(g)) return "translation gradient " + describe(g) + " is not finite";
+    }
+    return {};
+}
 
 }  // namespace
 
@@ -20,6 +57,92 @@ IrradianceCache::IrradianceCache(const Bounds3& scene_bounds, const IrradianceCa
     Node root{center, half, {}, {}};
     root.children.fill(-1);
     nodes_.push_back(std::move(root));
+}
+
+IrradianceCache::IrradianceCache(State state)
+    : settings_(state.settings), records_(std::move(state.records)), nodes_(std::move(state.nodes)) {}
+
+Expected<std::unique_ptr<IrradianceCache>> IrradianceCache::from_state(State state) {
+    const float a = state.settings.accuracy;
+    if (!(a > 0.0f && a <= 1.0f)) return Error{"irradiance cache accuracy " + describe(a) + " is not in (0, 1]"};
+    for (size_t i = 0; i < state.records.size(); ++i) {
+        if (std::string problem = record_problem(state.records[i]); !problem.empty()) {
+            return Error{"irradiance record " + std::to_string(i) + ": " + problem};
+        }
+    }
+    if (state.records.size() > size_t(std::numeric_limits<uint32_t>::max())) {
+        return Error{"irradiance cache of " + std::to_string(state.records.size()) + " records (at most 2^32 - 1)"};
+    }
+    const std::vector<Node>& nodes = state.nodes;
+    if (nodes.empty()) return Error{"irradiance cache octree has no root node"};
+    if (nodes.size() > size_t(std::numeric_limits<int32_t>::max())) {
+        return Error{"irradiance cache octree of " + std::to_string(nodes.size()) + " nodes (at most 2^31 - 1)"};
+    }
+    const Node& root = nodes[0];
+    if (!is_finite(root.center) || !finite(root.half_size) || !(root.half_size > 0.0f)) {
+        return Error{"octree root: centre " + describe(root.center) + ", half size " + describe(root.half_size) +
+                     " (must be finite, the half size positive)"};
+    }
+    // Parents come before their children (insert appends a child after its parent), so one pass
+    // in index order sees every node's parent first: a node without one is unreachable, a node
+    // with two makes a lookup visit it twice (and a chain of them, exponentially often).
+    std::vector<int32_t> parent(nodes.size(), -1);
+    std::vector<uint8_t> depth(nodes.size(), 0);
+    std::vector<uint8_t> filed(state.records.size(), 0);
+    for (size_t i = 0; i < nodes.size(); ++i) {
+        const Node& node = nodes[i];
+        // Messages are built only on failure: a large cache has many nodes.
+        const auto name = [&] { return "octree node " + std::to_string(i); };
+        if (i > 0 && parent[i] < 0) return Error{name() + " is no other node's child"};
+        for (int octant = 0; octant < 8; ++octant) {
+            const int32_t child = node.children[size_t(octant)];
+            if (child == -1) continue;
+            const auto slot = [&] {
+                return name() + " child " + std::to_string(octant) + " is node " + std::to_string(child);
+            };
+            if (child < 0 || size_t(child) >= nodes.size()) {
+                return Error{slot() + " (the octree has " + std::to_string(nodes.size()) + " nodes)"};
+            }
+            if (size_t(child) <= i) return Error{slot() + ", not a later node (a cycle or a shared node)"};
+            if (parent[size_t(child)] >= 0) {
+                return Error{slot() + ", already the child of node " + std::to_string(parent[size_t(child)])};
+            }
+            if (depth[i] >= kMaxDepth) return Error{slot() + ", deeper than " + std::to_string(kMaxDepth) + " levels"};
+            // The exact cube child_for makes, so that lookups descend exactly as they did.
+            const Node& c = nodes[size_t(child)];
+            const Vec3 center = octant_center(node.center, node.half_size, octant);
+            const float half = 0.5f * node.half_size;
+            if (c.center != center || c.half_size != half || !is_finite(center) || !(half > 0.0f)) {
+                return Error{slot() + ", the cube at " + describe(c.center) + " with half size " +
+                             describe(c.half_size) + ", not its parent's octant at " + describe(center) +
+                             " with half size " + describe(half)};
+            }
+            parent[size_t(child)] = int32_t(i);
+            depth[size_t(child)] = uint8_t(depth[i] + 1);
+        }
+        for (size_t k = 0; k < node.records.size(); ++k) {
+            const uint32_t r = node.records[k];
+            if (r >= state.records.size()) {
+                return Error{name() + " files record " + std::to_string(r) + " (the cache has " +
+                             std::to_string(state.records.size()) + " records)"};
+            }
+            if (k > 0 && r <= node.records[k - 1]) {
+                return Error{name() + " files record " + std::to_string(r) + " after record " +
+                             std::to_string(node.records[k - 1]) + " (must be ascending)"};
+            }
+            filed[r] = 1;
+        }
+    }
+    if (const auto lost = std::find(filed.begin(), filed.end(), 0); lost != filed.end()) {
+        return Error{"irradiance record " + std::to_string(lost - filed.begin()) + " is in no octree node"};
+    }
+    return std::unique_ptr<IrradianceCache>(new IrradianceCache(std::move(state)));
+}
+
+size_t IrradianceCache::memory_bytes() const {
+    size_t bytes = sizeof(*this) + records_.capacity() * sizeof(IrradianceRecord) + nodes_.capacity() * sizeof(Node);
+    for (const Node& node : nodes_) bytes += node.records.capacity() * sizeof(uint32_t);
+    return bytes;
 }
 
 template <typename F>
@@ -110,9 +233,7 @@ int32_t IrradianceCache::child_for(int32_t node_index, const Vec3& p) {
     const int octant = (p.x > node.center.x ? 1 : 0) | (p.y > node.center.y ? 2 : 0) | (p.z > node.center.z ? 4 : 0);
     int32_t child = node.children[static_cast<size_t>(octant)];
     if (child < 0) {
-        const float h = 0.5f * node.half_size;
-        const Vec3 c = node.center + Vec3(octant & 1 ? h : -h, octant & 2 ? h : -h, octant & 4 ? h : -h);
-        Node n{c, h, {}, {}};
+        Node n{octant_center(node.center, node.half_size, octant), 0.5f * node.half_size, {}, {}};
         n.children.fill(-1);
         child = static_cast<int32_t>(nodes_.size());
         nodes_.push_back(std::move(n));

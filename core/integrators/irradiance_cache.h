@@ -14,19 +14,22 @@
 // radius (a R_i <= h < 2 a R_i), in every node of that level its domain overlaps (at most 8), so a
 // lookup tests only the records of the nodes on P's root-to-leaf path.
 //
-// Thread safety: the cache has two phases that never overlap. Reading (interpolate, covers) is
-// const and may run on any number of threads at once with no lock. Writing (insert) is done by
-// one thread while nobody reads. IrradianceCacheBuilder alternates them in waves, merging each
-// wave's new records in a fixed order, which is why the cache, and the image, are the same for
-// any thread count and tile order.
+// Thread safety: the cache has two phases that never overlap. Reading (interpolate and the other
+// const methods: records, nodes, state, memory_bytes) may run on any number of threads at once
+// with no lock. Writing (insert) is done by one thread while nobody reads. IrradianceCacheBuilder
+// alternates them in waves, merging each wave's new records in a fixed order, which is why the
+// cache, and the image, are the same for any thread count and tile order. A cache restored by
+// from_state is only read.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "core/math/vec.h"
 #include "core/scene/scene.h"
+#include "core/util/expected.h"
 
 namespace photond {
 
@@ -46,7 +49,31 @@ struct IrradianceCacheSettings {
 
 class IrradianceCache {
 public:
+    /// An octree node: a cube (centre, half size), its children by octant (x, y, z bits; -1 when
+    /// absent) and the indices of the records filed in it, ascending.
+    struct Node {
+        Vec3 center{0.0f};
+        float half_size = 0.0f;
+        std::array<int32_t, 8> children{-1, -1, -1, -1, -1, -1, -1, -1};
+        std::vector<uint32_t> records;
+    };
+    /// The exact internal state, so that a cache can be stored and restored with bit-identical
+    /// interpolation (re-inserting the records would clamp their radii again and file them anew).
+    struct State {
+        IrradianceCacheSettings settings;
+        std::vector<IrradianceRecord> records;
+        std::vector<Node> nodes;  // nodes[0] is the root
+    };
+
     IrradianceCache(const Bounds3& scene_bounds, const IrradianceCacheSettings& settings);
+
+    /// A cache from a state taken by state(), or read from a file: nothing in it is trusted. The
+    /// state is refused (with a message naming the node or record) unless the accuracy is in
+    /// (0, 1], every record is finite with a positive radius, the nodes form one tree below node
+    /// 0 (every other node the child of exactly one earlier node, at most kMaxDepth levels deep)
+    /// whose children are the exact octants of their parents, and the nodes' record indices are
+    /// ascending, in range, and file every record at least once.
+    static Expected<std::unique_ptr<IrradianceCache>> from_state(State state);
 
     /// Interpolated irradiance at p (normal n, unit); false when no record is usable there.
     /// `accuracy_scale` > 1 widens every record's domain (extrapolation, for points the
@@ -59,15 +86,19 @@ public:
 
     size_t size() const { return records_.size(); }
     const std::vector<IrradianceRecord>& records() const { return records_; }
+    const std::vector<Node>& nodes() const { return nodes_; }
     const IrradianceCacheSettings& settings() const { return settings_; }
+    /// A copy of the whole state (for from_state).
+    State state() const { return State{settings_, records_, nodes_}; }
+    /// Approximate bytes held (records, nodes and their record lists), for a memory budget.
+    size_t memory_bytes() const;
+
+    /// The deepest octree level (the root is level 0).
+    static constexpr int kMaxDepth = 48;
 
 private:
-    struct Node {
-        Vec3 center;
-        float half_size;
-        std::array<int32_t, 8> children;
-        std::vector<uint32_t> records;
-    };
+    explicit IrradianceCache(State state);
+
     /// Calls f(record index) for the records of every node whose records, with their validity
     /// radius scaled by domain_scale, can reach within `reach` of p (a record may come twice).
     template <typename F>
@@ -79,7 +110,6 @@ private:
     template <typename F>
     void for_each_on_path(const Vec3& p, F&& f) const;
 
-    static constexpr int kMaxDepth = 48;
     int32_t child_for(int32_t node, const Vec3& p);
 
     IrradianceCacheSettings settings_;

@@ -1,6 +1,7 @@
 #include "core/integrators/photon_mapping.h"
 
 #include "core/integrators/direct.h"
+#include "core/util/sha256.h"
 
 namespace photond {
 namespace {
@@ -42,6 +43,47 @@ void PhotonMapIntegrator::prepare(const Camera& camera, CacheBuildStatistics* st
     CacheBuildSettings build = settings_.cache;
     build.max_specular_depth = settings_.max_specular_depth;
     cache_ = build_irradiance_cache(*scene_, *gatherer_, camera, build, statistics);
+}
+
+std::string PhotonMapIntegrator::render_cache_key(const std::string& photon_map_key, const CameraDesc& camera,
+                                                  int width, int height) const {
+    Sha256 hasher;
+    const auto hash_float = [&](float value) { hasher.update_value(value == 0.0f ? 0.0f : value); };
+    const auto hash_vec3 = [&](const Vec3& v) {
+        hash_float(v.x);
+        hash_float(v.y);
+        hash_float(v.z);
+    };
+    hasher.update_string("photond render-cache key");
+    hasher.update_value(kRenderCacheAlgorithmVersion);
+    hasher.update_string(photon_map_key);
+    // The view: what the camera's rays are (the name and whether a glTF node placed it are not).
+    hash_vec3(camera.position);
+    hash_vec3(camera.look_at);
+    hash_vec3(camera.up);
+    hash_float(camera.vfov_deg);
+    hash_float(camera.aspect);
+    hasher.update_value(static_cast<int32_t>(camera.projection));
+    hash_float(camera.ortho_half_height);
+    hasher.update_value(int32_t(width));
+    hasher.update_value(int32_t(height));
+    // What the prepass does at each record (CacheBuildSettings, GatherSettings); threads, cancel
+    // and region do not change the cache.
+    const CacheBuildSettings& cache = settings_.cache;
+    hash_float(cache.cache.accuracy);
+    hasher.update_value(uint8_t(cache.cache.gradients));
+    hash_float(cache.min_spacing_px);
+    hash_float(cache.max_spacing_px);
+    hasher.update_value(uint64_t(cache.seed));
+    hasher.update_value(int32_t(settings_.max_specular_depth));
+    const GatherSettings& gather = gatherer_ ? gatherer_->settings() : settings_.gather;
+    hasher.update_value(uint32_t(gather.rays));
+    hasher.update_value(int32_t(gather.max_specular_depth));
+    hasher.update_value(int32_t(gather.max_glossy_bounces));
+    hasher.update_value(uint32_t(gather.k_global));
+    hash_float(gather.max_radius);
+    hasher.update_value(uint8_t(gather.gather_diffuse_sky));
+    return "rc1-" + Sha256::hex(hasher.finish());
 }
 
 Color PhotonMapIntegrator::radiance(const CameraRay& ray, SampleContext& context) const {

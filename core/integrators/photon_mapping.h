@@ -34,6 +34,10 @@ struct PhotonMapIntegratorSettings {
     int glossy_rays = 1;  // BSDF-sampled rays per visible point for non-Lambertian lobes
 };
 
+/// Bump when the irradiance cache's prepass or gathering changes what it stores for the same
+/// inputs: every cached render cache then misses.
+inline constexpr uint32_t kRenderCacheAlgorithmVersion = 1;
+
 /// Default search radius caps as a share of the scene's bounding radius.
 inline constexpr float kDefaultGlobalRadiusShare = 0.2f;
 inline constexpr float kDefaultCausticRadiusShare = 0.05f;
@@ -44,12 +48,22 @@ public:
                         const PhotonMapIntegratorSettings& settings);
     std::string_view name() const override { return "photon-map"; }
 
+    /// Whether this integrator fills an irradiance cache (final gathering with the cache on).
+    bool uses_irradiance_cache() const { return gatherer_ && settings_.irradiance_cache; }
     /// Fills the irradiance cache for this camera (a no-op without final gathering or cache).
     void prepare(const Camera& camera, CacheBuildStatistics* statistics);
+    /// Takes a cache prepare() built earlier for the same render_cache_key (another job or node).
+    void use_cache(std::shared_ptr<const IrradianceCache> cache) { cache_ = std::move(cache); }
+    /// The content key of the cache prepare() builds for this camera over maps of
+    /// `photon_map_key`: "rc1-" + 64 hex digits, from the photon-map key, the camera and image
+    /// size, the cache's and gathering's settings, the seed and kRenderCacheAlgorithmVersion.
+    std::string render_cache_key(const std::string& photon_map_key, const CameraDesc& camera, int width,
+                                 int height) const;
 
     Color radiance(const CameraRay& ray, SampleContext& context) const override;
 
     const IrradianceCache* cache() const { return cache_.get(); }
+    const std::shared_ptr<const IrradianceCache>& shared_cache() const { return cache_; }
 
 private:
     Color radiance_along(const Ray& ray, int depth, float path_length, RayFootprint footprint,
@@ -62,7 +76,7 @@ private:
     RadianceEstimateOptions caustic_options_;
     RadianceEstimateOptions global_options_;
     std::unique_ptr<FinalGatherer> gatherer_;
-    std::unique_ptr<IrradianceCache> cache_;
+    std::shared_ptr<const IrradianceCache> cache_;
     /// What next-event estimation samples: the scene's lights, or with final gathering under an
     /// environment, the lights with only the sky's peaks (the gather collects the rest).
     const LightSet* direct_lights_ = nullptr;

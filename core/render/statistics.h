@@ -58,7 +58,9 @@ struct RenderStatistics {
         int waves = 0;
         uint64_t lookups = 0;  // render pass
         uint64_t misses = 0;   // lookups no record covered (gathered on the spot)
-        double seconds = 0.0;  // the prepass that placed the records
+        double seconds = 0.0;  // the prepass that placed the records (0 when taken from a store)
+        std::string cache;     // "hit" when taken from the render-cache store, "miss" when built
+        std::string key;       // its render-cache key (with a store)
         double interpolated_share() const {
             return lookups > 0 ? 1.0 - static_cast<double>(misses) / static_cast<double>(lookups) : 0.0;
         }

@@ -1,10 +1,14 @@
 // What the daemon keeps: the photon-map cache (a second view of a scene skips photon tracing;
 // maps move between daemons by export and import; a corrupt file on disk is set aside and
-// rebuilt), finished jobs across a restart, jobs interrupted by a clean shutdown or killed
+// rebuilt), the render caches (a view's irradiance cache built once for its jobs and regions, and
+// moved between daemons), finished jobs across a restart, jobs interrupted by a clean shutdown or killed
 // (resumed from their tiles, failed as poison after three deaths), and uploaded scenes rendered by
 // content id.
 #include <gtest/gtest.h>
 
+#include <set>
+
+#include "core/image/exr_assemble.h"
 #include "core/image/exr_io.h"
 #include "core/util/sha256.h"
 #include "tests/server/daemon_harness.h"
@@ -241,28 +245,119 @@ TEST_F(DaemonCache, FinishedJobsSurviveARestartAndInterruptedJobsRunAgain) {
     EXPECT_NE(daemon.log().find("(1 queued)"), std::string::npos) << daemon.log();
 }
 
-TEST_F(DaemonCache, TwoDaemonsShareOneCacheDirectory) {
-    // Render farms share photon maps through a common --cache-dir: both daemons trace the same
-    // key at the same time, each renames its complete file into place, neither reads half a file.
+TEST_F(DaemonCache, AViewsIrradianceCacheIsBuiltOnceForItsJobsAndRegionsAndTravelsBetweenDaemons) {
+    json job = photon_job();
+    job["image"]["width"] = 64;
+    job["output"] = {{"pixel_type", "float"}};
+    Daemon daemon(dir_.path() / "cache");
+    ASSERT_TRUE(daemon.started()) << daemon.log();
+    const HttpClient client = daemon.client();
+    const auto image_of = [](const HttpClient& c, const json& status) {
+        return c.get("/v1/jobs/" + status.at("id").get<std::string>() + "/image.exr").body;
+    };
+
+    const json first = render(client, job);
+    ASSERT_EQ(first.at("state"), "done") << first.dump();
+    const json& built = first.at("statistics").at("irradiance_cache");
+    EXPECT_EQ(built.at("cache"), "miss");
+    EXPECT_GT(built.at("waves").get<int>(), 0);
+    const std::string key = built.at("key");
+    EXPECT_EQ(key.rfind("rc1-", 0), 0u);
+    EXPECT_TRUE(fs::exists(dir_.path() / "cache" / "render-caches" / (key + ".rc")));
+    const std::string whole = image_of(client, first);
+
+    // The same view again (more samples per pixel: the prepass does not depend on them): no prepass.
+    json more_samples = job;
+    more_samples["image"]["spp"] = 2;
+    const json again = render(client, more_samples);
+    ASSERT_EQ(again.at("state"), "done") << again.dump();
+    EXPECT_EQ(again.at("statistics").at("irradiance_cache").at("cache"), "hit");
+    EXPECT_EQ(again.at("statistics").at("irradiance_cache").at("key"), key);
+    EXPECT_EQ(again.at("statistics").at("irradiance_cache").at("waves"), 0);
+    EXPECT_EQ(again.at("statistics").at("irradiance_cache").at("records"), built.at("records"));
+
+    // Another view: another key, built.
+    json other = job;
+    other["camera"] = kOtherView;
+    const json other_view = render(client, other);
+    EXPECT_EQ(other_view.at("statistics").at("irradiance_cache").at("cache"), "miss");
+    EXPECT_NE(other_view.at("statistics").at("irradiance_cache").at("key"), key);
+
+    // The frame's regions take the frame's cache and assemble into its bytes.
+    std::vector<fs::path> parts;
+    const std::vector<std::array<int, 4>> regions = {{0, 0, 40, 20}, {40, 0, 64, 20}, {0, 20, 20, 32}, {20, 20, 64, 32}};
+    for (const auto& region : regions) {
+        json part = job;
+        part["image"]["region"] = region;
+        const json done = render(client, part);
+        ASSERT_EQ(done.at("state"), "done") << done.dump();
+        EXPECT_EQ(done.at("statistics").at("irradiance_cache").at("cache"), "hit");
+        parts.push_back(dir_.path() / ("part" + std::to_string(parts.size()) + ".exr"));
+        write_file(parts.back(), image_of(client, done));
+    }
+    const auto assembled = assemble_exr_parts(parts);
+    ASSERT_TRUE(assembled.has_value()) << assembled.error().message;
+    EXPECT_TRUE(std::string(assembled->bytes.begin(), assembled->bytes.end()) == whole);
+    EXPECT_NE(client.get("/metrics").body.find("photond_render_cache_hits_total 5\n"), std::string::npos);
+
+    // Another daemon takes the photon maps and the render cache by import: no photon pass, no
+    // prepass, the same bytes.
+    const std::string photon_key = first.at("photons").at("key");
+    const HttpResponse maps = client.get("/v1/photon-maps/" + photon_key);
+    const HttpResponse cache = client.get("/v1/render-caches/" + key);
+    ASSERT_EQ(cache.status, 200);
+    EXPECT_EQ(client.get("/v1/render-caches").json_body().at("keys").size(), 2u);
+    Daemon node(dir_.path() / "node");
+    ASSERT_TRUE(node.started()) << node.log();
+    const HttpClient remote = node.client();
+    EXPECT_EQ(remote.request("PUT", "/v1/photon-maps/" + photon_key, maps.body).status, 201);
+    EXPECT_EQ(remote.request("PUT", "/v1/render-caches/" + key, cache.body).status, 201);
+    EXPECT_EQ(remote.request("PUT", "/v1/render-caches/" + key, cache.body).status, 200);  // the same again
+    const std::string other_key = other_view.at("statistics").at("irradiance_cache").at("key");
+    const HttpResponse mislabelled = remote.request("PUT", "/v1/render-caches/" + other_key, cache.body);
+    EXPECT_EQ(mislabelled.status, 422) << mislabelled.body;
+    EXPECT_EQ(remote.request("PUT", "/v1/render-caches/rc1-../x", cache.body).status, 404);
+    const json imported = render(remote, job);
+    ASSERT_EQ(imported.at("state"), "done") << imported.dump();
+    EXPECT_EQ(imported.at("photons").at("cache"), "hit");
+    EXPECT_EQ(imported.at("statistics").at("irradiance_cache").at("cache"), "hit");
+    EXPECT_TRUE(image_of(remote, imported) == whole);
+}
+
+TEST_F(DaemonCache, TwoDaemonsShareOneCacheDirectoryAndBuildEachKeyOnce) {
+    // Render farms share photon maps and render caches through a common --cache-dir: both daemons
+    // get the same job at once, one builds each key (a lock file per key) while the other waits
+    // and then reads the complete file; nobody reads half a file.
+    json job = photon_job();
+    job["photons"]["global"] = 150000;  // tracing takes long enough for the two to meet
     Daemon first(dir_.path() / "shared");
     Daemon second(dir_.path() / "shared");
     ASSERT_TRUE(first.started() && second.started()) << first.log();
-    const std::string a = first.client().post("/v1/jobs", photon_job().dump()).json_body().at("id");
-    const std::string b =
-        second.client().post("/v1/jobs", photon_job(kOtherView).dump()).json_body().at("id");
+    const std::string a = first.client().post("/v1/jobs", job.dump()).json_body().at("id");
+    const std::string b = second.client().post("/v1/jobs", job.dump()).json_body().at("id");
     const json done_a = wait_for_status(first.client(), a, is_terminal_state);
     const json done_b = wait_for_status(second.client(), b, is_terminal_state);
     ASSERT_EQ(done_a.at("state"), "done") << done_a.dump();
     ASSERT_EQ(done_b.at("state"), "done") << done_b.dump();
     EXPECT_EQ(done_a.at("photons").at("key"), done_b.at("photons").at("key"));
-    const fs::path maps = dir_.path() / "shared" / "photon-maps";
-    for (const auto& entry : fs::directory_iterator(maps))
-        EXPECT_EQ(entry.path().extension(), ".pm")
-            << entry.path();  // no temporary or corrupt files
-    // A third view on a fresh daemon of the farm: a hit from the shared directory.
+    const std::set<std::string> photon_caches = {done_a.at("photons").at("cache"), done_b.at("photons").at("cache")};
+    EXPECT_EQ(photon_caches, (std::set<std::string>{"hit", "miss"})) << "traced by both daemons";
+    const std::set<std::string> render_caches = {done_a.at("statistics").at("irradiance_cache").at("cache"),
+                                                 done_b.at("statistics").at("irradiance_cache").at("cache")};
+    EXPECT_EQ(render_caches, (std::set<std::string>{"hit", "miss"})) << "built by both daemons";
+    EXPECT_TRUE(first.client().get("/v1/jobs/" + a + "/image.exr").body ==
+                second.client().get("/v1/jobs/" + b + "/image.exr").body);
+    for (const char* kind : {"photon-maps", "render-caches"})
+        for (const auto& entry : fs::directory_iterator(dir_.path() / "shared" / kind))
+            EXPECT_TRUE(entry.path().extension() == ".pm" || entry.path().extension() == ".rc" ||
+                        entry.path().extension() == ".lock")
+                << entry.path();  // no temporary or corrupt files
+    // Another view on a fresh daemon of the farm: a hit from the shared directory.
     Daemon third(dir_.path() / "shared", {"--photon-cache-mb", "0"});
     ASSERT_TRUE(third.started());
-    const json hit = render(third.client(), photon_job(kOtherView));
+    json other = job;
+    other["camera"] = kOtherView;
+    const json hit = render(third.client(), other);
     EXPECT_EQ(hit.at("photons").at("cache"), "hit");
     EXPECT_NE(third.client().get("/metrics").body.find("photond_photon_cache_bytes 0\n"),
               std::string::npos);

@@ -1,11 +1,7 @@
 // PhotonMapCache on its own: concurrent requests for one key trace once, the memory budget
 // evicts the least recently used maps (which stay on disk), files are written atomically and a
 // corrupt one is set aside.
-//
-// The test executables link photond_core and photond_protocol only (tests/CMakeLists.txt), not
-// the daemon library (which needs cpp-httplib's link settings), so the cache's two sources, which
-// depend on the core alone, are compiled into this test.
-#include "server/photon_map_cache.cpp"
+#include "server/photon_map_cache.h"
 
 #include <gtest/gtest.h>
 
@@ -14,7 +10,7 @@
 #include <thread>
 
 #include "core/photon/photon_map_io.h"
-#include "server/atomic_file.cpp"
+#include "server/atomic_file.h"
 #include "tests/server/daemon_harness.h"
 
 namespace photond::service {
