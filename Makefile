@@ -145,6 +145,15 @@ load: build
 	python3 bench/load_test.py --photond $(BUILD)/server/photond --clients 200 \
 		--seconds $(LOAD_SECONDS) --latency-goal-ms 50 --json bench/results/load_test.json
 
+# deploy/slurm/ on a real single-node Slurm cluster started by the test (Debian's slurmctld,
+# slurmd and munge; as root): 2 views x 4 regions, assembled frames byte-identical to photond
+# render (tests/slurm/slurm_cluster_test.sh; run by CI, about 15 s).
+SLURM_PACKAGES := slurmctld slurmd slurm-client munge
+.PHONY: test-slurm
+test-slurm: build
+	$(call install_missing,$(SLURM_PACKAGES))
+	bash tests/slurm/slurm_cluster_test.sh $(BUILD)/server/photond
+
 format:
 	find core protocol server clients tests bench -name '*.h' -o -name '*.cpp' | xargs clang-format -i
 

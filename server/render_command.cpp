@@ -17,6 +17,8 @@
 #include "protocol/json_text.h"
 #include "protocol/statistics.h"
 #include "server/atomic_file.h"
+#include "server/photon_map_cache.h"
+#include "server/render_cache_directory.h"
 #include "server/render_pipeline.h"
 
 namespace photond::service {
@@ -39,6 +41,11 @@ constexpr const char* kUsage =
     "  --exposure EV           the preview's exposure in stops (output.exposure_ev; default:\n"
     "                          automatic, the log-average luminance mapped to middle grey)\n"
     "  --stats-json FILE       write the render statistics as JSON\n"
+    "  --cache-dir DIR         keep and take photon maps and irradiance caches in DIR, laid out\n"
+    "                          as `photond serve --cache-dir` (render nodes may share it: each\n"
+    "                          key is built once)\n"
+    "  --caches-only           build the photon maps and the irradiance cache into --cache-dir\n"
+    "                          and stop (a render farm's preparation step; no -o)\n"
     "  --quiet                 no progress bar and no statistics on stderr (warnings only)\n";
 
 struct Arguments {
@@ -50,6 +57,8 @@ struct Arguments {
     std::string output;
     std::string preview;
     std::string stats_json;
+    std::string cache_dir;
+    bool caches_only = false;
     bool quiet = false;
 };
 
@@ -118,6 +127,12 @@ Expected<Arguments> parse_arguments(std::span<const std::string> args) {
             auto v = value("--stats-json");
             if (!v) return v.error();
             a.stats_json = *v;
+        } else if (arg == "--cache-dir") {
+            auto v = value("--cache-dir");
+            if (!v) return v.error();
+            a.cache_dir = *v;
+        } else if (arg == "--caches-only") {
+            a.caches_only = true;
         } else if (arg == "--quiet") {
             a.quiet = true;
         } else if (!arg.empty() && arg[0] == '-') {
@@ -129,7 +144,10 @@ Expected<Arguments> parse_arguments(std::span<const std::string> args) {
         }
         if (!status) return status.error();
     }
-    if (a.output.empty()) return Error{"missing -o OUT.exr"};
+    if (a.caches_only && a.cache_dir.empty()) return Error{"--caches-only: give the --cache-dir to build them into"};
+    if (a.caches_only && !(a.output.empty() && a.preview.empty()))
+        return Error{"--caches-only renders no image: leave out -o and --preview"};
+    if (a.output.empty() && !a.caches_only) return Error{"missing -o OUT.exr"};
     if (a.scene.empty() && a.job_file.empty()) return Error{"missing SCENE or --job FILE"};
     // Where the outputs go is checked before the render, not after it.
     for (const auto& [option, file] :
@@ -267,6 +285,16 @@ int run_render_command(std::span<const std::string> args) {
     }
     ProgressBar progress(!a.quiet && isatty(STDERR_FILENO));
     PipelineOptions options;
+    std::optional<PhotonMapCache> photon_maps;
+    std::optional<RenderCacheDirectory> render_caches;
+    if (!a.cache_dir.empty()) {
+        const auto log = [](const std::string& line) { std::fprintf(stderr, "photond render: %s\n", line.c_str()); };
+        photon_maps.emplace(std::filesystem::path(a.cache_dir) / "photon-maps", size_t{1} << 30, log);
+        render_caches.emplace(std::filesystem::path(a.cache_dir) / "render-caches", size_t{256} << 20, log);
+        options.photon_maps = &*photon_maps;
+        options.render_caches = &*render_caches;
+    }
+    options.caches_only = a.caches_only;
     options.threads = a.threads;
     options.scene_root = scene_root;
     options.callbacks.on_tile = [&](const TileEvent& e, const Image&) { progress.update(e.tiles_done, e.tiles_total); };
@@ -293,6 +321,17 @@ int run_render_command(std::span<const std::string> args) {
         stats["job"] = protocol::to_json(*job);
         stats_text = protocol::json_text(stats, 2) + "\n";
     }
+    const auto write_stats = [&]() -> Status {
+        return a.stats_json.empty() ? Status::ok() : write_file_atomically(a.stats_json, stats_text);
+    };
+    if (a.caches_only) {
+        if (Status st = write_stats(); !st) {
+            std::fprintf(stderr, "photond render: %s\n", st.error().message.c_str());
+            return 1;
+        }
+        if (!a.quiet) print_statistics(result->statistics);
+        return 0;
+    }
     std::vector<std::filesystem::path> written;
     const auto fail = [&](const std::string& message) {
         std::fprintf(stderr, "photond render: %s\n", message.c_str());
@@ -308,9 +347,7 @@ int run_render_command(std::span<const std::string> args) {
             return fail(st.error().message);
         written.push_back(a.preview);
     }
-    if (!a.stats_json.empty()) {
-        if (Status st = write_file_atomically(a.stats_json, stats_text); !st) return fail(st.error().message);
-    }
+    if (Status st = write_stats(); !st) return fail(st.error().message);
     if (!a.quiet) print_statistics(result->statistics);
     // Warnings are never silenced: --quiet prints them alone.
     if (a.quiet)

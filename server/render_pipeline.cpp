@@ -521,6 +521,11 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
         }
     }
 
+    if (options.caches_only) {
+        stats.total_seconds = seconds_since(start);
+        return result;
+    }
+
     TileSettings tiles;
     tiles.tile_size = job.image.tile_size;
     tiles.samples_per_pixel = job.image.spp;

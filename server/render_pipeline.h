@@ -60,6 +60,7 @@ struct PipelineOptions {
     RenderCallbacks callbacks;          // per-tile progress and cancellation
     PhotonMapStore* photon_maps = nullptr;  // null: photon maps are built for this job only
     RenderCacheStore* render_caches = nullptr;  // null: irradiance caches are built for this job only
+    bool caches_only = false;  // stop after the photon maps and the irradiance cache (no image)
     SceneLookup scene_lookup;               // null: {"id": ...} scenes are refused
     SceneBundleLookup bundle_lookup;        // null: uploaded scenes have no files for the job
     PassCallback on_pass;

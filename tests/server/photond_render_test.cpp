@@ -19,6 +19,7 @@
 namespace {
 
 namespace fs = std::filesystem;
+using json = nlohmann::json;
 
 const std::string kPhotond = std::string(PHOTOND_BINARY_DIR) + "/server/photond";
 
@@ -108,6 +109,31 @@ TEST_F(PhotondRender, RegionsRenderedApartAssembleIntoTheBytesOfTheWholeFrame) {
     EXPECT_NE(short_of_one.output.find("672 pixel(s) within [30,72)x[24,40) are in no part"), std::string::npos)
         << short_of_one.output;
     EXPECT_FALSE(fs::exists(dir_ / "short.exr"));
+}
+
+TEST_F(PhotondRender, ACacheDirectoryPreparedOnceServesLaterRendersWithTheSameBytes) {
+    // A render farm's steps: --caches-only builds the photon maps and the irradiance cache into a
+    // shared directory; later renders (here a region and the whole view) take both from there.
+    const std::string common = "render builtin:cornell-box-diffuse --preset preview --width 48 --height 32 --quiet ";
+    const std::string cache = "--cache-dir " + (dir_ / "cache").string() + " ";
+    const auto refused = run(common + "--caches-only");
+    EXPECT_EQ(refused.exit_code, 2);
+    EXPECT_NE(refused.output.find("--caches-only: give the --cache-dir"), std::string::npos) << refused.output;
+    const auto prepared = run(common + cache + "--caches-only --stats-json " + (dir_ / "prepared.json").string());
+    ASSERT_EQ(prepared.exit_code, 0) << prepared.output;
+    const json built = json::parse(read_file(dir_ / "prepared.json"));
+    EXPECT_EQ(built.at("photons").at("cache"), "miss");
+    EXPECT_EQ(built.at("irradiance_cache").at("cache"), "miss");
+    ASSERT_EQ(run(common + cache + "-o " + (dir_ / "cached.exr").string() + " --stats-json " +
+                  (dir_ / "cached.json").string())
+                  .exit_code,
+              0);
+    const json taken = json::parse(read_file(dir_ / "cached.json"));
+    EXPECT_EQ(taken.at("photons").at("cache"), "hit");
+    EXPECT_EQ(taken.at("irradiance_cache").at("cache"), "hit");
+    EXPECT_EQ(taken.at("irradiance_cache").at("key"), built.at("irradiance_cache").at("key"));
+    ASSERT_EQ(run(common + "-o " + (dir_ / "alone.exr").string()).exit_code, 0);
+    EXPECT_TRUE(read_file(dir_ / "cached.exr") == read_file(dir_ / "alone.exr"));
 }
 
 TEST_F(PhotondRender, JobFileAndSetOverrides) {
