@@ -8,37 +8,25 @@
 // without its checksum and the fuzzer appends the right one; even, the rest is taken as it is
 // (fuzz/corpus/photon_map holds both kinds, made from files the daemon wrote).
 #include <cstdint>
-#include <cstdio>
-#include <cstdlib>
 #include <span>
 #include <vector>
 
 #include "core/photon/photon_map_io.h"
-#include "core/util/sha256.h"
+#include "fuzz/checksummed_input.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (size == 0) return 0;
-    const bool append_checksum = (data[0] & 1) != 0;
-    std::vector<uint8_t> bytes(data + 1, data + size);
-    if (append_checksum) {
-        const photond::Sha256Digest checksum = photond::sha256(bytes);
-        bytes.insert(bytes.end(), checksum.begin(), checksum.end());
-    }
+    const std::vector<uint8_t> bytes = photond::fuzz::checksummed_file(data, size);
     (void)photond::read_photon_map_key(bytes);
     const photond::Expected<photond::PhotonMaps> maps =
         photond::deserialize_photon_maps(bytes, std::string());
-    if (!maps && maps.error().message.empty()) {
-        std::fprintf(stderr, "refused with an empty message\n");
-        std::abort();
-    }
+    photond::fuzz::require(maps || !maps.error().message.empty(), "refused with an empty message");
     if (maps) {
         // What was accepted is written back identically (the file holds the tree's order).
         const auto again =
             photond::serialize_photon_maps(*maps, photond::read_photon_map_key(bytes));
-        if (!again || *again != bytes) {
-            std::fprintf(stderr, "an accepted file is not written back byte for byte\n");
-            std::abort();
-        }
+        photond::fuzz::require(again && *again == bytes,
+                               "an accepted file is not written back byte for byte");
     }
     return 0;
 }

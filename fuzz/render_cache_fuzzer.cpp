@@ -12,14 +12,12 @@
 // lookups: near its records and at its nodes' centres, on the root-to-leaf path and widened.
 #include <algorithm>
 #include <cstdint>
-#include <cstdio>
-#include <cstdlib>
 #include <memory>
 #include <span>
 #include <vector>
 
 #include "core/integrators/irradiance_cache_io.h"
-#include "core/util/sha256.h"
+#include "fuzz/checksummed_input.h"
 
 namespace {
 
@@ -43,27 +41,18 @@ void lookups(const photond::IrradianceCache& cache) {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (size == 0) return 0;
-    const bool append_checksum = (data[0] & 1) != 0;
-    std::vector<uint8_t> bytes(data + 1, data + size);
-    if (append_checksum) {
-        const photond::Sha256Digest checksum = photond::sha256(bytes);
-        bytes.insert(bytes.end(), checksum.begin(), checksum.end());
-    }
+    const std::vector<uint8_t> bytes = photond::fuzz::checksummed_file(data, size);
     (void)photond::read_irradiance_cache_key(bytes);
     const photond::Expected<std::unique_ptr<photond::IrradianceCache>> cache =
         photond::deserialize_irradiance_cache(bytes, std::string());
-    if (!cache && cache.error().message.empty()) {
-        std::fprintf(stderr, "refused with an empty message\n");
-        std::abort();
-    }
+    photond::fuzz::require(cache || !cache.error().message.empty(),
+                           "refused with an empty message");
     if (cache) {
         // What was accepted is written back identically (the file holds the exact state).
         const auto again =
             photond::serialize_irradiance_cache(**cache, photond::read_irradiance_cache_key(bytes));
-        if (!again || *again != bytes) {
-            std::fprintf(stderr, "an accepted file is not written back byte for byte\n");
-            std::abort();
-        }
+        photond::fuzz::require(again && *again == bytes,
+                               "an accepted file is not written back byte for byte");
         lookups(**cache);
     }
     return 0;

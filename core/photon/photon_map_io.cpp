@@ -1,21 +1,13 @@
 #include "core/photon/photon_map_io.h"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <bit>
-#include <cerrno>
-#include <cstdio>
 #include <cstring>
 #include <exception>
 #include <memory>
-#include <random>
-#include <system_error>
 
+#include "core/util/binary_file.h"
 #include "core/util/sha256.h"
 
 namespace photond {
@@ -30,31 +22,7 @@ constexpr size_t kChecksumSize = 32;
 static_assert(sizeof(PhotonTracingStatistics) == 88,
               "PhotonTracingStatistics changed: store the new field in photon_map_io");
 
-std::string system_message(int error_number) {
-    return std::error_code(error_number, std::generic_category()).message();
-}
-
 // ---- Writing ----------------------------------------------------------------------------------
-
-class ByteWriter {
-public:
-    void put_bytes(const void* data, size_t size) {
-        const uint8_t* bytes = static_cast<const uint8_t*>(data);
-        bytes_.insert(bytes_.end(), bytes, bytes + size);
-    }
-    void put_u8(uint8_t value) { bytes_.push_back(value); }
-    void put_u32(uint32_t value) {
-        for (int i = 0; i < 4; ++i) bytes_.push_back(uint8_t(value >> (8 * i)));
-    }
-    void put_u64(uint64_t value) {
-        for (int i = 0; i < 8; ++i) bytes_.push_back(uint8_t(value >> (8 * i)));
-    }
-    void reserve(size_t size) { bytes_.reserve(size); }
-    std::vector<uint8_t>& bytes() { return bytes_; }
-
-private:
-    std::vector<uint8_t> bytes_;
-};
 
 void put_map(ByteWriter& out, const std::shared_ptr<const PhotonMap>& map) {
     out.put_u8(map ? 1 : 0);
@@ -65,62 +33,6 @@ void put_map(ByteWriter& out, const std::shared_ptr<const PhotonMap>& map) {
 }
 
 // ---- Reading ----------------------------------------------------------------------------------
-
-// Reads fields from [0, end) and never past it; a read that does not fit sets the error.
-class ByteReader {
-public:
-    ByteReader(std::span<const uint8_t> bytes, size_t end) : bytes_(bytes), end_(end) {}
-
-    size_t position() const { return position_; }
-    size_t remaining() const { return end_ - position_; }
-    const std::string& error() const { return error_; }
-
-    bool get_bytes(void* data, size_t size, const char* field) {
-        if (!error_.empty()) return false;
-        if (size > remaining()) {
-            error_ = "truncated photon-map data: " + std::string(field) + " at byte " +
-                     std::to_string(position_) + " needs " + std::to_string(size) + " bytes, " +
-                     std::to_string(remaining()) + " remain";
-            return false;
-        }
-        if (size > 0) std::memcpy(data, bytes_.data() + position_, size);
-        position_ += size;
-        return true;
-    }
-    bool get_u8(uint8_t& value, const char* field) { return get_bytes(&value, 1, field); }
-    bool get_u32(uint32_t& value, const char* field) {
-        std::array<uint8_t, 4> b;
-        if (!get_bytes(b.data(), b.size(), field)) return false;
-        value = uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
-        return true;
-    }
-    bool get_u64(uint64_t& value, const char* field) {
-        std::array<uint8_t, 8> b;
-        if (!get_bytes(b.data(), b.size(), field)) return false;
-        value = 0;
-        for (int i = 7; i >= 0; --i) value = (value << 8) | b[i];
-        return true;
-    }
-    bool get_flag(bool& value, const char* field) {
-        uint8_t byte = 0;
-        if (!get_u8(byte, field)) return false;
-        if (byte > 1) {
-            return fail(std::string(field) + " is " + std::to_string(byte) + " (must be 0 or 1)");
-        }
-        value = byte == 1;
-        return true;
-    }
-    bool fail(std::string message) {
-        if (error_.empty()) error_ = std::move(message);
-        return false;
-    }
-
-private:
-    std::span<const uint8_t> bytes_;
-    size_t end_;
-    size_t position_ = 0;
-    std::string error_;
-};
 
 struct Header {
     uint32_t version = 0;
@@ -225,7 +137,7 @@ Expected<PhotonMaps> deserialize_checked(std::span<const uint8_t> bytes,
     // The header first, for the clearest message about a foreign or other-version file.
     const size_t body_size = bytes.size() >= kChecksumSize ? bytes.size() - kChecksumSize : 0;
     {
-        ByteReader in(bytes, bytes.size());
+        ByteReader in(bytes, bytes.size(), "photon-map");
         Header header;
         if (!read_header(in, header)) return Error{in.error()};
     }
@@ -235,7 +147,7 @@ Expected<PhotonMaps> deserialize_checked(std::span<const uint8_t> bytes,
         return Error{"checksum mismatch: the file is corrupt"};
     }
 
-    ByteReader in(bytes, body_size);
+    ByteReader in(bytes, body_size, "photon-map");
     Header header;
     if (!read_header(in, header) || !read_key(in, header.key)) return Error{in.error()};
     if (!expected_key.empty() && header.key != expected_key) {
@@ -251,79 +163,6 @@ Expected<PhotonMaps> deserialize_checked(std::span<const uint8_t> bytes,
                      " unexpected bytes before its checksum"};
     }
     return maps;
-}
-
-// A name no other writer (thread or process) uses: pid, a random number and a counter.
-std::filesystem::path temporary_path(const std::filesystem::path& path) {
-    static std::atomic<uint64_t> counter{0};
-    std::random_device random;
-    const uint64_t unique =
-        (uint64_t(random()) << 32 | random()) ^ (counter.fetch_add(1) * 0x9e3779b97f4a7c15ull);
-    char suffix[64];
-    std::snprintf(suffix, sizeof(suffix), ".tmp-%ld-%016llx", long(::getpid()),
-                  static_cast<unsigned long long>(unique));
-    std::filesystem::path temporary = path;
-    temporary += suffix;
-    return temporary;
-}
-
-Status write_all(const std::filesystem::path& path, std::span<const uint8_t> bytes) {
-    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-    if (fd < 0) {
-        const int error_number = errno;
-        return Error{"cannot create the temporary file " + path.filename().string() + ": " +
-                     system_message(error_number)};
-    }
-    size_t written = 0;
-    while (written < bytes.size()) {
-        const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
-        if (n < 0) {
-            if (errno == EINTR) continue;
-            const int error_number = errno;
-            ::close(fd);
-            return Error{"cannot write " + path.filename().string() + ": " +
-                         system_message(error_number)};
-        }
-        written += size_t(n);
-    }
-    if (::close(fd) != 0) {
-        const int error_number = errno;
-        return Error{"cannot write " + path.filename().string() + ": " +
-                     system_message(error_number)};
-    }
-    return Status::ok();
-}
-
-Status read_all(const std::filesystem::path& path, std::vector<uint8_t>& bytes) {
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) return Error{"cannot open: " + system_message(errno)};
-    struct FdCloser {
-        int fd;
-        ~FdCloser() { ::close(fd); }
-    } closer{fd};
-    struct stat info {};
-    if (::fstat(fd, &info) != 0) return Error{"cannot stat: " + system_message(errno)};
-    if (!S_ISREG(info.st_mode)) return Error{"not a regular file"};
-    const auto read_up_to = [&](size_t size) -> Status {
-        while (bytes.size() < size) {
-            uint8_t chunk[1 << 16];
-            const ssize_t n = ::read(fd, chunk, std::min(sizeof(chunk), size - bytes.size()));
-            if (n < 0) {
-                if (errno == EINTR) continue;
-                return Error{"cannot read: " + system_message(errno)};
-            }
-            if (n == 0) break;  // the file is shorter than it was: the checksum will tell
-            bytes.insert(bytes.end(), chunk, chunk + n);
-        }
-        return Status::ok();
-    };
-    // The magic first, so that a large foreign file is not read whole.
-    if (Status s = read_up_to(kMagic.size()); !s) return s;
-    if (bytes.size() < kMagic.size() || !std::equal(kMagic.begin(), kMagic.end(), bytes.begin())) {
-        return Status::ok();  // deserialize_photon_maps names the problem
-    }
-    bytes.reserve(size_t(info.st_size));
-    return read_up_to(size_t(info.st_size));
 }
 
 }  // namespace
@@ -383,41 +222,20 @@ Status write_photon_maps_file(const std::filesystem::path& path, const PhotonMap
                               const std::string& key) {
     Expected<std::vector<uint8_t>> bytes = serialize_photon_maps(maps, key);
     if (!bytes) return Error{path.string() + ": " + bytes.error().message};
-    const std::filesystem::path temporary = temporary_path(path);
-    if (Status written = write_all(temporary, *bytes); !written) {
-        std::error_code ignored;
-        std::filesystem::remove(temporary, ignored);
-        return Error{path.string() + ": " + written.error().message};
-    }
-    // rename(2) replaces path atomically: a reader opens either the old file or the new one.
-    std::error_code error;
-    std::filesystem::rename(temporary, path, error);
-    if (error) {
-        std::error_code ignored;
-        std::filesystem::remove(temporary, ignored);
-        return Error{path.string() + ": cannot rename " + temporary.filename().string() +
-                     " into place: " + error.message()};
-    }
-    return Status::ok();
+    return write_file_atomically(path, *bytes);
 }
 
 Expected<PhotonMaps> read_photon_maps_file(const std::filesystem::path& path,
                                            const std::string& expected_key) {
-    std::vector<uint8_t> bytes;
-    try {
-        if (Status read = read_all(path, bytes); !read) {
-            return Error{path.string() + ": " + read.error().message};
-        }
-    } catch (const std::exception& e) {
-        return Error{path.string() + ": cannot read: " + e.what()};
-    }
-    Expected<PhotonMaps> maps = deserialize_photon_maps(bytes, expected_key);
+    Expected<std::vector<uint8_t>> bytes = read_file_with_magic(path, kMagic);
+    if (!bytes) return bytes.error();
+    Expected<PhotonMaps> maps = deserialize_photon_maps(*bytes, expected_key);
     if (!maps) return Error{path.string() + ": " + maps.error().message};
     return maps;
 }
 
 std::string read_photon_map_key(std::span<const uint8_t> bytes) {
-    ByteReader in(bytes, bytes.size());
+    ByteReader in(bytes, bytes.size(), "photon-map");
     Header header;
     if (!read_header(in, header) || !read_key(in, header.key)) return {};
     return header.key;

@@ -1,0 +1,146 @@
+#include "core/util/binary_file.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cstdio>
+#include <exception>
+#include <random>
+#include <system_error>
+
+namespace photond {
+namespace {
+
+std::string system_message(int error_number) {
+    return std::error_code(error_number, std::generic_category()).message();
+}
+
+Status write_all(const std::filesystem::path& path, std::span<const uint8_t> bytes) {
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        const int error_number = errno;
+        return Error{"cannot create the temporary file " + path.filename().string() + ": " +
+                     system_message(error_number)};
+    }
+    size_t written = 0;
+    while (written < bytes.size()) {
+        const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
+        if (n < 0) {
+            if (errno == EINTR) continue;
+            const int error_number = errno;
+            ::close(fd);
+            return Error{"cannot write " + path.filename().string() + ": " +
+                         system_message(error_number)};
+        }
+        written += size_t(n);
+    }
+    if (::close(fd) != 0) {
+        const int error_number = errno;
+        return Error{"cannot write " + path.filename().string() + ": " +
+                     system_message(error_number)};
+    }
+    return Status::ok();
+}
+
+Status read_all(const std::filesystem::path& path, std::span<const uint8_t> magic,
+                std::vector<uint8_t>& bytes) {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return Error{"cannot open: " + system_message(errno)};
+    struct FdCloser {
+        int fd;
+        ~FdCloser() { ::close(fd); }
+    } closer{fd};
+    struct stat info {};
+    if (::fstat(fd, &info) != 0) return Error{"cannot stat: " + system_message(errno)};
+    if (!S_ISREG(info.st_mode)) return Error{"not a regular file"};
+    const auto read_up_to = [&](size_t size) -> Status {
+        while (bytes.size() < size) {
+            uint8_t chunk[1 << 16];
+            const ssize_t n = ::read(fd, chunk, std::min(sizeof(chunk), size - bytes.size()));
+            if (n < 0) {
+                if (errno == EINTR) continue;
+                return Error{"cannot read: " + system_message(errno)};
+            }
+            if (n == 0) break;  // the file is shorter than it was: the checksum will tell
+            bytes.insert(bytes.end(), chunk, chunk + n);
+        }
+        return Status::ok();
+    };
+    // The magic first, so that a large foreign file is not read whole.
+    if (Status s = read_up_to(magic.size()); !s) return s;
+    if (bytes.size() < magic.size() || !std::equal(magic.begin(), magic.end(), bytes.begin())) {
+        return Status::ok();  // the format's parser names the problem
+    }
+    bytes.reserve(size_t(info.st_size));
+    return read_up_to(size_t(info.st_size));
+}
+
+}  // namespace
+
+bool ByteReader::get_flag(bool& value, const char* field) {
+    uint8_t byte = 0;
+    if (!get_u8(byte, field)) return false;
+    if (byte > 1) {
+        return fail(std::string(field) + " is " + std::to_string(byte) + " (must be 0 or 1)");
+    }
+    value = byte == 1;
+    return true;
+}
+
+void ByteReader::truncated(size_t size, const char* field) {
+    fail("truncated " + std::string(data_name_) + " data: " + std::string(field) + " at byte " +
+         std::to_string(position_) + " needs " + std::to_string(size) + " bytes, " +
+         std::to_string(remaining()) + " remain");
+}
+
+std::filesystem::path unique_temporary_path(const std::filesystem::path& path) {
+    // The pid, a random number and a counter.
+    static std::atomic<uint64_t> counter{0};
+    std::random_device random;
+    const uint64_t unique =
+        (uint64_t(random()) << 32 | random()) ^ (counter.fetch_add(1) * 0x9e3779b97f4a7c15ull);
+    char suffix[64];
+    std::snprintf(suffix, sizeof(suffix), ".tmp-%ld-%016llx", long(::getpid()),
+                  static_cast<unsigned long long>(unique));
+    std::filesystem::path temporary = path;
+    temporary += suffix;
+    return temporary;
+}
+
+Status write_file_atomically(const std::filesystem::path& path, std::span<const uint8_t> bytes) {
+    const std::filesystem::path temporary = unique_temporary_path(path);
+    if (Status written = write_all(temporary, bytes); !written) {
+        std::error_code ignored;
+        std::filesystem::remove(temporary, ignored);
+        return Error{path.string() + ": " + written.error().message};
+    }
+    // rename(2) replaces path atomically: a reader opens either the old file or the new one.
+    std::error_code error;
+    std::filesystem::rename(temporary, path, error);
+    if (error) {
+        std::error_code ignored;
+        std::filesystem::remove(temporary, ignored);
+        return Error{path.string() + ": cannot rename " + temporary.filename().string() +
+                     " into place: " + error.message()};
+    }
+    return Status::ok();
+}
+
+Expected<std::vector<uint8_t>> read_file_with_magic(const std::filesystem::path& path,
+                                                    std::span<const uint8_t> magic) {
+    std::vector<uint8_t> bytes;
+    try {
+        if (Status read = read_all(path, magic, bytes); !read) {
+            return Error{path.string() + ": " + read.error().message};
+        }
+    } catch (const std::exception& e) {
+        return Error{path.string() + ": cannot read: " + e.what()};
+    }
+    return bytes;
+}
+
+}  // namespace photond
