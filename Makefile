@@ -154,6 +154,15 @@ test-slurm: build
 	$(call install_missing,$(SLURM_PACKAGES))
 	bash tests/slurm/slurm_cluster_test.sh $(BUILD)/server/photond
 
+# deploy/ checked against the built binary (tests/deploy/check_deploy.py: the unit with
+# systemd-analyze verify and its ExecStart run under the unit's rules, the Dockerfile, the
+# Kubernetes manifests, shell scripts with shellcheck; run by CI).
+DEPLOY_PACKAGES := python3-yaml systemd shellcheck
+.PHONY: test-deploy
+test-deploy: build
+	$(call install_missing,$(DEPLOY_PACKAGES))
+	python3 tests/deploy/check_deploy.py $(BUILD)/server/photond
+
 format:
 	find core protocol server clients tests bench -name '*.h' -o -name '*.cpp' | xargs clang-format -i
 
