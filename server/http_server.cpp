@@ -413,6 +413,12 @@ void HttpServer::Impl::install() {
         services.metrics.record_response(res.status);
         if (options.access_log) log(req.method + " " + req.path + " " + std::to_string(res.status));
     });
+    // SO_REUSEADDR alone: cpp-httplib's default also sets SO_REUSEPORT, with which a second daemon
+    // on the same port started without an error and took half of the first one's connections.
+    server.set_socket_options([](socket_t socket) {
+        int yes = 1;
+        ::setsockopt(socket, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    });
     server.set_payload_max_length(options.max_body_bytes);
     server.set_keep_alive_timeout(2);
     server.set_read_timeout(30);

@@ -492,5 +492,20 @@ TEST_F(DaemonErrors, RefusesToListenBeyondLoopbackWithoutAToken) {
     EXPECT_NE(empty.find("empty"), std::string::npos) << empty;
 }
 
+TEST_F(DaemonErrors, ASecondDaemonOnATakenPortRefusesToStart) {
+    // cpp-httplib's default socket options include SO_REUSEPORT: a second daemon bound the same
+    // port without an error and took part of the first one's connections.
+    Daemon first(dir_.path() / "first");
+    ASSERT_TRUE(first.started()) << first.log();
+    const auto [code, output] =
+        run_command("timeout 10 " + kPhotondBinary + " serve --listen 127.0.0.1:" + std::to_string(first.port()) +
+                    " --cache-dir " + (dir_.path() / "second").string());
+    EXPECT_EQ(code, 1) << output;
+    EXPECT_NE(output.find("cannot listen on 127.0.0.1:" + std::to_string(first.port()) + " (in use"),
+              std::string::npos)
+        << output;
+    EXPECT_EQ(first.client().get("/healthz").status, 200);
+}
+
 }  // namespace
 }  // namespace photond::test
