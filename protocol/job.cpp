@@ -1,6 +1,7 @@
 #include "protocol/job.h"
 
 #include <algorithm>
+#include <regex>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -186,8 +187,8 @@ constexpr std::array<std::string_view, 5> kImageFields{"width", "height", "tile_
 constexpr std::array<std::string_view, 5> kPhotonFields{"global", "caustic", "k_global",
                                                         "k_caustic", "seed"};
 constexpr std::array<std::string_view, 1> kGatherFields{"rays"};
-constexpr std::array<std::string_view, 5> kIrradianceCacheFields{
-    "enabled", "a", "gradients", "min_spacing_px", "max_spacing_px"};
+constexpr std::array<std::string_view, 6> kIrradianceCacheFields{
+    "enabled", "a", "gradients", "min_spacing_px", "max_spacing_px", "start_from"};
 constexpr std::array<std::string_view, 3> kOutputFields{"pixel_type", "aovs", "exposure_ev"};
 constexpr std::array<std::string_view, 4> kEnvironmentFields{"color", "image", "intensity",
                                                              "rotation_deg"};
@@ -417,6 +418,14 @@ void overlay_irradiance_cache(const json& value, IrradianceCacheSpec& cache) {
     fields.overlay_bool("gradients", cache.gradients);
     fields.overlay_number("min_spacing_px", limits::kCacheSpacingPx, cache.min_spacing_px);
     fields.overlay_number("max_spacing_px", limits::kCacheSpacingPx, cache.max_spacing_px);
+    if (const json* v = fields.find("start_from")) {
+        static const std::regex key_pattern("rc[0-9]{1,4}-[0-9a-f]{64}");
+        if (!v->is_string() || !std::regex_match(v->get_ref<const std::string&>(), key_pattern))
+            fail(fields.path_of("start_from"),
+                 "must be a render-cache key, rc1-<64 hex digits> (statistics.irradiance_cache.key of an earlier "
+                 "view)" + got(*v));
+        cache.start_from = v->get<std::string>();
+    }
 }
 
 void check_irradiance_cache(const IrradianceCacheSpec& cache) {
@@ -784,7 +793,11 @@ json irradiance_cache_schema() {
                                           "Lamorlette 2004)")},
          {"max_spacing_px", number_schema(limits::kCacheSpacingPx,
                                           "largest record spacing in pixels; at least "
-                                          "min_spacing_px")}},
+                                          "min_spacing_px")},
+         {"start_from", {{"type", "string"},
+                         {"pattern", "^rc[0-9]{1,4}-[0-9a-f]{64}$"},
+                         {"description", "the render-cache key (statistics.irradiance_cache.key) of an earlier "
+                                         "view of the scene whose records this view's cache starts from"}}}},
         {}, "the irradiance cache of the final gather");
 }
 
@@ -999,6 +1012,7 @@ nlohmann::json to_json(const Job& job) {
                                     {"gradients", cache.gradients},
                                     {"min_spacing_px", cache.min_spacing_px},
                                     {"max_spacing_px", cache.max_spacing_px}};
+    if (!cache.start_from.empty()) document["irradiance_cache"]["start_from"] = cache.start_from;
     document["output"] = {{"pixel_type", job.output.pixel_type}, {"aovs", job.output.aovs}};
     if (job.output.exposure_ev) document["output"]["exposure_ev"] = *job.output.exposure_ev;
     const EnvironmentSpec& environment = job.environment;

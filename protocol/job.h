@@ -142,6 +142,9 @@ struct IrradianceCacheSpec {
     bool gradients = false;
     double min_spacing_px = 0.0;
     double max_spacing_px = 0.0;
+    /// The render-cache key of an earlier view's cache to start from (its records serve this
+    /// view where valid); empty: start empty.
+    std::string start_from;
 
     bool operator==(const IrradianceCacheSpec&) const = default;
 };

@@ -61,6 +61,10 @@ nlohmann::json to_json(const RenderStatistics& s) {
         };
         if (!c.cache.empty()) result["irradiance_cache"]["cache"] = c.cache;
         if (!c.key.empty()) result["irradiance_cache"]["key"] = c.key;
+        if (!c.start_from.empty()) {
+            result["irradiance_cache"]["start_from"] = c.start_from;
+            result["irradiance_cache"]["records_reused"] = c.records_reused;
+        }
     }
     return result;
 }

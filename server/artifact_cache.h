@@ -122,6 +122,21 @@ public:
         return *built;
     }
 
+    /// The artifact for `key` from memory or disk (then kept in memory); nullptr when it is not
+    /// here (a corrupt file is moved aside).
+    std::shared_ptr<const Value> find(const std::string& key) {
+        if (!Traits::is_valid_key(key)) return nullptr;
+        {
+            std::lock_guard lock(mutex_);
+            if (auto found = find_locked(key)) return found;
+        }
+        auto found = read_disk(key);
+        if (!found) return nullptr;
+        std::lock_guard lock(mutex_);
+        insert_locked(key, *found);
+        return *found;
+    }
+
     /// The file bytes of the artifact for `key` (from disk, else serialized from memory); nullopt
     /// when the key is unknown here.
     std::optional<std::vector<uint8_t>> export_bytes(const std::string& key) {

@@ -50,6 +50,7 @@ public:
         bool* cache_hit) override {
         return ArtifactCache::get_or_build(key, build, cache_hit);
     }
+    std::shared_ptr<const IrradianceCache> find_cache(const std::string& key) override { return find(key); }
 };
 
 }  // namespace photond::service

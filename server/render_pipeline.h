@@ -43,6 +43,8 @@ public:
     virtual Expected<std::shared_ptr<const IrradianceCache>> get_or_build(
         const std::string& key, const std::function<Expected<std::shared_ptr<const IrradianceCache>>()>& build,
         bool* cache_hit) = 0;
+    /// The cache kept under `key`; nullptr when there is none.
+    virtual std::shared_ptr<const IrradianceCache> find_cache(const std::string& key) = 0;
 };
 
 /// Resolves {"id": "sha256:..."} scenes (uploaded to the daemon).

@@ -86,12 +86,27 @@ IrradianceRecord make_irradiance_record(const FinalGatherer& gatherer, const Dif
     return r;
 }
 
+bool start_matches(const IrradianceCache& start, const RenderScene& rs, const CacheBuildSettings& settings) {
+    const IrradianceCache empty(rs.scene->bounds, settings.cache);
+    const IrradianceCache::Node& root = empty.nodes().front();
+    const IrradianceCache::Node& start_root = start.nodes().front();
+    return start.settings().accuracy == settings.cache.accuracy && start.settings().gradients == settings.cache.gradients &&
+           start_root.center == root.center && start_root.half_size == root.half_size;
+}
+
 std::unique_ptr<IrradianceCache> build_irradiance_cache(const RenderScene& rs, const FinalGatherer& gatherer,
                                                         const Camera& camera, const CacheBuildSettings& settings,
-                                                        CacheBuildStatistics* statistics) {
-    const auto start = std::chrono::steady_clock::now();
-    auto cache = std::make_unique<IrradianceCache>(rs.scene->bounds, settings.cache);
+                                                        CacheBuildStatistics* statistics, const IrradianceCache* start) {
+    const auto started = std::chrono::steady_clock::now();
+    std::unique_ptr<IrradianceCache> cache;
+    if (start) {
+        // A copy of a valid cache's state is valid: from_state cannot refuse it.
+        cache = std::move(IrradianceCache::from_state(start->state())).value();
+    } else {
+        cache = std::make_unique<IrradianceCache>(rs.scene->bounds, settings.cache);
+    }
     CacheBuildStatistics stats;
+    stats.records_reused = cache->size();
     const PixelRect frame{0, 0, camera.width(), camera.height()};
     const PixelRect area = settings.region ? settings.region->intersect(frame) : frame;
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
@@ -153,7 +168,7 @@ std::unique_ptr<IrradianceCache> build_irradiance_cache(const RenderScene& rs, c
         ++stats.waves;
     }
     stats.records = cache->size();
-    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     if (statistics) *statistics = stats;
     return cache;
 }

@@ -29,6 +29,7 @@ struct CacheBuildSettings {
 
 struct CacheBuildStatistics {
     uint64_t records = 0;
+    uint64_t records_reused = 0;  // taken from the start cache
     uint64_t candidates = 0;  // visible points examined
     int waves = 0;
     RayCounters counters;
@@ -53,8 +54,17 @@ inline void record_radius_limits(const CacheBuildSettings& s, float footprint, f
 IrradianceRecord make_irradiance_record(const FinalGatherer& gatherer, const DiffusePoint& point,
                                         const CacheBuildSettings& settings, Rng& rng, RayCounters& counters);
 
+/// Fills a cache for `camera`. With `start` (a cache built earlier for another view of the same
+/// scene and settings, see start_matches), the cache starts as a copy of it: its records serve
+/// this view where they are valid and the waves add records only where none is (Radiance's
+/// ambient file carried from view to view). The result depends on `start` and the camera alone.
 std::unique_ptr<IrradianceCache> build_irradiance_cache(const RenderScene& scene, const FinalGatherer& gatherer,
                                                         const Camera& camera, const CacheBuildSettings& settings,
-                                                        CacheBuildStatistics* statistics);
+                                                        CacheBuildStatistics* statistics,
+                                                        const IrradianceCache* start = nullptr);
+
+/// Whether `start` can start a cache of `scene` with `settings`: the same accuracy and gradients,
+/// and an octree over the same bounds (records of another scene are not).
+bool start_matches(const IrradianceCache& start, const RenderScene& scene, const CacheBuildSettings& settings);
 
 }  // namespace photond

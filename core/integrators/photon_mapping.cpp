@@ -38,15 +38,16 @@ PhotonMapIntegrator::PhotonMapIntegrator(std::shared_ptr<const RenderScene> scen
                                                                   : scene_->lights.get();
 }
 
-void PhotonMapIntegrator::prepare(const Camera& camera, CacheBuildStatistics* statistics) {
+void PhotonMapIntegrator::prepare(const Camera& camera, CacheBuildStatistics* statistics,
+                                  const IrradianceCache* start) {
     if (!gatherer_ || !settings_.irradiance_cache) return;
     CacheBuildSettings build = settings_.cache;
     build.max_specular_depth = settings_.max_specular_depth;
-    cache_ = build_irradiance_cache(*scene_, *gatherer_, camera, build, statistics);
+    cache_ = build_irradiance_cache(*scene_, *gatherer_, camera, build, statistics, start);
 }
 
 std::string PhotonMapIntegrator::render_cache_key(const std::string& photon_map_key, const CameraDesc& camera,
-                                                  int width, int height) const {
+                                                  int width, int height, const std::string& start_key) const {
     Sha256 hasher;
     const auto hash_float = [&](float value) { hasher.update_value(value == 0.0f ? 0.0f : value); };
     const auto hash_vec3 = [&](const Vec3& v) {
@@ -83,6 +84,8 @@ std::string PhotonMapIntegrator::render_cache_key(const std::string& photon_map_
     hasher.update_value(uint32_t(gather.k_global));
     hash_float(gather.max_radius);
     hasher.update_value(uint8_t(gather.gather_diffuse_sky));
+    // A cache that starts from another holds that one's records: its key is part of this one.
+    if (!start_key.empty()) hasher.update_string(start_key);
     return "rc1-" + Sha256::hex(hasher.finish());
 }
 

@@ -50,15 +50,18 @@ public:
 
     /// Whether this integrator fills an irradiance cache (final gathering with the cache on).
     bool uses_irradiance_cache() const { return gatherer_ && settings_.irradiance_cache; }
-    /// Fills the irradiance cache for this camera (a no-op without final gathering or cache).
-    void prepare(const Camera& camera, CacheBuildStatistics* statistics);
+    /// Fills the irradiance cache for this camera (a no-op without final gathering or cache),
+    /// starting from `start` when given (build_irradiance_cache; check start_matches first).
+    void prepare(const Camera& camera, CacheBuildStatistics* statistics, const IrradianceCache* start = nullptr);
+    const CacheBuildSettings& cache_settings() const { return settings_.cache; }
     /// Takes a cache prepare() built earlier for the same render_cache_key (another job or node).
     void use_cache(std::shared_ptr<const IrradianceCache> cache) { cache_ = std::move(cache); }
     /// The content key of the cache prepare() builds for this camera over maps of
     /// `photon_map_key`: "rc1-" + 64 hex digits, from the photon-map key, the camera and image
-    /// size, the cache's and gathering's settings, the seed and kRenderCacheAlgorithmVersion.
-    std::string render_cache_key(const std::string& photon_map_key, const CameraDesc& camera, int width,
-                                 int height) const;
+    /// size, the cache's and gathering's settings, the seed, the key of the cache it starts from
+    /// (if any) and kRenderCacheAlgorithmVersion.
+    std::string render_cache_key(const std::string& photon_map_key, const CameraDesc& camera, int width, int height,
+                                 const std::string& start_key = "") const;
 
     Color radiance(const CameraRay& ray, SampleContext& context) const override;
 

@@ -61,6 +61,8 @@ struct RenderStatistics {
         double seconds = 0.0;  // the prepass that placed the records (0 when taken from a store)
         std::string cache;     // "hit" when taken from the render-cache store, "miss" when built
         std::string key;       // its render-cache key (with a store)
+        std::string start_from;       // the key of the cache it started from, if any
+        uint64_t records_reused = 0;  // records taken from that cache
         double interpolated_share() const {
             return lookups > 0 ? 1.0 - static_cast<double>(misses) / static_cast<double>(lookups) : 0.0;
         }

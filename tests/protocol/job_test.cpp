@@ -161,7 +161,7 @@ Job full_job() {
     job.integrator = "path";
     job.photons = PhotonSpec{123, 456, 9, 999, 0xfedcba9876543210ull};
     job.gather.rays = 333;
-    job.irradiance_cache = IrradianceCacheSpec{false, 0.1234567890123, false, 0.1, 1024.0};
+    job.irradiance_cache = IrradianceCacheSpec{false, 0.1234567890123, false, 0.1, 1024.0, "rc1-" + std::string(64, 'e')};
     job.output = OutputSpec{"float", {"depth", "direct", "normal"}, -2.5};
     job.environment = EnvironmentSpec{.kind = EnvironmentSpec::Kind::Image,
                                       .image = "skies/noon.hdr",

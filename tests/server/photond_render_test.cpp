@@ -136,6 +136,53 @@ TEST_F(PhotondRender, ACacheDirectoryPreparedOnceServesLaterRendersWithTheSameBy
     EXPECT_TRUE(read_file(dir_ / "cached.exr") == read_file(dir_ / "alone.exr"));
 }
 
+TEST_F(PhotondRender, AViewsIrradianceCacheStartsFromAnEarlierViewsDeterministically) {
+    // irradiance_cache.start_from: the second view's cache begins with the first view's records
+    // and adds records only where they do not serve; the same for any thread count.
+    const std::string common = "render builtin:cornell-box-diffuse --preset preview --width 64 --height 48 --quiet ";
+    const std::string second_view =
+        "--set 'camera.look_from=[1.8,2.2,-7.0]' --set 'camera.look_at=[3.2,2.5,2.8]' --set camera.vfov_deg=38 ";
+    const std::string cache = "--cache-dir " + (dir_ / "cache").string() + " ";
+    ASSERT_EQ(run(common + cache + "-o " + (dir_ / "first.exr").string() + " --stats-json " +
+                  (dir_ / "first.json").string())
+                  .exit_code,
+              0);
+    const json first = json::parse(read_file(dir_ / "first.json")).at("irradiance_cache");
+    const std::string start = "--set irradiance_cache.start_from=" + first.at("key").get<std::string>() + " ";
+    for (const char* threads : {"1", "2"}) {
+        const auto chained = run(common + cache + second_view + start + "--threads " + threads + " -o " +
+                                 (dir_ / (std::string("chained") + threads + ".exr")).string() + " --stats-json " +
+                                 (dir_ / "chained.json").string());
+        ASSERT_EQ(chained.exit_code, 0) << chained.output;
+        fs::remove_all(dir_ / "cache" / "render-caches");  // built again: the same bytes
+        ASSERT_EQ(run(common + cache + "-o " + (dir_ / "first.exr").string()).exit_code, 0);
+    }
+    EXPECT_TRUE(read_file(dir_ / "chained1.exr") == read_file(dir_ / "chained2.exr"));
+    const json chained = json::parse(read_file(dir_ / "chained.json")).at("irradiance_cache");
+    EXPECT_EQ(chained.at("start_from"), first.at("key"));
+    EXPECT_EQ(chained.at("records_reused"), first.at("records"));
+    EXPECT_GT(chained.at("records").get<uint64_t>(), first.at("records").get<uint64_t>());
+    ASSERT_EQ(run(common + cache + second_view + "-o " + (dir_ / "alone.exr").string() + " --stats-json " +
+                  (dir_ / "alone.json").string())
+                  .exit_code,
+              0);
+    const json alone = json::parse(read_file(dir_ / "alone.json")).at("irradiance_cache");
+    EXPECT_NE(alone.at("key"), chained.at("key"));
+    // It needs the store, the key must be there, and be a key.
+    const auto no_store = run(common + second_view + start + "-o " + (dir_ / "x.exr").string());
+    EXPECT_EQ(no_store.exit_code, 1);
+    EXPECT_NE(no_store.output.find("needs --cache-dir"), std::string::npos) << no_store.output;
+    const auto missing = run(common + cache + second_view + "--set irradiance_cache.start_from=rc1-" +
+                             std::string(64, 'a') + " -o " + (dir_ / "x.exr").string());
+    EXPECT_EQ(missing.exit_code, 1);
+    EXPECT_NE(missing.output.find("no render cache rc1-aaaa"), std::string::npos) << missing.output;
+    const auto malformed = run(common + cache + "--set irradiance_cache.start_from=view1 -o " + (dir_ / "x.exr").string());
+    EXPECT_EQ(malformed.exit_code, 2);
+    EXPECT_NE(malformed.output.find("irradiance_cache.start_from: must be a render-cache key"), std::string::npos)
+        << malformed.output;
+    EXPECT_FALSE(fs::exists(dir_ / "x.exr"));
+}
+
 TEST_F(PhotondRender, JobFileAndSetOverrides) {
     std::ofstream(dir_ / "job.json") << R"({"scene": {"builtin": "furnace"}, "integrator": "direct",
         "image": {"width": 16, "height": 8, "spp": 1}})";
