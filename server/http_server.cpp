@@ -38,6 +38,8 @@ using Handler = std::function<void(const Request&, Response&)>;
 constexpr const char* kJsonType = "application/json";
 constexpr const char* kProblemType = "application/problem+json";
 constexpr const char* kExrType = "image/x-exr";
+/// The most views one batch may carry.
+constexpr size_t kMaxBatchViews = 1000;
 // HTTP threads kept waiting for the next burst of connections; the others end after the timeout.
 constexpr size_t kKeptHttpThreads = 8;
 constexpr std::chrono::milliseconds kHttpThreadIdleTimeout{10000};
@@ -232,6 +234,7 @@ struct HttpServer::Impl {
     void list_photon_maps(const Request& req, Response& res);
     void export_photon_maps(const Request& req, Response& res);
     void import_photon_maps(const Request& req, Response& res);
+    void submit_batch(const Request& req, Response& res);
     void list_render_caches(const Request& req, Response& res);
     void export_render_cache(const Request& req, Response& res);
     void import_render_cache(const Request& req, Response& res);
@@ -258,6 +261,7 @@ void HttpServer::Impl::register_routes() {
     };
     route("POST", "/v1/jobs", bind_handler(&Impl::submit_job));
     route("GET", "/v1/jobs", bind_handler(&Impl::list_jobs));
+    route("POST", "/v1/batches", bind_handler(&Impl::submit_batch));
     route("GET", job, bind_handler(&Impl::get_job));
     route("DELETE", job, bind_handler(&Impl::cancel_job));
     route("GET", job + "/events", bind_handler(&Impl::job_events));
@@ -447,6 +451,46 @@ void HttpServer::Impl::submit_job(const Request& req, Response& res) {
     const JobManager::Submitted submitted = services.jobs.submit(job, key);
     res.set_header("Location", "/v1/jobs/" + submitted.status.id);
     send_json(res, protocol::to_json(submitted.status), submitted.created ? 202 : 200);
+}
+
+void HttpServer::Impl::submit_batch(const Request& req, Response& res) {
+    if (req.body.empty())
+        throw ServiceError(ErrorKind::MalformedRequest,
+                           "the request has no body: send {\"job\": {...}, \"cameras\": [{...}, ...]}");
+    if (json_nesting_depth(req.body) > kMaxJsonNesting)
+        throw ServiceError(ErrorKind::MalformedRequest, json_nesting_message());
+    const json document = json::parse(req.body, nullptr, false);
+    if (document.is_discarded()) throw ServiceError(ErrorKind::MalformedRequest, "the batch is not valid JSON");
+    if (!document.is_object()) throw ServiceError(ErrorKind::InvalidField, "a batch must be a JSON object", "");
+    for (const auto& [name, value] : document.items())
+        if (name != "job" && name != "cameras")
+            throw ServiceError(ErrorKind::InvalidField, "unknown field (expected \"job\" and \"cameras\")", name);
+    if (!document.contains("job") || !document["job"].is_object())
+        throw ServiceError(ErrorKind::InvalidField, "must be the job description every view shares", "job");
+    const json& cameras = document.value("cameras", json());
+    if (!cameras.is_array() || cameras.empty() || cameras.size() > kMaxBatchViews)
+        throw ServiceError(ErrorKind::InvalidField,
+                           "must be a list of 1 to " + std::to_string(kMaxBatchViews) + " cameras, one per view",
+                           "cameras");
+    if (document["job"].contains("camera"))
+        throw ServiceError(ErrorKind::InvalidField, "the views' cameras are the batch's \"cameras\"", "job.camera");
+    std::vector<protocol::Job> views;
+    for (size_t k = 0; k < cameras.size(); ++k) {
+        json view = document["job"];
+        view["camera"] = cameras[k];
+        auto parsed = protocol::parse_job_detailed(view);
+        if (auto* error = std::get_if<protocol::FieldError>(&parsed)) {
+            // Named as the batch names it: cameras[k]... or job....
+            const bool camera = error->path == "camera" || error->path.rfind("camera.", 0) == 0;
+            const std::string path = camera ? "cameras[" + std::to_string(k) + "]" + error->path.substr(6)
+                                            : "job." + error->path;
+            throw ServiceError(ErrorKind::InvalidField, path + ": " + error->message, path);
+        }
+        views.push_back(std::get<protocol::Job>(std::move(parsed)));
+    }
+    json jobs = json::array();
+    for (const protocol::JobStatus& status : services.jobs.submit_batch(views)) jobs.push_back(protocol::to_json(status));
+    send_json(res, {{"jobs", std::move(jobs)}}, 202);
 }
 
 void HttpServer::Impl::list_jobs(const Request& req, Response& res) {

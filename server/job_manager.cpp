@@ -419,11 +419,15 @@ JobManager::Submitted JobManager::submit(const protocol::Job& job,
         submission.sequence = next_sequence_++;
     }
     check_scene(job);
-    submission.created_at_ms = now_ms();
-    submission.id = make_job_id(submission.sequence, submission.created_at_ms);
     submission.job = job;
     submission.idempotency_key = idempotency_key;
     submission.request_digest = digest;
+    return {enqueue(std::move(submission)), true};
+}
+
+protocol::JobStatus JobManager::enqueue(JobSubmission submission) {
+    submission.created_at_ms = now_ms();
+    submission.id = make_job_id(submission.sequence, submission.created_at_ms);
     auto entry = std::make_shared<Entry>(submission);
     // On disk first: a job the client was told about survives a crash right after. A job that
     // cannot be kept whole leaves nothing (the next start reported each such directory).
@@ -440,13 +444,70 @@ JobManager::Submitted JobManager::submit(const protocol::Job& job,
         push_event_locked(*entry, JobEventType::State, {{"state", "queued"}});
         jobs_[entry->id()] = entry;
         arrival_order_.push_back(entry->id());
-        queue_.insert({{-job.priority, submission.sequence}, entry->id()});
-        if (!idempotency_key.empty()) idempotency_keys_[idempotency_key] = entry->id();
+        queue_.insert({{-submission.job.priority, submission.sequence}, entry->id()});
+        if (!submission.idempotency_key.empty()) idempotency_keys_[submission.idempotency_key] = entry->id();
         status = entry->status;
     }
     metrics_->record_submitted();
     work_available_.notify_one();
-    return {status, true};
+    return status;
+}
+
+std::vector<protocol::JobStatus> JobManager::submit_batch(const std::vector<protocol::Job>& views) {
+    std::lock_guard submit_lock(submit_mutex_);
+    uint64_t first_sequence = 0;
+    {
+        std::lock_guard lock(mutex_);
+        if (stopping_) throw ServiceError(ErrorKind::Unavailable, "the daemon is shutting down");
+        if (queue_.size() + views.size() > options_.max_queued) {
+            const int retry = retry_after_seconds_locked();
+            throw ServiceError(ErrorKind::QueueFull, "the queue holds " + std::to_string(queue_.size()) +
+                                                         " jobs and the batch " + std::to_string(views.size()) +
+                                                         " (--max-queued " + std::to_string(options_.max_queued) +
+                                                         "); retry in " + std::to_string(retry) + " s")
+                .with_header("Retry-After", std::to_string(retry));
+        }
+        first_sequence = next_sequence_;
+        next_sequence_ += views.size();
+    }
+    for (size_t k = 0; k < views.size(); ++k) check_scene(views[k]);
+    // The views run in their order (one priority, consecutive arrivals), each irradiance cache
+    // starting from the one before when there is one (photon-map with the cache on).
+    std::vector<protocol::JobStatus> queued;
+    try {
+        for (size_t k = 0; k < views.size(); ++k) {
+            JobSubmission submission;
+            submission.sequence = first_sequence + k;
+            submission.job = views[k];
+            const std::string normalized = protocol::json_text(protocol::to_json(views[k]));
+            submission.request_digest =
+                sha256_hex({reinterpret_cast<const uint8_t*>(normalized.data()), normalized.size()});
+            const bool chained = views[k].integrator == "photon-map" && views[k].irradiance_cache.enabled &&
+                                 views[k].irradiance_cache.start_from.empty();
+            if (k > 0 && chained) submission.start_from_job = queued.back().id;
+            queued.push_back(enqueue(std::move(submission)));
+        }
+    } catch (...) {
+        // A batch that cannot be queued whole leaves no view to run: those queued are cancelled.
+        for (const protocol::JobStatus& status : queued) cancel(status.id, std::chrono::milliseconds(0));
+        throw;
+    }
+    return queued;
+}
+
+std::string JobManager::start_key_of(const std::string& earlier_id) const {
+    std::unique_lock lock(mutex_);
+    const auto earlier = find_locked(lock, earlier_id);
+    const protocol::JobStatus& s = earlier->status;
+    if (s.state != JobState::Done)
+        throw std::runtime_error("the batch's earlier view, job " + earlier_id + ", is " +
+                                 std::string(protocol::to_string(s.state)) +
+                                 (s.error.empty() ? std::string() : " (" + s.error + ")") +
+                                 ": its irradiance cache, where this view's starts, is missing");
+    if (!s.statistics || !s.statistics->contains("irradiance_cache") ||
+        !s.statistics->at("irradiance_cache").contains("key"))
+        throw std::runtime_error("the batch's earlier view, job " + earlier_id + ", kept no irradiance cache");
+    return s.statistics->at("irradiance_cache").at("key").get<std::string>();
 }
 
 std::shared_ptr<JobManager::Entry> JobManager::find_locked(std::unique_lock<std::mutex>& lock,
@@ -931,7 +992,18 @@ void JobManager::run(const std::shared_ptr<Entry>& entry) {
         e.changed.notify_all();
     };
 
-    auto result = run_job(e.submission.job, device_, options);
+    protocol::Job job = e.submission.job;
+    if (!e.submission.start_from_job.empty()) {
+        std::string key;
+        try {
+            key = start_key_of(e.submission.start_from_job);
+        } catch (const std::exception& error) {
+            finish(entry, JobState::Failed, error.what(), nullptr);
+            return;
+        }
+        job.irradiance_cache.start_from = key;
+    }
+    auto result = run_job(job, device_, options);
     if (result) {
         std::lock_guard lock(run_warnings_mutex);
         for (const std::string& w : run_warnings) result->statistics.warnings.push_back(w);
@@ -980,7 +1052,6 @@ void JobManager::run(const std::shared_ptr<Entry>& entry) {
     // The final image, written before the job is announced done so that it can be fetched
     // as soon as a client hears of it. (The PNG preview is made on its first request.)
     options.on_pass("writing");
-    const protocol::Job& job = e.submission.job;
     const ExrWriteOptions exr = exr_options(job);
     const Clock::time_point writing_started = Clock::now();
     if (Status written = write_exr(store_.image_path(e.id()), result->layers, exr); !written) {

@@ -104,6 +104,12 @@ public:
     /// description), QueueFull (with Retry-After), Unavailable (shutting down, disk failure).
     Submitted submit(const protocol::Job& job, const std::string& idempotency_key);
 
+    /// Queues a batch of views (jobs of one scene with their cameras), in order (a view that
+    /// cannot be queued cancels those queued before it); with photon-map and the irradiance cache on, each view's cache starts from the view
+    /// before (irradiance_cache.start_from, resolved when it runs): deterministic for the batch.
+    /// Throws as submit.
+    std::vector<protocol::JobStatus> submit_batch(const std::vector<protocol::Job>& views);
+
     /// Throws ServiceError NotFound for an unknown id (so do the members below).
     protocol::JobStatus status(const std::string& id) const;
     /// Newest first; `state` filters; job lists carry no statistics.
@@ -171,6 +177,11 @@ private:
     /// The event history of a job read from disk, rebuilt from its state and, where it was kept,
     /// where its streams ended.
     void push_history_locked(Entry& entry, const std::optional<JobStore::StreamHistory>& kept) const;
+    /// Saves a submission (sequence, job and digest filled) and queues it; its status.
+    protocol::JobStatus enqueue(JobSubmission submission);
+    /// The render-cache key of a done job (a batch's earlier view); throws std::runtime_error
+    /// saying why there is none.
+    std::string start_key_of(const std::string& earlier_id) const;
     /// Checks the job's scene and its lighting (throws InvalidField naming the field).
     void check_scene(const protocol::Job& job) const;
     /// The pipeline's options for this daemon's jobs (no callbacks).

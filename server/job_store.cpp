@@ -58,12 +58,13 @@ Status JobStore::save_submission(const JobSubmission& s) {
     if (error)
         return Error{job_directory(s.id).string() + ": cannot be created (" + error.message() +
                      ")"};
-    const json document = {{"id", s.id},
+    json document = {{"id", s.id},
                            {"job", protocol::to_json(s.job)},
                            {"sequence", s.sequence},
                            {"created_at", protocol::format_timestamp(s.created_at_ms)},
                            {"idempotency_key", s.idempotency_key},
                            {"request_digest", s.request_digest}};
+    if (!s.start_from_job.empty()) document["start_from_job"] = s.start_from_job;
     return write_file_atomically(job_directory(s.id) / "job.json", protocol::json_text(document, 2) + "\n");
 }
 
@@ -115,6 +116,7 @@ Expected<StoredJob> JobStore::load(const std::string& id) const {
             protocol::parse_timestamp(submission_json->value("created_at", std::string())).value_or(0);
         s.idempotency_key = submission_json->value("idempotency_key", std::string());
         s.request_digest = submission_json->value("request_digest", std::string());
+        s.start_from_job = submission_json->value("start_from_job", std::string());
         if (s.id != id) throw std::runtime_error("id does not match the directory");
     } catch (const std::exception& e) {
         return Error{(dir / "job.json").string() + ": " + e.what()};

@@ -35,6 +35,9 @@ struct JobSubmission {
     int64_t created_at_ms = 0;
     std::string idempotency_key;  // empty when the request had none
     std::string request_digest;   // SHA-256 of the normalized job, for Idempotency-Key checks
+    /// A batch's earlier view: this job's irradiance cache starts from that job's (resolved when
+    /// it runs; empty for a job of its own).
+    std::string start_from_job;
 };
 
 struct StoredJob {

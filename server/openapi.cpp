@@ -294,6 +294,33 @@ json openapi_document() {
                    "rc1-<64 hex digits> (statistics.irradiance_cache.key in a job's status)");
     paths["/v1/jobs"]["post"]["requestBody"] = {
         {"required", true}, {"content", {{"application/json", {{"schema", ref("Job")}}}}}};
+    paths["/v1/batches"] = {
+        {"post",
+         operation("submitBatch",
+                   "Queue views of one scene as a job each, in order: photon maps traced once, each view's "
+                   "irradiance cache starting from the one before",
+                   {{"202", response("queued", content("application/json",
+                                                       {{"type", "object"},
+                                                        {"properties",
+                                                         {{"jobs", {{"type", "array"}, {"items", ref("JobStatus")}}}}}}))},
+                    {"400", problem("malformed JSON")},
+                    {"413", problem("request body too large (--max-body-mb)")},
+                    {"422", problem("invalid batch: `field` names job.<field> or cameras[k].<field>")},
+                    {"429", problem("the queue cannot take the whole batch (--max-queued)")},
+                    {"503", problem("shutting down")}})}};
+    paths["/v1/batches"]["post"]["requestBody"] = {
+        {"required", true},
+        {"content",
+         {{"application/json",
+           {{"schema",
+             {{"type", "object"},
+              {"required", json::array({"job", "cameras"})},
+              {"additionalProperties", false},
+              {"properties",
+               {{"job", {{"description", "the job every view shares (without camera)"}, {"$ref", "#/components/schemas/Job"}}},
+                {"cameras",
+                 {{"type", "array"}, {"minItems", 1}, {"maxItems", 1000},
+                  {"description", "one camera per view (the Job's camera field)"}}}}}}}}}}}};
     paths["/healthz"] = {
         {"get", operation("healthz", "Liveness",
                           {{"200", response("ok", content("text/plain", {{"type", "string"}}))}},

@@ -306,6 +306,7 @@ TEST_F(DaemonApi, OpenApiHealthReadinessAndMetrics) {
         {"/v1/photon-maps/{key}", "put"},
         {"/v1/photon-maps", "get"},
         {"/v1/render-caches", "get"},
+        {"/v1/batches", "post"},
         {"/v1/render-caches/{key}", "get"},
         {"/v1/render-caches/{key}", "put"},
         {"/healthz", "get"},

@@ -324,6 +324,68 @@ TEST_F(DaemonCache, AViewsIrradianceCacheIsBuiltOnceForItsJobsAndRegionsAndTrave
     EXPECT_TRUE(image_of(remote, imported) == whole);
 }
 
+TEST_F(DaemonCache, ABatchOfViewsTracesOnceAndCarriesTheIrradianceCacheFromViewToView) {
+    // POST /v1/batches: a job per view, run in order; the photon maps are traced once and each
+    // view's irradiance cache starts from the one before, as photond render does with
+    // irradiance_cache.start_from: the same bytes on a daemon and offline.
+    const json shared = {{"scene", {{"builtin", "cornell-box-diffuse"}}},
+                         {"preset", "preview"},
+                         {"image", {{"width", 64}, {"height", 48}}}};
+    const json cameras = json::array({json{{"look_from", {2.78, 2.73, -8.0}}, {"look_at", {2.78, 2.73, 0.0}}},
+                                      json{{"look_from", {1.8, 2.2, -7.0}}, {"look_at", {3.2, 2.5, 2.8}},
+                                           {"vfov_deg", 38}}});
+    Daemon daemon(dir_.path() / "cache");
+    ASSERT_TRUE(daemon.started()) << daemon.log();
+    const HttpClient client = daemon.client();
+    const HttpResponse submitted = client.post("/v1/batches", json{{"job", shared}, {"cameras", cameras}}.dump());
+    ASSERT_EQ(submitted.status, 202) << submitted.body;
+    const json jobs = submitted.json_body().at("jobs");
+    ASSERT_EQ(jobs.size(), 2u);
+    std::vector<json> views;
+    for (const json& job : jobs) views.push_back(wait_for_status(client, job.at("id"), is_terminal_state));
+    ASSERT_EQ(views[0].at("state"), "done") << views[0].dump();
+    ASSERT_EQ(views[1].at("state"), "done") << views[1].dump();
+    EXPECT_EQ(views[0].at("photons").at("cache"), "miss");
+    EXPECT_EQ(views[1].at("photons").at("cache"), "hit");
+    const json& first = views[0].at("statistics").at("irradiance_cache");
+    const json& second = views[1].at("statistics").at("irradiance_cache");
+    EXPECT_EQ(second.at("start_from"), first.at("key"));
+    EXPECT_EQ(second.at("records_reused"), first.at("records"));
+    EXPECT_GT(second.at("records").get<uint64_t>(), first.at("records").get<uint64_t>());
+
+    // Offline, view by view with a cache directory: the same keys and bytes.
+    const fs::path offline = dir_.path() / "offline";
+    for (size_t k = 0; k < 2; ++k) {
+        json view = shared;
+        view["camera"] = cameras[k];
+        if (k == 1) view["irradiance_cache"] = {{"start_from", first.at("key")}};
+        write_file(dir_.path() / ("view" + std::to_string(k) + ".json"), view.dump());
+        const auto [code, output] = run_command(kPhotondBinary + " render --quiet --cache-dir " + offline.string() +
+                                                " --job " + (dir_.path() / ("view" + std::to_string(k) + ".json")).string() +
+                                                " -o " + (dir_.path() / ("view" + std::to_string(k) + ".exr")).string());
+        ASSERT_EQ(code, 0) << output;
+        const std::string id = views[k].at("id");
+        EXPECT_TRUE(read_file(dir_.path() / ("view" + std::to_string(k) + ".exr")) ==
+                    client.get("/v1/jobs/" + id + "/image.exr").body)
+            << "view " << k;
+    }
+
+    // A batch's problems are named as the batch names them.
+    const HttpResponse bad_camera =
+        client.post("/v1/batches", json{{"job", shared}, {"cameras", {cameras[0], {{"vfov_deg", 500}}}}}.dump());
+    EXPECT_EQ(bad_camera.status, 422);
+    EXPECT_EQ(bad_camera.json_body().value("field", ""), "cameras[1].look_from") << bad_camera.body;
+    json bad_job = shared;
+    bad_job["image"]["spp"] = 0;
+    EXPECT_EQ(client.post("/v1/batches", json{{"job", bad_job}, {"cameras", cameras}}.dump()).json_body().value("field", ""),
+              "job.image.spp");
+    EXPECT_EQ(client.post("/v1/batches", json{{"job", shared}, {"cameras", json::array()}}.dump()).status, 422);
+    EXPECT_EQ(client.post("/v1/batches", json{{"job", shared}, {"cameras", cameras}, {"extra", 1}}.dump())
+                  .json_body()
+                  .value("field", ""),
+              "extra");
+}
+
 TEST_F(DaemonCache, TwoDaemonsShareOneCacheDirectoryAndBuildEachKeyOnce) {
     // Render farms share photon maps and render caches through a common --cache-dir: both daemons
     // get the same job at once, one builds each key (a lock file per key) while the other waits
