@@ -163,6 +163,14 @@ test-deploy: build
 	$(call install_missing,$(DEPLOY_PACKAGES))
 	python3 tests/deploy/check_deploy.py $(BUILD)/server/photond
 
+# deploy/docker/Dockerfile's runtime stage without Docker: a debootstrap Debian 12 root file
+# system, the stage's RUN line, the built binaries, the ENTRYPOINT and HEALTHCHECK run in it
+# (tests/deploy/container_rootfs_test.sh; as root; run by CI, about 35 s the first time).
+.PHONY: test-container
+test-container: build
+	$(call install_missing,debootstrap curl)
+	bash tests/deploy/container_rootfs_test.sh $(BUILD)
+
 format:
 	find core protocol server clients tests bench -name '*.h' -o -name '*.cpp' | xargs clang-format -i
 
