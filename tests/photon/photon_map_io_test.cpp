@@ -14,6 +14,7 @@
 #include <mutex>
 #include <thread>
 
+#include "tests/checked_file_format.h"
 #include "core/math/rng.h"
 #include "core/photon/photon_tracer.h"
 #include "core/scene/builtin_scenes.h"
@@ -392,35 +393,16 @@ TEST(PhotonMapIo, EveryFlippedByteIsRefused) {
     Rng rng(21, 0);
     for (int i = 0; i < 40; ++i) positions.push_back(rng.next_u32() % original.size());
     for (size_t i = original.size() - 32; i < original.size(); ++i) positions.push_back(i);
-    std::vector<uint8_t> bytes = original;
-    for (size_t position : positions) {
-        for (uint8_t flip : {uint8_t(0x01), uint8_t(0x80)}) {
-            bytes[position] ^= flip;
-            Expected<PhotonMaps> result = deserialize_photon_maps(bytes, kKey);
-            ASSERT_FALSE(result) << "flip " << int(flip) << " at byte " << position;
-            EXPECT_FALSE(result.error().message.empty());
-            bytes[position] = original[position];
-        }
-    }
-    EXPECT_EQ(bytes, original);
-    EXPECT_TRUE(deserialize_photon_maps(bytes, kKey));
+    photond::test::expect_every_flip_refused(original, positions, [](std::span<const uint8_t> bytes) {
+        return deserialize_photon_maps(bytes, kKey);
+    });
 }
 
 TEST(PhotonMapIo, EveryTruncationIsRefused) {
     const std::vector<uint8_t>& original = cornell_bytes();
-    std::vector<size_t> lengths;
-    for (size_t n = 0; n < 200; ++n) lengths.push_back(n);
-    for (size_t n = 200; n < original.size(); n += 4099) lengths.push_back(n);
-    for (size_t n = original.size() - 40; n < original.size(); ++n) lengths.push_back(n);
-    for (size_t n : lengths) {
-        Expected<PhotonMaps> result = deserialize_photon_maps(std::span(original).first(n), kKey);
-        ASSERT_FALSE(result) << "truncated to " << n << " bytes";
-        EXPECT_FALSE(result.error().message.empty());
-    }
-    // Extra bytes after the checksum are refused too.
-    std::vector<uint8_t> longer = original;
-    longer.push_back(0);
-    EXPECT_FALSE(deserialize_photon_maps(longer, kKey));
+    photond::test::expect_every_truncation_refused(original, 4099, [](std::span<const uint8_t> bytes) {
+        return deserialize_photon_maps(bytes, kKey);
+    });
 }
 
 TEST(PhotonMapIo, ForeignDataIsRefused) {
@@ -495,24 +477,7 @@ TEST(PhotonMapIo, AResealedBrokenTreeIsRefused) {
 
 // ---- Files ------------------------------------------------------------------------------------
 
-class PhotonMapFileTest : public ::testing::Test {
-protected:
-    void SetUp() override {
-        const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        directory_ = std::filesystem::temp_directory_path() /
-                     ("photond-photon-map-io-" + std::to_string(::getpid()) + "-" + info->name());
-        std::filesystem::remove_all(directory_);
-        std::filesystem::create_directories(directory_);
-    }
-    void TearDown() override { std::filesystem::remove_all(directory_); }
-
-    size_t files_in_directory() const {
-        return size_t(std::distance(std::filesystem::directory_iterator(directory_),
-                                    std::filesystem::directory_iterator()));
-    }
-
-    std::filesystem::path directory_;
-};
+class PhotonMapFileTest : public photond::test::ScratchDirectoryTest {};
 
 TEST_F(PhotonMapFileTest, WritesAndReadsBack) {
     const std::filesystem::path path = directory_ / "maps.pm";
