@@ -160,6 +160,15 @@ class PhotondClient:
             raise PhotondError(0, "the server accepted the job but sent no job id")
         return answer["id"]
 
+    def submit_batch(self, job: Dict[str, Any], cameras: List[Dict[str, Any]]) -> List[str]:
+        """POST /v1/batches: a job per camera, run in order, each view's irradiance cache
+        starting from the one before; returns the views' job ids in order."""
+        answer = self._json("POST", "/v1/batches", {"job": job, "cameras": cameras})
+        jobs = answer.get("jobs") if isinstance(answer, dict) else None
+        if not isinstance(jobs, list) or len(jobs) != len(cameras):
+            raise PhotondError(0, "the server accepted the batch but sent no job ids")
+        return [str(view["id"]) for view in jobs]
+
     def status(self, job_id: str) -> Dict[str, Any]:
         """GET /v1/jobs/{id}: state, progress, plan, timings, photons.cache, error."""
         return self._json("GET", self._job_path(job_id))
@@ -281,6 +290,33 @@ class PhotondClient:
         if not isinstance(answer, dict) or "id" not in answer:
             raise PhotondError(0, "the server accepted the scene but sent no id")
         return str(answer["id"])
+
+    # -- photon maps and render caches ---------------------------------------------------------
+
+    _CACHE_KINDS = ("photon-maps", "render-caches")
+
+    def export_cache(self, kind: str, key: str, path: str) -> str:
+        """GET /v1/photon-maps/{key} or /v1/render-caches/{key} (kind "photon-maps" or
+        "render-caches"; the keys are photons.key and statistics.irradiance_cache.key of a job's
+        status) into a file; returns the path."""
+        if kind not in self._CACHE_KINDS:
+            raise ValueError(f"kind must be one of {self._CACHE_KINDS}")
+        with self._open("GET", f"/v1/{kind}/{urllib.parse.quote(key, safe='')}") as response:
+            data = response.read()
+        with open(path, "wb") as out:
+            out.write(data)
+        return path
+
+    def import_cache(self, kind: str, key: str, path: str) -> bool:
+        """PUT the file exported by export_cache on another daemon; True when the key was new
+        there, False when the same artifact was already kept (PhotondError 409 for another)."""
+        if kind not in self._CACHE_KINDS:
+            raise ValueError(f"kind must be one of {self._CACHE_KINDS}")
+        with open(path, "rb") as source:
+            body = source.read()
+        answer = self._json_body("PUT", f"/v1/{kind}/{urllib.parse.quote(key, safe='')}", body,
+                                 "application/octet-stream")
+        return bool(answer.get("created")) if isinstance(answer, dict) else False
 
     def _json_body(self, method: str, path: str, body: bytes, content_type: str) -> Any:
         with self._open(method, path, body, {"Content-Type": content_type}) as response:

@@ -144,6 +144,40 @@ class PythonClientTest(unittest.TestCase):
         self.assertEqual(second_status["photons"]["cache"], "hit")
         self.assertEqual(second_status["timings"].get("photon_tracing", 0.0), 0.0)
 
+    def test_batch_views_and_caches_move_to_another_daemon(self):
+        job = small_job()
+        job.pop("camera", None)
+        job["integrator"] = "photon-map"
+        job["photons"] = {"global": 2000, "caustic": 1000, "seed": 11}
+        cameras = [{"look_from": [0, 2.75, 10.75], "look_at": [0, 2.75, 0]},
+                   {"look_from": [1.5, 3.0, 10.0], "look_at": [0, 2.75, 0]}]
+        ids = self.client.submit_batch(job, cameras)
+        self.assertEqual(len(ids), 2)
+        views = [self.client.wait(job_id, timeout=60) for job_id in ids]
+        for view in views:
+            self.assertEqual(view["state"], "done", view)
+        first_cache = views[0]["statistics"]["irradiance_cache"]
+        self.assertEqual(views[1]["statistics"]["irradiance_cache"]["start_from"], first_cache["key"])
+        # Both artifacts of the first view to a second daemon: its job takes them.
+        maps = self.client.export_cache("photon-maps", views[0]["photons"]["key"], self.path("maps.pm"))
+        cache = self.client.export_cache("render-caches", first_cache["key"], self.path("view.rc"))
+        os.makedirs(os.path.join(self.directory, "other"), exist_ok=True)
+        other = Daemon(os.path.join(self.directory, "other"))
+        try:
+            remote = PhotondClient(other.url)
+            self.assertTrue(remote.import_cache("photon-maps", views[0]["photons"]["key"], maps))
+            self.assertTrue(remote.import_cache("render-caches", first_cache["key"], cache))
+            self.assertFalse(remote.import_cache("render-caches", first_cache["key"], cache))
+            single = dict(job, camera=cameras[0])
+            status = remote.wait(remote.submit(single), timeout=60)
+            self.assertEqual(status["photons"]["cache"], "hit")
+            self.assertEqual(status["statistics"]["irradiance_cache"]["cache"], "hit")
+        finally:
+            other.stop()
+        with self.assertRaises(PhotondError) as refused:
+            self.client.submit_batch(job, [{"vfov_deg": 500}])
+        self.assertEqual(refused.exception.field, "cameras[0].look_from")
+
     def test_example_script_renders_views(self):
         out_dir = self.path("views")
         result = subprocess.run(
