@@ -485,25 +485,28 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     if (!integrator) return integrator.error();
     stats.plan.insert(stats.plan.begin(), environment_decision);
 
-    if (auto* photon_map = dynamic_cast<PhotonMapIntegrator*>(integrator->get());
-        photon_map && photon_map->uses_irradiance_cache()) {
+    auto* photon_map = dynamic_cast<PhotonMapIntegrator*>(integrator->get());
+    if (!job.irradiance_cache.start_from.empty() && !(photon_map && photon_map->uses_irradiance_cache()))
+        stats.warnings.push_back("irradiance_cache.start_from is ignored: this job has no irradiance cache (it needs the "
+                                 "photon-map integrator with irradiance_cache.enabled)");
+    if (photon_map && photon_map->uses_irradiance_cache()) {
         if (options.on_pass) options.on_pass("irradiance_cache");
         pass_start = Clock::now();
         CacheBuildStatistics cache_stats;
         RenderStatistics::IrradianceCacheFigures figures;
         // An earlier view's cache to start from (irradiance_cache.start_from), from the store.
-        std::shared_ptr<const IrradianceCache> start;
+        std::shared_ptr<const IrradianceCache> start_cache;
         if (!job.irradiance_cache.start_from.empty()) {
             const std::string& start_key = job.irradiance_cache.start_from;
             if (!options.render_caches || stats.photon_map_key.empty())
                 return Error{"irradiance_cache.start_from: this render keeps no render caches to start from (photond "
                              "render needs --cache-dir)"};
-            start = options.render_caches->find_cache(start_key);
-            if (!start)
+            start_cache = options.render_caches->find_cache(start_key);
+            if (!start_cache)
                 return Error{"irradiance_cache.start_from: no render cache " + start_key +
                              " here (render that view first, or import its cache with PUT /v1/render-caches/" +
                              start_key + ")"};
-            if (!start_matches(*start, **render_scene, photon_map->cache_settings()))
+            if (!start_matches(*start_cache, **render_scene, photon_map->cache_settings()))
                 return Error{"irradiance_cache.start_from: render cache " + start_key +
                              " was built for another scene or other irradiance_cache.a/gradients"};
             figures.start_from = start_key;
@@ -514,7 +517,7 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
             figures.key = photon_map->render_cache_key(stats.photon_map_key, *camera_desc, job.image.width,
                                                        job.image.height, job.irradiance_cache.start_from);
             const auto build = [&]() -> Expected<std::shared_ptr<const IrradianceCache>> {
-                photon_map->prepare(*camera, &cache_stats, start.get());
+                photon_map->prepare(*camera, &cache_stats, start_cache.get());
                 if (options.callbacks.cancel && options.callbacks.cancel->load())
                     return Error{"cancelled during the irradiance-cache prepass"};  // incomplete: not kept
                 return photon_map->shared_cache();
@@ -529,7 +532,7 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
         }
         if (photon_map->cache()) {
             figures.records = photon_map->cache()->size();
-            if (start) figures.records_reused = start->size();
+            if (start_cache) figures.records_reused = start_cache->size();
             figures.waves = cache_stats.waves;
             figures.seconds = seconds_since(pass_start);
             stats.irradiance_cache = figures;
