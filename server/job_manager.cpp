@@ -1072,8 +1072,10 @@ void JobManager::run(const std::shared_ptr<Entry>& entry) {
         std::lock_guard lock(mutex_);
         e.image_verified = true;
     }
-    result->statistics.passes.push_back(
-        {"writing", std::chrono::duration<double>(Clock::now() - writing_started).count()});
+    // The job's total is the pipeline's and the writing: its passes add up to it.
+    const double writing = std::chrono::duration<double>(Clock::now() - writing_started).count();
+    result->statistics.passes.push_back({"writing", writing});
+    result->statistics.total_seconds += writing;
     {
         std::lock_guard lock(mutex_);
         e.image = std::make_shared<const ImageLayers>(std::move(result->layers));

@@ -117,6 +117,7 @@ Expected<std::shared_ptr<const PhotonMaps>> build_photon_maps(const protocol::Jo
         return std::make_shared<const PhotonMaps>();
     }
     if (options.on_pass) options.on_pass("photon_tracing");
+    const Clock::time_point pass_start = Clock::now();
     const auto trace = [&]() { return trace_photons(scene, settings); };
     std::shared_ptr<const PhotonMaps> maps;
     if (options.photon_maps) {
@@ -157,9 +158,18 @@ Expected<std::shared_ptr<const PhotonMaps>> build_photon_maps(const protocol::Jo
                         std::to_string(maps->statistics.emitted_caustic) + " emitted: the scene has no caustics";
         }
     }
+    // The photon pass in parts: tracing, the kd-trees and the irradiance precomputed at photons
+    // when traced here, and the rest of its wall time (the cache's file written, or read on a
+    // hit) as photon_map_store, so that the passes add up to the whole.
     const bool traced_here = stats.photon_cache != "hit";
-    stats.passes.push_back({"photon_tracing", traced_here ? maps->statistics.tracing_seconds : 0.0});
-    stats.passes.push_back({"photon_kdtree", traced_here ? maps->statistics.build_seconds : 0.0});
+    const PhotonTracingStatistics& traced = maps->statistics;
+    const double tracing = traced_here ? traced.tracing_seconds : 0.0;
+    const double kdtree = traced_here ? traced.build_seconds : 0.0;
+    const double irradiance = traced_here ? traced.irradiance_seconds : 0.0;
+    stats.passes.push_back({"photon_tracing", tracing});
+    stats.passes.push_back({"photon_kdtree", kdtree});
+    stats.passes.push_back({"photon_irradiance", irradiance});
+    stats.passes.push_back({"photon_map_store", std::max(0.0, seconds_since(pass_start) - tracing - kdtree - irradiance)});
     return maps;
 }
 

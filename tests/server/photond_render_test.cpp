@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <vector>
 
@@ -181,6 +182,30 @@ TEST_F(PhotondRender, AViewsIrradianceCacheStartsFromAnEarlierViewsDeterministic
     EXPECT_NE(malformed.output.find("irradiance_cache.start_from: must be a render-cache key"), std::string::npos)
         << malformed.output;
     EXPECT_FALSE(fs::exists(dir_ / "x.exr"));
+}
+
+TEST_F(PhotondRender, ThePassesAddUpToTheTotal) {
+    // Every second accounted for: the photon pass in its parts (the irradiance precomputed at
+    // photons was in no pass: at 10M photons most of the time), on a trace and on a cache hit.
+    const std::string common = "render builtin:cornell-box-diffuse --preset preview --width 96 --height 64 --quiet "
+                               "--cache-dir " + (dir_ / "cache").string() + " --stats-json ";
+    for (const char* run_name : {"traced", "cached"}) {
+        const fs::path stats_file = dir_ / (std::string(run_name) + ".json");
+        ASSERT_EQ(run(common + stats_file.string() + " -o " + (dir_ / "out.exr").string()).exit_code, 0);
+        const json stats = json::parse(read_file(stats_file));
+        double sum = 0.0;
+        std::set<std::string> names;
+        for (const json& pass : stats.at("passes")) {
+            sum += pass.at("seconds").get<double>();
+            names.insert(pass.at("name").get<std::string>());
+        }
+        const double total = stats.at("total_seconds").get<double>();
+        EXPECT_GT(total, 0.0);
+        EXPECT_NEAR(sum, total, 0.02 * total) << run_name << ": " << stats.at("passes").dump();
+        for (const char* name : {"scene", "acceleration", "photon_tracing", "photon_kdtree", "photon_irradiance",
+                                 "photon_map_store", "irradiance_cache", "render"})
+            EXPECT_TRUE(names.contains(name)) << run_name << " lacks the pass " << name;
+    }
 }
 
 TEST_F(PhotondRender, JobFileAndSetOverrides) {
