@@ -123,19 +123,24 @@ bool same_secret(std::string_view given, std::string_view expected) {
     return difference == 0;
 }
 
-protocol::Job decode_job(const std::string& body) {
-    if (body.empty())
-        throw ServiceError(ErrorKind::MalformedRequest, "the request has no body: send the job description as JSON");
+/// A JSON request body; refused when empty (`expected` says what to send), nested deeper than
+/// kMaxJsonNesting or malformed (with the line and column).
+json decode_json_body(const std::string& body, const std::string& expected) {
+    if (body.empty()) throw ServiceError(ErrorKind::MalformedRequest, "the request has no body: send " + expected);
     if (json_nesting_depth(body) > kMaxJsonNesting)
         throw ServiceError(ErrorKind::MalformedRequest, json_nesting_message());
-    const json document = json::parse(body, nullptr, false);
+    json document = json::parse(body, nullptr, false);
     if (document.is_discarded()) {
         // Parsed again for the message with line and column.
         const auto parsed = protocol::parse_job_text_detailed(body);
         const auto* error = std::get_if<protocol::FieldError>(&parsed);
-        throw ServiceError(ErrorKind::MalformedRequest,
-                           error ? error->message : std::string("malformed JSON"));
+        throw ServiceError(ErrorKind::MalformedRequest, error ? error->message : std::string("malformed JSON"));
     }
+    return document;
+}
+
+protocol::Job decode_job(const std::string& body) {
+    const json document = decode_json_body(body, "the job description as JSON");
     auto parsed = protocol::parse_job_detailed(document);
     if (auto* error = std::get_if<protocol::FieldError>(&parsed))
         throw ServiceError(ErrorKind::InvalidField, protocol::describe(*error), error->path);
@@ -454,13 +459,7 @@ void HttpServer::Impl::submit_job(const Request& req, Response& res) {
 }
 
 void HttpServer::Impl::submit_batch(const Request& req, Response& res) {
-    if (req.body.empty())
-        throw ServiceError(ErrorKind::MalformedRequest,
-                           "the request has no body: send {\"job\": {...}, \"cameras\": [{...}, ...]}");
-    if (json_nesting_depth(req.body) > kMaxJsonNesting)
-        throw ServiceError(ErrorKind::MalformedRequest, json_nesting_message());
-    const json document = json::parse(req.body, nullptr, false);
-    if (document.is_discarded()) throw ServiceError(ErrorKind::MalformedRequest, "the batch is not valid JSON");
+    const json document = decode_json_body(req.body, "{\"job\": {...}, \"cameras\": [{...}, ...]}");
     if (!document.is_object()) throw ServiceError(ErrorKind::InvalidField, "a batch must be a JSON object", "");
     for (const auto& [name, value] : document.items())
         if (name != "job" && name != "cameras")

@@ -65,6 +65,13 @@ json rect_json(const PixelRect& r) { return json::array({r.x0, r.y0, r.x1, r.y1}
 /// most likely crash it again (a poison job).
 constexpr int kMaxCrashes = 3;
 
+/// SHA-256 of the job description with every default filled: what an Idempotency-Key names and
+/// what a job's kept tiles belong to.
+std::string request_digest(const protocol::Job& job) {
+    const std::string normalized = protocol::json_text(protocol::to_json(job));
+    return sha256_hex({reinterpret_cast<const uint8_t*>(normalized.data()), normalized.size()});
+}
+
 std::vector<protocol::PlanEntry> plan_of(const RenderStatistics& statistics) {
     std::vector<protocol::PlanEntry> plan;
     for (const PassDecision& d : statistics.plan) plan.push_back({d.pass, d.enabled, d.reason});
@@ -389,9 +396,7 @@ int JobManager::retry_after_seconds_locked() const {
 JobManager::Submitted JobManager::submit(const protocol::Job& job,
                                          const std::string& idempotency_key) {
     std::lock_guard submit_lock(submit_mutex_);
-    const std::string normalized = protocol::json_text(protocol::to_json(job));
-    const std::string digest =
-        sha256_hex({reinterpret_cast<const uint8_t*>(normalized.data()), normalized.size()});
+    const std::string digest = request_digest(job);
     JobSubmission submission;
     {
         std::unique_lock lock(mutex_);
@@ -479,9 +484,7 @@ std::vector<protocol::JobStatus> JobManager::submit_batch(const std::vector<prot
             JobSubmission submission;
             submission.sequence = first_sequence + k;
             submission.job = views[k];
-            const std::string normalized = protocol::json_text(protocol::to_json(views[k]));
-            submission.request_digest =
-                sha256_hex({reinterpret_cast<const uint8_t*>(normalized.data()), normalized.size()});
+            submission.request_digest = request_digest(views[k]);
             const bool chained = views[k].integrator == "photon-map" && views[k].irradiance_cache.enabled &&
                                  views[k].irradiance_cache.start_from.empty();
             if (k > 0 && chained) submission.start_from_job = queued.back().id;
@@ -609,17 +612,10 @@ protocol::JobStatus JobManager::cancel(const std::string& id, std::chrono::milli
                 queue_.erase({{-entry->submission.job.priority, entry->submission.sequence}, id});
                 entry->cancelled_by_user = true;
                 entry->cancel = true;
-                const protocol::JobStatus ended = ended_status_locked(*entry, JobState::Cancelled, "", nullptr);
                 lock.unlock();
-                keep_status(ended);
-                kept_tiles(*entry).clear();  // a job resumed after a restart may have some
+                finish(entry, JobState::Cancelled, "", nullptr);  // also removes tiles a resumed job kept
                 lock.lock();
-                announce_end_locked(*entry, ended);
-                const protocol::JobStatus status = entry->status;
-                lock.unlock();
-                keep_stream_history(entry);
-                log("job " + id + " cancelled while queued");
-                return status;
+                return entry->status;
             }
             [[fallthrough]];
         case JobState::Running:

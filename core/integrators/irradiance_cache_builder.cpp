@@ -98,13 +98,8 @@ std::unique_ptr<IrradianceCache> build_irradiance_cache(const RenderScene& rs, c
                                                         const Camera& camera, const CacheBuildSettings& settings,
                                                         CacheBuildStatistics* statistics, const IrradianceCache* start) {
     const auto started = std::chrono::steady_clock::now();
-    std::unique_ptr<IrradianceCache> cache;
-    if (start) {
-        // A copy of a valid cache's state is valid: from_state cannot refuse it.
-        cache = std::move(IrradianceCache::from_state(start->state())).value();
-    } else {
-        cache = std::make_unique<IrradianceCache>(rs.scene->bounds, settings.cache);
-    }
+    auto cache = start ? std::make_unique<IrradianceCache>(*start)
+                       : std::make_unique<IrradianceCache>(rs.scene->bounds, settings.cache);
     CacheBuildStatistics stats;
     stats.records_reused = cache->size();
     const PixelRect frame{0, 0, camera.width(), camera.height()};
