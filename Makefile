@@ -6,8 +6,15 @@ JOBS ?= $(shell nproc)
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 DEBIAN_PACKAGES := cmake g++ make pkg-config libembree-dev libtbb-dev libopenexr-dev libimath-dev \
 	libtinygltf-dev libcpp-httplib-dev nlohmann-json3-dev libglm-dev libpng-dev libssl-dev libarchive-dev libgtest-dev \
-	libbenchmark-dev curl python3 gnuplot-nox libmeshoptimizer-dev libdraco-dev libstb-dev gltfpack
+	libbenchmark-dev curl python3 python3-venv python3-pip python3-setuptools python3-wheel gnuplot-nox libmeshoptimizer-dev libdraco-dev libstb-dev gltfpack
 OUT ?= out
+# The tools of the interface checks that ctest runs (tests/server/metrics_exposition_test.cpp:
+# promtool; tests/server/openapi_document_test.cpp: npm, which installs the OpenAPI validator into
+# the build tree), as command:package. A command already on the PATH is kept, whatever package
+# brought it: NodeSource's nodejs carries its own npm and conflicts with Debian's npm package.
+TEST_TOOLS := promtool:prometheus node:nodejs npm:npm
+missing_tool_packages = $(shell for t in $(TEST_TOOLS); do \
+	command -v $$(echo $$t | cut -d: -f1) >/dev/null || echo $$t | cut -d: -f2; done)
 
 .PHONY: all deps configure build test tsan demo bench clean format
 
@@ -24,7 +31,7 @@ install_missing = @missing=$$(for p in $(1); do \
 	fi
 
 deps:
-	$(call install_missing,$(DEBIAN_PACKAGES))
+	$(call install_missing,$(DEBIAN_PACKAGES) $(missing_tool_packages))
 
 configure: deps
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release

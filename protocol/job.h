@@ -1,4 +1,4 @@
-// The job description v1 of the render service (PRODUCT.md, "Job description v1"): plain structs,
+// The job description v1 of the render service (README.md, "Job description v1"): plain structs,
 // their JSON mapping, validation with the offending field's path, and a JSON Schema built from the
 // same limits. Versioned by adding fields, never by changing what a field means.
 //

@@ -331,7 +331,7 @@ json problem_json_schema() {
               {"field",
                {{"type", "string"},
                 {"description", "the offending job field's path, e.g. irradiance_cache.a"}}},
-              {"instance", {{"type", "string"}}}}}};
+              {"instance", {{"type", "string"}, {"format", "uri-reference"}}}}}};
 }
 
 }  // namespace photond::protocol

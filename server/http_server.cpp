@@ -12,6 +12,7 @@
 #include <random>
 #include <regex>
 #include <set>
+#include <stdexcept>
 #include <vector>
 
 #include "core/util/json_depth.h"
@@ -24,6 +25,7 @@
 #include "server/openapi.h"
 #include "server/photon_map_cache.h"
 #include "server/render_cache_directory.h"
+#include "server/routes.h"
 #include "server/scene_store.h"
 #include "server/service_error.h"
 
@@ -43,20 +45,40 @@ constexpr size_t kMaxBatchViews = 1000;
 // HTTP threads kept waiting for the next burst of connections; the others end after the timeout.
 constexpr size_t kKeptHttpThreads = 8;
 constexpr std::chrono::milliseconds kHttpThreadIdleTimeout{10000};
-constexpr std::string_view kIdPattern = "([A-Za-z0-9_-]{1,128})";
 
 // ---------------------------------------------------------------------------------------------
 // Errors: the one place where failures become HTTP responses.
 
+/// A request path as a URI reference (RFC 3986) for a problem's "instance": cpp-httplib hands
+/// over the percent-decoded path, which may hold spaces, quotes or bytes that are not UTF-8.
+std::string uri_reference(std::string_view path) {
+    // A colon stays only where it cannot read as a scheme (after a leading slash).
+    const std::string_view kept =
+        path.starts_with('/') ? "-._~!$&'()*+,;=:@/" : "-._~!$&'()*+,;=@/";
+    std::string reference;
+    for (const char c : path) {
+        const bool alphanumeric =
+            (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9');
+        if (alphanumeric || kept.find(c) != std::string_view::npos) {
+            reference += c;
+        } else {
+            char escaped[4];
+            std::snprintf(escaped, sizeof escaped, "%%%02X", static_cast<unsigned char>(c));
+            reference += escaped;
+        }
+    }
+    return reference;
+}
+
 void write_problem(Response& res, ErrorKind kind, const std::string& detail,
-                   const std::string& field, const std::string& instance) {
+                   const std::string& field, const std::string& path) {
     protocol::Problem problem;
     problem.type = error_type_uri(kind);
     problem.title = error_title(kind);
     problem.status = http_status(kind);
     problem.detail = detail;
     problem.field = field;
-    problem.instance = instance;
+    problem.instance = uri_reference(path);
     res.status = problem.status;
     res.set_content(protocol::json_text(protocol::to_json(problem), 2) + "\n", kProblemType);
 }
@@ -182,13 +204,13 @@ struct HttpServer::Impl {
     HttpServices services;
     ListeningServer server;
 
-    struct Route {
+    struct BoundRoute {
         std::string method;
         std::string pattern;
         Handler handler;
         bool open = false;  // served without the bearer token (health checks)
     };
-    std::vector<Route> routes;
+    std::vector<BoundRoute> routes;
     std::vector<std::pair<std::regex, std::set<std::string>>> known_paths;  // for 405 answers
 
     Impl(HttpServerOptions o, HttpServices s) : options(std::move(o)), services(s) {}
@@ -222,14 +244,15 @@ struct HttpServer::Impl {
     void register_routes();
     void install();
 
-    // Handlers, in the order of PRODUCT.md.
+    // Handlers, in the order of the route table (server/routes.cpp).
     void submit_job(const Request& req, Response& res);
     void list_jobs(const Request& req, Response& res);
+    void submit_batch(const Request& req, Response& res);
     void get_job(const Request& req, Response& res);
     void cancel_job(const Request& req, Response& res);
     void job_events(const Request& req, Response& res);
-    void job_tile(const Request& req, Response& res);
     void job_tile_stream(const Request& req, Response& res);
+    void job_tile(const Request& req, Response& res);
     void job_image(const Request& req, Response& res);
     void job_preview(const Request& req, Response& res);
     void upload_scene(const Request& req, Response& res);
@@ -239,7 +262,6 @@ struct HttpServer::Impl {
     void list_photon_maps(const Request& req, Response& res);
     void export_photon_maps(const Request& req, Response& res);
     void import_photon_maps(const Request& req, Response& res);
-    void submit_batch(const Request& req, Response& res);
     void list_render_caches(const Request& req, Response& res);
     void export_render_cache(const Request& req, Response& res);
     void import_render_cache(const Request& req, Response& res);
@@ -259,42 +281,56 @@ struct HttpServer::Impl {
     }
 };
 
+/// A handler for every route of the table (server/routes.h), found by its operation id; a route
+/// without a handler or a handler without a route stops the daemon at its start.
 void HttpServer::Impl::register_routes() {
-    const std::string job = "/v1/jobs/" + std::string(kIdPattern);
-    auto bind_handler = [this](void (Impl::*member)(const Request&, Response&)) -> Handler {
-        return [this, member](const Request& req, Response& res) { (this->*member)(req, res); };
+    using Member = void (Impl::*)(const Request&, Response&);
+    const std::map<std::string, Member> handlers = {
+        {"submitJob", &Impl::submit_job},
+        {"listJobs", &Impl::list_jobs},
+        {"submitBatch", &Impl::submit_batch},
+        {"getJob", &Impl::get_job},
+        {"cancelJob", &Impl::cancel_job},
+        {"jobEvents", &Impl::job_events},
+        {"jobTileStream", &Impl::job_tile_stream},
+        {"jobTile", &Impl::job_tile},
+        {"jobImage", &Impl::job_image},
+        {"jobPreview", &Impl::job_preview},
+        {"uploadScene", &Impl::upload_scene},
+        {"listScenes", &Impl::list_scenes},
+        {"getScene", &Impl::get_scene},
+        {"deleteScene", &Impl::delete_scene},
+        {"listPhotonMaps", &Impl::list_photon_maps},
+        {"exportPhotonMaps", &Impl::export_photon_maps},
+        {"importPhotonMaps", &Impl::import_photon_maps},
+        {"listRenderCaches", &Impl::list_render_caches},
+        {"exportRenderCache", &Impl::export_render_cache},
+        {"importRenderCache", &Impl::import_render_cache},
+        {"healthz", &Impl::healthz},
+        {"readyz", &Impl::readyz},
+        {"metrics", &Impl::metrics},
+        {"openapi", &Impl::openapi},
     };
-    route("POST", "/v1/jobs", bind_handler(&Impl::submit_job));
-    route("GET", "/v1/jobs", bind_handler(&Impl::list_jobs));
-    route("POST", "/v1/batches", bind_handler(&Impl::submit_batch));
-    route("GET", job, bind_handler(&Impl::get_job));
-    route("DELETE", job, bind_handler(&Impl::cancel_job));
-    route("GET", job + "/events", bind_handler(&Impl::job_events));
-    route("GET", job + "/tiles", bind_handler(&Impl::job_tile_stream));
-    route("GET", job + "/tiles/([0-9]{1,9})/([0-9]{1,9})\\.exr", bind_handler(&Impl::job_tile));
-    route("GET", job + "/image\\.exr", bind_handler(&Impl::job_image));
-    route("GET", job + "/preview\\.png", bind_handler(&Impl::job_preview));
-    route("POST", "/v1/scenes", bind_handler(&Impl::upload_scene));
-    route("GET", "/v1/scenes", bind_handler(&Impl::list_scenes));
-    route("GET", "/v1/scenes/([^/]+)", bind_handler(&Impl::get_scene));
-    route("DELETE", "/v1/scenes/([^/]+)", bind_handler(&Impl::delete_scene));
-    route("GET", "/v1/photon-maps", bind_handler(&Impl::list_photon_maps));
-    route("GET", "/v1/photon-maps/([^/]+)", bind_handler(&Impl::export_photon_maps));
-    route("PUT", "/v1/photon-maps/([^/]+)", bind_handler(&Impl::import_photon_maps));
-    route("GET", "/v1/render-caches", bind_handler(&Impl::list_render_caches));
-    route("GET", "/v1/render-caches/([^/]+)", bind_handler(&Impl::export_render_cache));
-    route("PUT", "/v1/render-caches/([^/]+)", bind_handler(&Impl::import_render_cache));
-    route("GET", "/healthz", bind_handler(&Impl::healthz), /*open=*/true);
-    route("GET", "/readyz", bind_handler(&Impl::readyz), /*open=*/true);
-    route("GET", "/metrics", bind_handler(&Impl::metrics));
-    route("GET", "/v1/openapi.json", bind_handler(&Impl::openapi));
+    std::set<std::string> unused;
+    for (const auto& [id, member] : handlers) unused.insert(id);
+    for (const Route& r : api_routes()) {
+        const auto it = handlers.find(r.operation_id);
+        if (it == handlers.end() || !unused.erase(r.operation_id))
+            throw std::logic_error(r.method + " " + r.path + ": no handler for operation '" +
+                                   r.operation_id + "', or a second route for it");
+        const Member member = it->second;
+        route(r.method, r.path_regex(),
+              [this, member](const Request& req, Response& res) { (this->*member)(req, res); },
+              !r.authenticated);
+    }
+    if (!unused.empty()) throw std::logic_error("a handler without a route: " + *unused.begin());
 }
 
 /// Hands the routes to cpp-httplib, each wrapped with the token check, and answers 405 (with
 /// Allow) for the other methods on a known path.
 void HttpServer::Impl::install() {
     std::map<std::string, std::set<std::string>> methods_of;  // pattern -> methods
-    for (const Route& r : routes) methods_of[r.pattern].insert(r.method);
+    for (const BoundRoute& r : routes) methods_of[r.pattern].insert(r.method);
     // Bodies are read through a content reader, whatever their Content-Type: cpp-httplib parses
     // an application/x-www-form-urlencoded body (what curl's --data-binary sends by default) as a
     // form and refuses it beyond 8 KiB, which README's uploads of real files hit. The reader
@@ -341,7 +377,7 @@ void HttpServer::Impl::install() {
         else if (method == "DELETE")
             server.Delete(pattern, std::move(handler));
     };
-    for (const Route& r : routes) {
+    for (const BoundRoute& r : routes) {
         add(r.method, r.pattern,
             [this, handler = r.handler, open = r.open](const Request& req, Response& res) {
                 if (!open) check_token(req);

@@ -1,9 +1,9 @@
-// The HTTP API v1 of `photond serve` (PRODUCT.md, "HTTP API v1") on cpp-httplib. Every route is
-// registered in one function (register_routes in http_server.cpp); handlers are thin: decode the
-// request, call the job manager or a store, encode the answer. Failures are thrown as
-// ServiceError and turned into RFC 9457 problem+json in one place, the server's exception
-// handler; errors that cpp-httplib raises itself (no route, body too large, malformed request)
-// get the same treatment in its error handler.
+// The HTTP API v1 of `photond serve` on cpp-httplib. The routes are those of the route table
+// (server/routes.h), registered in one function (register_routes in http_server.cpp); handlers
+// are thin: decode the request, call the job manager or a store, encode the answer. Failures are
+// thrown as ServiceError and turned into RFC 9457 problem+json in one place, the server's
+// exception handler; errors that cpp-httplib raises itself (no route, body too large, malformed
+// request) get the same treatment in its error handler.
 //
 // httplib.h is kept out of this header: it must be compiled with the definitions that
 // PkgConfig::HTTPLIB carries (Debian builds the library with OpenSSL, zlib and Brotli support),

@@ -42,8 +42,8 @@ std::string Metrics::render(const MetricsSnapshot& s) const {
         sample(out, "photond_jobs{state=\"" + state + "\"}", count);
     header(out, "photond_jobs_submitted_total", "counter", "Jobs accepted by POST /v1/jobs.");
     sample(out, "photond_jobs_submitted_total", jobs_submitted_.load());
-    header(out, "photond_queue_depth", "gauge", "Jobs waiting in the queue.");
-    sample(out, "photond_queue_depth", s.queue_depth);
+    header(out, "photond_queue_jobs", "gauge", "Jobs waiting in the queue.");
+    sample(out, "photond_queue_jobs", s.queue_depth);
     header(out, "photond_tiles_rendered_total", "counter", "Tiles finished by the renderer.");
     sample(out, "photond_tiles_rendered_total", tiles_rendered_.load());
     header(out, "photond_rays_total", "counter",
@@ -74,18 +74,18 @@ std::string Metrics::render(const MetricsSnapshot& s) const {
     for (size_t i = 1; i < responses_.size(); ++i)
         sample(out, "photond_http_responses_total{code=\"" + std::to_string(i) + "xx\"}",
                responses_[i].load());
-    header(out, "photond_pass_seconds", "histogram", "Duration of the render passes of jobs.");
+    const std::string pass_duration = "photond_pass_duration_seconds";
+    header(out, pass_duration.c_str(), "histogram", "Duration of the render passes of jobs.");
     std::lock_guard lock(mutex_);
     for (const auto& [pass, h] : pass_seconds_) {
         const std::string label = "pass=\"" + pass + "\"";
         for (size_t i = 0; i < kPassBuckets.size(); ++i)
-            sample(
-                out,
-                "photond_pass_seconds_bucket{" + label + ",le=\"" + number(kPassBuckets[i]) + "\"}",
-                h.buckets[i]);
-        sample(out, "photond_pass_seconds_bucket{" + label + ",le=\"+Inf\"}", h.count);
-        out += "photond_pass_seconds_sum{" + label + "} " + number(h.sum) + "\n";
-        sample(out, "photond_pass_seconds_count{" + label + "}", h.count);
+            sample(out,
+                   pass_duration + "_bucket{" + label + ",le=\"" + number(kPassBuckets[i]) + "\"}",
+                   h.buckets[i]);
+        sample(out, pass_duration + "_bucket{" + label + ",le=\"+Inf\"}", h.count);
+        out += pass_duration + "_sum{" + label + "} " + number(h.sum) + "\n";
+        sample(out, pass_duration + "_count{" + label + "}", h.count);
     }
     return out;
 }

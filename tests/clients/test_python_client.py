@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""The standard-library Python client (clients/python/photond_client.py) against a real daemon
-on a free loopback port. Run by ctest as `python_client`, with PHOTOND_BINARY_DIR set to the
-build directory (or pass it as the first argument)."""
+"""The standard-library Python client (clients/python/photond_client, imported from the source
+tree) against a real daemon on a free loopback port. Run by ctest as `python_client`, with
+PHOTOND_BINARY_DIR set to the build directory (or pass it as the first argument). The installed
+package and its photond-submit command: test_python_package.py."""
 
 import json
 import os
@@ -39,15 +40,15 @@ def small_job(**camera):
 
 
 class Daemon:
-    """`photond serve --listen 127.0.0.1:0` with a temporary cache directory."""
+    """`photond serve --listen 127.0.0.1:0` with a temporary cache directory (and `extra_args`)."""
 
-    def __init__(self, directory):
+    def __init__(self, directory, extra_args=()):
         self.log_path = os.path.join(directory, "daemon.log")
         self.log = open(self.log_path, "wb")
         # stdout goes to the log too (a pipe nobody reads would block the daemon when full).
         self.process = subprocess.Popen(
             [PHOTOND, "serve", "--listen", "127.0.0.1:0", "--cache-dir",
-             os.path.join(directory, "cache"), "--threads", "2"],
+             os.path.join(directory, "cache"), "--threads", "2", *extra_args],
             stdout=self.log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
         self.url = None
         deadline = time.monotonic() + 30
@@ -84,7 +85,11 @@ class PythonClientTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.directory = tempfile.mkdtemp(prefix="photond_python_client_")
-        cls.daemon = Daemon(cls.directory)
+        try:
+            cls.daemon = Daemon(cls.directory)
+        except BaseException:
+            shutil.rmtree(cls.directory, ignore_errors=True)  # tearDownClass will not run
+            raise
         cls.client = PhotondClient(cls.daemon.url)
 
     @classmethod
@@ -97,7 +102,8 @@ class PythonClientTest(unittest.TestCase):
 
     def test_submit_events_tiles_and_image(self):
         job_id = self.client.submit(small_job())
-        status = self.client.wait(job_id, timeout=60)
+        seen = []
+        status = self.client.wait(job_id, timeout=60, on_event=seen.append)
         self.assertEqual(status["state"], "done", status)
         self.assertEqual(status["progress"]["tiles_done"], status["progress"]["tiles_total"])
         self.assertEqual(status["progress"]["tiles_total"], 4 * 3)
@@ -118,6 +124,11 @@ class PythonClientTest(unittest.TestCase):
         resumed = list(self.client.events(job_id, last_event_id=events[2].id))
         self.assertEqual([e.id for e in resumed], [e.id for e in events[3:]])
 
+        # wait's on_event saw each event once, in order, up to the end of the job.
+        self.assertTrue(seen)
+        self.assertEqual([e.id for e in seen], [e.id for e in events[-len(seen):]])
+        self.assertIn("progress", [e.type for e in seen])
+
         tile = self.client.tile(job_id, 0, 0)
         self.assertEqual(tile[:4], EXR_MAGIC)
 
@@ -129,6 +140,20 @@ class PythonClientTest(unittest.TestCase):
         self.assertFalse(os.path.exists(path + ".part"))
 
         self.assertIn(job_id, [job["id"] for job in self.client.jobs()])
+
+    def test_fetch_image_waits_longer_than_the_client_timeout(self):
+        # ?wait=true answers only when the job ends: the client's read timeout must not apply.
+        client = PhotondClient(self.daemon.url, timeout=0.3)
+        job_id = client.submit({
+            "scene": {"builtin": "cornell-box"}, "integrator": "path",
+            "image": {"width": 64, "height": 48, "spp": 256, "tile_size": 16}})
+        started = time.monotonic()
+        path = client.fetch_image(job_id, self.path("slow.exr"))
+        self.assertGreater(time.monotonic() - started, 0.3, "the job was too fast to tell")
+        with open(path, "rb") as image:
+            self.assertEqual(image.read(4), EXR_MAGIC)
+        with open(client.fetch_preview(job_id, self.path("slow.png")), "rb") as preview:
+            self.assertEqual(preview.read(8), b"\x89PNG\r\n\x1a\n")
 
     def test_second_view_hits_the_photon_map_cache(self):
         # Photon counts no other test uses, so that the first view is a miss here.

@@ -8,6 +8,7 @@
 #include "core/image/exr_io.h"
 #include "core/image/png_preview.h"
 #include "protocol/job.h"
+#include "server/routes.h"
 #include "tests/server/daemon_harness.h"
 
 namespace photond::test {
@@ -289,33 +290,18 @@ TEST_F(DaemonApi, OpenApiHealthReadinessAndMetrics) {
     EXPECT_EQ(openapi.at("components").at("schemas").at("Job"), protocol::job_json_schema());
     for (const char* schema : {"JobStatus", "JobEvent", "Problem", "SceneInfo"})
         EXPECT_TRUE(openapi.at("components").at("schemas").contains(schema)) << schema;
-    const std::vector<std::pair<std::string, std::string>> operations = {
-        {"/v1/jobs", "post"},
-        {"/v1/jobs", "get"},
-        {"/v1/jobs/{id}", "get"},
-        {"/v1/jobs/{id}", "delete"},
-        {"/v1/jobs/{id}/events", "get"},
-        {"/v1/jobs/{id}/tiles", "get"},
-        {"/v1/jobs/{id}/tiles/{tx}/{ty}.exr", "get"},
-        {"/v1/jobs/{id}/image.exr", "get"},
-        {"/v1/jobs/{id}/preview.png", "get"},
-        {"/v1/scenes", "post"},
-        {"/v1/scenes/{id}", "get"},
-        {"/v1/scenes/{id}", "delete"},
-        {"/v1/photon-maps/{key}", "get"},
-        {"/v1/photon-maps/{key}", "put"},
-        {"/v1/photon-maps", "get"},
-        {"/v1/render-caches", "get"},
-        {"/v1/batches", "post"},
-        {"/v1/render-caches/{key}", "get"},
-        {"/v1/render-caches/{key}", "put"},
-        {"/healthz", "get"},
-        {"/readyz", "get"},
-        {"/metrics", "get"},
-        {"/v1/openapi.json", "get"}};
-    for (const auto& [path, method] : operations)
-        EXPECT_TRUE(openapi.at("paths").contains(path) && openapi["paths"][path].contains(method))
-            << method << " " << path;
+    // The document's operations are the route table's, no more and no fewer.
+    size_t documented = 0;
+    for (const auto& [path, operations] : openapi.at("paths").items())
+        documented += operations.size();
+    EXPECT_EQ(documented, service::api_routes().size());
+    for (const service::Route& route : service::api_routes()) {
+        const std::string method = lower(route.method);
+        ASSERT_TRUE(openapi["paths"].contains(route.path) &&
+                    openapi["paths"][route.path].contains(method))
+            << route.method << " " << route.path;
+        EXPECT_EQ(openapi["paths"][route.path][method].at("operationId"), route.operation_id);
+    }
     EXPECT_EQ(openapi["paths"]["/v1/jobs"]["post"]["requestBody"]["content"]["application/json"]
                      ["schema"]["$ref"],
               "#/components/schemas/Job");
@@ -331,8 +317,8 @@ TEST_F(DaemonApi, OpenApiHealthReadinessAndMetrics) {
           "photond_jobs{state=\"queued\"} 0", "# TYPE photond_jobs_submitted_total counter",
           "photond_jobs_submitted_total 1", "photond_tiles_rendered_total 12",
           "photond_photon_cache_misses_total 1", "photond_photon_cache_hits_total 0",
-          "photond_queue_depth 0", "# TYPE photond_pass_seconds histogram",
-          "photond_pass_seconds_count{pass=\"render\"} 1", "# HELP photond_rays_total",
+          "photond_queue_jobs 0", "# TYPE photond_pass_duration_seconds histogram",
+          "photond_pass_duration_seconds_count{pass=\"render\"} 1", "# HELP photond_rays_total",
           "# TYPE photond_photon_cache_bytes gauge"})
         EXPECT_NE(text.find(line), std::string::npos) << line << "\n" << text;
     EXPECT_EQ(text.find("photond_rays_total 0\n"), std::string::npos);

@@ -390,7 +390,7 @@ TEST_F(DaemonErrors, FullQueueAnswers429WithRetryAfter) {
     expect_problem(client, refused, 429, "", "max-queued");
     EXPECT_GE(std::stoi(refused.header("retry-after")), 1);
     const std::string metrics = client.get("/metrics").body;
-    EXPECT_NE(metrics.find("photond_queue_depth 1"), std::string::npos) << metrics;
+    EXPECT_NE(metrics.find("photond_queue_jobs 1"), std::string::npos) << metrics;
     // Cancelling makes room again.
     EXPECT_EQ(client.request("DELETE", "/v1/jobs/" + queued.json_body().at("id").get<std::string>())
                   .status,

@@ -478,6 +478,14 @@ inline std::pair<int, std::string> run_command(const std::string& command) {
     return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
 }
 
+/// The path of a program on the PATH (`command -v`); empty when there is none.
+inline std::string program_path(const std::string& name) {
+    auto [status, output] = run_command("command -v " + name);
+    while (!output.empty() && std::isspace(static_cast<unsigned char>(output.back())))
+        output.pop_back();
+    return status == 0 ? output : std::string();
+}
+
 /// Polls GET /v1/jobs/{id} until `done(status)` or the timeout; returns the last status.
 inline json wait_for_status(const HttpClient& client, const std::string& id,
                             const std::function<bool(const json&)>& done,

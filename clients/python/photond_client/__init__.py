@@ -1,6 +1,8 @@
 """A client of the photond render daemon's HTTP API v1, for pipelines.
 
-Standard library only (urllib), Python 3.9 or newer. Copy this one file next to your script::
+Standard library only (urllib), Python 3.9 or newer, fully typed (PEP 561). Install it with
+``pip install ./clients/python`` (which also installs the ``photond-submit`` command, see
+photond_client.submit), or copy this one file next to your script as photond_client.py::
 
     from photond_client import PhotondClient, PhotondError
 
@@ -16,6 +18,7 @@ status 0 and a title naming its URL.
 
 from __future__ import annotations
 
+import contextlib
 import http.client
 import json
 import os
@@ -23,9 +26,11 @@ import time
 import urllib.error
 import urllib.parse
 import urllib.request
-from typing import Any, Dict, Iterator, List, Optional
+from typing import Any, Callable, Dict, Generator, Iterator, List, Optional, Protocol
 
-__all__ = ["PhotondClient", "PhotondError", "ServerEvent", "TERMINAL_STATES"]
+__all__ = ["PhotondClient", "PhotondError", "ServerEvent", "TERMINAL_STATES", "__version__"]
+
+__version__ = "0.1.0"
 
 #: States after which a job never changes again.
 TERMINAL_STATES = frozenset({"done", "failed", "cancelled"})
@@ -42,7 +47,7 @@ class PhotondError(Exception):
     (status 0)."""
 
     def __init__(self, status: int, title: str, detail: str = "", field: Optional[str] = None,
-                 type: str = "about:blank"):  # noqa: A002 - the RFC 9457 member's name
+                 type: str = "about:blank") -> None:  # noqa: A002 - the RFC 9457 member's name
         self.status = status
         self.title = title
         self.detail = detail
@@ -66,7 +71,11 @@ class ServerEvent:
 
     __slots__ = ("type", "id", "data")
 
-    def __init__(self, type: str, id: str, data: Any):  # noqa: A002
+    type: str
+    id: str
+    data: Any
+
+    def __init__(self, type: str, id: str, data: Any) -> None:  # noqa: A002
         self.type = type
         self.id = id
         self.data = data
@@ -82,15 +91,17 @@ def _problem_from_http_error(error: urllib.error.HTTPError) -> PhotondError:
     except OSError:
         pass
     content_type = error.headers.get("Content-Type", "") if error.headers else ""
-    document = None
+    document: Any = None
     if "json" in content_type.lower():
         try:
             document = json.loads(body.decode("utf-8"))
         except (ValueError, UnicodeDecodeError):
             document = None
     if isinstance(document, dict) and document.get("title"):
+        field = document.get("field")
         return PhotondError(int(document.get("status", error.code)), str(document["title"]),
-                            str(document.get("detail", "") or ""), document.get("field") or None,
+                            str(document.get("detail", "") or ""),
+                            str(field) if field else None,
                             str(document.get("type", "about:blank")))
     detail = body.decode("utf-8", "replace").strip().replace("\n", " ")[:300]
     return PhotondError(error.code, f"{error.reason} (HTTP {error.code})", detail)
@@ -101,7 +112,7 @@ class PhotondClient:
     kept); `token` is sent as a bearer token."""
 
     def __init__(self, base_url: str, token: Optional[str] = None,
-                 timeout: float = _DEFAULT_TIMEOUT_S):
+                 timeout: float = _DEFAULT_TIMEOUT_S) -> None:
         if "://" not in base_url:
             base_url = "http://" + base_url
         self.base_url = base_url.rstrip("/")
@@ -117,14 +128,18 @@ class PhotondClient:
         return "/v1/jobs/" + urllib.parse.quote(job_id, safe=":@") + suffix
 
     def _open(self, method: str, path: str, body: Optional[bytes] = None,
-              headers: Optional[Dict[str, str]] = None, timeout: Optional[float] = None):
+              headers: Optional[Dict[str, str]] = None, timeout: Optional[float] = None,
+              no_timeout: bool = False) -> http.client.HTTPResponse:
         request = urllib.request.Request(self._url(path), data=body, method=method)
         if self.token:
             request.add_header("Authorization", "Bearer " + self.token)
         for name, value in (headers or {}).items():
             request.add_header(name, value)
         try:
-            return urllib.request.urlopen(request, timeout=timeout or self.timeout)
+            # no_timeout: a request the server answers only when a job ends (?wait=true).
+            response: http.client.HTTPResponse = urllib.request.urlopen(
+                request, timeout=None if no_timeout else (timeout or self.timeout))
+            return response
         except urllib.error.HTTPError as error:
             raise _problem_from_http_error(error) from None
         except (urllib.error.URLError, http.client.HTTPException, OSError) as error:
@@ -149,6 +164,13 @@ class PhotondClient:
             raise PhotondError(0, f"the server at {self.base_url} answered {method} {path} "
                                   "with a body that is not JSON") from None
 
+    def _json_object(self, method: str, path: str) -> Dict[str, Any]:
+        answer = self._json(method, path)
+        if not isinstance(answer, dict):
+            raise PhotondError(0, f"the server at {self.base_url} answered {method} {path} "
+                                  "with JSON that is not an object")
+        return answer
+
     # -- jobs ----------------------------------------------------------------------------------
 
     def submit(self, job: Dict[str, Any], idempotency_key: Optional[str] = None) -> str:
@@ -156,9 +178,10 @@ class PhotondClient:
         idempotency key)."""
         headers = {"Idempotency-Key": idempotency_key} if idempotency_key else None
         answer = self._json("POST", "/v1/jobs", job, headers)
-        if not isinstance(answer, dict) or not isinstance(answer.get("id"), str):
+        job_id = answer.get("id") if isinstance(answer, dict) else None
+        if not isinstance(job_id, str):
             raise PhotondError(0, "the server accepted the job but sent no job id")
-        return answer["id"]
+        return job_id
 
     def submit_batch(self, job: Dict[str, Any], cameras: List[Dict[str, Any]]) -> List[str]:
         """POST /v1/batches: a job per camera, run in order, each view's irradiance cache
@@ -171,7 +194,7 @@ class PhotondClient:
 
     def status(self, job_id: str) -> Dict[str, Any]:
         """GET /v1/jobs/{id}: state, progress, plan, timings, photons.cache, error."""
-        return self._json("GET", self._job_path(job_id))
+        return self._json_object("GET", self._job_path(job_id))
 
     def jobs(self) -> List[Dict[str, Any]]:
         """GET /v1/jobs: the daemon's jobs, newest first."""
@@ -182,10 +205,11 @@ class PhotondClient:
 
     def cancel(self, job_id: str) -> Dict[str, Any]:
         """DELETE /v1/jobs/{id}; returns the job's status."""
-        return self._json("DELETE", self._job_path(job_id))
+        return self._json_object("DELETE", self._job_path(job_id))
 
     def events(self, job_id: str, last_event_id: Optional[str] = None,
-               read_timeout: float = _STREAM_READ_TIMEOUT_S) -> Iterator[ServerEvent]:
+               read_timeout: float = _STREAM_READ_TIMEOUT_S
+               ) -> Generator[ServerEvent, None, None]:
         """GET /v1/jobs/{id}/events as a generator of ServerEvent, from the first event (or
         after `last_event_id`) until the server ends the stream (after done, failed or
         cancelled). A broken connection raises PhotondError with status 0; pass the last
@@ -198,11 +222,14 @@ class PhotondClient:
         with response:
             yield from _parse_sse(response, self.base_url)
 
-    def wait(self, job_id: str, timeout: Optional[float] = None) -> Dict[str, Any]:
+    def wait(self, job_id: str, timeout: Optional[float] = None,
+             on_event: Optional[Callable[[ServerEvent], None]] = None) -> Dict[str, Any]:
         """Waits until the job is done, failed or cancelled and returns its final status (it
         does not raise for a failed job: look at status["state"] and status.get("error")).
         Follows the event stream, resuming after breaks; polls when the stream is refused.
-        Raises TimeoutError after `timeout` seconds (None: no limit)."""
+        Raises TimeoutError after `timeout` seconds (None: no limit). `on_event`, when given,
+        is called with each event of the stream as it arrives (progress, tiles, states; each
+        once, also across reconnections; none while polling or for a job already ended)."""
         deadline = None if timeout is None else time.monotonic() + timeout
 
         def remaining() -> Optional[float]:
@@ -214,7 +241,7 @@ class PhotondClient:
             return left
 
         status = self.status(job_id)
-        last_event_id = None
+        last_event_id: Optional[str] = None
         use_events = True
         while status.get("state") not in TERMINAL_STATES:
             left = remaining()
@@ -226,6 +253,8 @@ class PhotondClient:
                 try:
                     for event in stream:
                         last_event_id = event.id or last_event_id
+                        if on_event is not None:
+                            on_event(event)
                         if event.type in TERMINAL_STATES:
                             ended = True
                             break
@@ -245,25 +274,43 @@ class PhotondClient:
         return status
 
     def fetch_image(self, job_id: str, path: str, wait: bool = True) -> str:
-        """GET /v1/jobs/{id}/image.exr (with wait: blocks until the job ends) into `path`,
-        written to a temporary name first. Returns `path`."""
+        """GET /v1/jobs/{id}/image.exr (with wait: blocks until the job ends, however long
+        that takes) into `path`, written to a temporary name first. Returns `path`."""
         suffix = "/image.exr?wait=true" if wait else "/image.exr"
-        timeout = None if wait else self.timeout
+        return self._download(self._job_path(job_id, suffix), path, "image", no_timeout=wait)
+
+    def fetch_preview(self, job_id: str, path: str) -> str:
+        """GET /v1/jobs/{id}/preview.png (the job's tone-mapped preview; of the tiles so far
+        while it runs) into `path`, written to a temporary name first. Returns `path`."""
+        return self._download(self._job_path(job_id, "/preview.png"), path, "preview")
+
+    def _download(self, server_path: str, path: str, what: str,
+                  no_timeout: bool = False) -> str:
         temporary = f"{path}.part"
-        try:
-            with self._open("GET", self._job_path(job_id, suffix), timeout=timeout) as response:
-                with open(temporary, "wb") as out:
+        with self._open("GET", server_path, no_timeout=no_timeout) as response:
+            try:
+                out = open(temporary, "wb")
+            except OSError as error:
+                raise PhotondError(0, f"cannot write {path}", error.strerror or str(error)) \
+                    from None
+            try:
+                with out:
                     while True:
                         chunk = response.read(1 << 16)
                         if not chunk:
                             break
                         out.write(chunk)
-        except (OSError, http.client.HTTPException) as error:
-            if os.path.exists(temporary):
+            except (OSError, http.client.HTTPException) as error:
+                if os.path.exists(temporary):
+                    os.remove(temporary)
+                raise PhotondError(0, f"the {what} download from {self.base_url} broke",
+                                   str(error)) from None
+        try:
+            os.replace(temporary, path)
+        except OSError as error:
+            with contextlib.suppress(OSError):
                 os.remove(temporary)
-            raise PhotondError(0, f"the image download from {self.base_url} broke",
-                               str(error)) from None
-        os.replace(temporary, path)
+            raise PhotondError(0, f"cannot write {path}", error.strerror or str(error)) from None
         return path
 
     def tile(self, job_id: str, tx: int, ty: int) -> bytes:
@@ -324,7 +371,11 @@ class PhotondClient:
         return json.loads(text.decode("utf-8")) if text else {}
 
 
-def _parse_sse(response, base_url: str) -> Iterator[ServerEvent]:
+class _LineReader(Protocol):
+    def readline(self, __limit: int = ...) -> bytes: ...
+
+
+def _parse_sse(response: _LineReader, base_url: str) -> Iterator[ServerEvent]:
     """Server-Sent Events (WHATWG HTML 9.2.6) from a file-like response, line by line."""
     event_type = ""
     data_lines: List[str] = []
