@@ -805,7 +805,10 @@ json output_schema() {
     json aovs = {{"type", "array"},
                  {"items", choice_schema(kAovNames, "an AOV layer")},
                  {"uniqueItems", true},
-                 {"description", "extra EXR layers besides the beauty image"}};
+                 {"description", "extra EXR layers besides the beauty image (layer.R, .G, .B): emission, direct, "
+                                 "indirect and caustic sum to the beauty image; albedo (base colour), normal "
+                                 "(facing the camera) and depth (distance along the ray) of the surface each "
+                                 "camera ray meets first, 0 where it meets none"}};
     return object_schema(
         {{"pixel_type", choice_schema(kPixelTypeNames, "EXR channel type")},
          {"aovs", aovs},

@@ -17,6 +17,7 @@
 #include <variant>
 #include <vector>
 
+#include "core/render/aov.h"
 #include "core/util/expected.h"
 
 namespace photond::protocol {
@@ -77,8 +78,8 @@ inline constexpr std::array<std::string_view, 2> kPixelTypeNames{"half", "float"
 inline constexpr std::array<std::string_view, 4> kLightTypeNames{"point", "spot", "directional",
                                                                  "quad"};
 inline constexpr std::array<std::string_view, 2> kEnvironmentImageExtensions{".exr", ".hdr"};
-inline constexpr std::array<std::string_view, 6> kAovNames{"direct", "indirect", "caustic",
-                                                           "albedo", "normal",   "depth"};
+// AOV layers: the renderer's one list (core/render/aov.h).
+inline constexpr const auto& kAovNames = kAllAovNames;
 
 /// Which scene to render: {"builtin": name} | {"path": relative to --scene-root} | {"id": content}.
 struct SceneRef {

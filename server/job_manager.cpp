@@ -93,7 +93,7 @@ struct JobManager::Entry {
     protocol::JobStatus status;
     std::vector<protocol::JobEvent> events;  // ids first_event_id, first_event_id + 1, ...
     uint64_t first_event_id = 1;  // above 1 for a history rebuilt shorter than it was
-    std::map<TileIndex, std::shared_ptr<const Image>> tiles;  // finished, while rendering
+    std::map<TileIndex, std::shared_ptr<const ImageLayers>> tiles;  // finished, while rendering
     std::vector<TileIndex> finished_order;
     std::shared_ptr<const ImageLayers> image;  // a done job's final image, while in memory
     bool image_verified = false;  // its file matched the checksum written with it (this process)
@@ -689,7 +689,7 @@ std::optional<JobManager::TileGeometry> JobManager::tile_geometry(const std::str
 
 std::optional<std::vector<uint8_t>> JobManager::tile_exr(const std::string& id, TileIndex tile) {
     std::shared_ptr<Entry> entry;
-    std::shared_ptr<const Image> pixels;
+    std::shared_ptr<const ImageLayers> pixels;
     bool done = false;
     {
         std::unique_lock lock(mutex_);
@@ -710,7 +710,7 @@ std::optional<std::vector<uint8_t>> JobManager::tile_exr(const std::string& id, 
         if (!image) return std::nullopt;
         layers = copy_rect(*image, rect);
     } else {
-        layers.beauty = *pixels;
+        layers = *pixels;
     }
     const ExrPixelType type =
         job.output.pixel_type == "float" ? ExrPixelType::Float : ExrPixelType::Half;
@@ -812,7 +812,7 @@ fs::path JobManager::image_file(const std::string& id) {
 
 std::vector<uint8_t> JobManager::preview_png(const std::string& id) {
     std::shared_ptr<Entry> entry;
-    std::vector<std::pair<TileIndex, std::shared_ptr<const Image>>> tiles;
+    std::vector<std::pair<TileIndex, std::shared_ptr<const ImageLayers>>> tiles;
     {
         std::unique_lock lock(mutex_);
         entry = find_locked(lock, id);
@@ -846,7 +846,7 @@ std::vector<uint8_t> JobManager::preview_png(const std::string& id) {
     Image frame(job.image.width, job.image.height);
     for (const auto& [index, pixels] : tiles) {
         const PixelRect rect = *entry->rect_of(index);
-        frame.paste(*pixels, rect.x0, rect.y0);
+        frame.paste(pixels->beauty, rect.x0, rect.y0);
     }
     auto png = encode_job_preview(job, frame);
     if (!png) throw ServiceError(ErrorKind::Internal, png.error().message);
@@ -946,7 +946,7 @@ void JobManager::run(const std::shared_ptr<Entry>& entry) {
         run_warnings.push_back(warning);
         return true;
     };
-    options.callbacks.restore_tile = [&](const PixelRect& rect, Image& frame) {
+    options.callbacks.restore_tile = [&](const PixelRect& rect, ImageLayers& frame) {
         std::string problem;
         const TileJournal::Restored restored = journal.restore(rect, frame, &problem);
         if (restored == TileJournal::Restored::Damaged) {
@@ -955,7 +955,7 @@ void JobManager::run(const std::shared_ptr<Entry>& entry) {
         }
         return restored == TileJournal::Restored::Restored;
     };
-    options.callbacks.on_tile = [&](const TileEvent& event, const Image& frame) {
+    options.callbacks.on_tile = [&](const TileEvent& event, const ImageLayers& frame) {
         if (!event.restored) {
             if (const Status kept = journal.save(event.rect, frame); !kept) {
                 metrics_->record_store_failure();
@@ -965,7 +965,7 @@ void JobManager::run(const std::shared_ptr<Entry>& entry) {
             }
         }
         // Only this tile's pixels are read: other threads write other tiles of the frame.
-        auto pixels = std::make_shared<const Image>(frame.copy_rect(event.rect));
+        auto pixels = std::make_shared<const ImageLayers>(copy_rect(frame, event.rect));
         const TileIndex index = e.index_of(event.rect);
         metrics_->record_tile();
         std::lock_guard lock(mutex_);

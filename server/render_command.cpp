@@ -297,7 +297,7 @@ int run_render_command(std::span<const std::string> args) {
     options.caches_only = a.caches_only;
     options.threads = a.threads;
     options.scene_root = scene_root;
-    options.callbacks.on_tile = [&](const TileEvent& e, const Image&) { progress.update(e.tiles_done, e.tiles_total); };
+    options.callbacks.on_tile = [&](const TileEvent& e, const ImageLayers&) { progress.update(e.tiles_done, e.tiles_total); };
     auto result = run_job(*job, *device, options);
     if (!result) {
         std::fprintf(stderr, "photond render: %s\n", result.error().message.c_str());

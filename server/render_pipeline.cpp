@@ -449,9 +449,6 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     stats.samples_per_pixel = job.image.spp;
     stats.threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
 
-    if (!job.output.aovs.empty())
-        return Error{"output.aovs: the " + job.integrator + " integrator does not produce AOVs yet"};
-
     Clock::time_point pass_start = Clock::now();
     if (options.on_pass) options.on_pass("scene");
     auto scene = load_job_scene(job.scene, options);
@@ -562,6 +559,11 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     tiles.samples_per_pixel = job.image.spp;
     tiles.seed = job.seed;
     tiles.threads = options.threads;
+    for (const std::string& name : job.output.aovs) {
+        const std::optional<Aov> aov = aov_from_name(name);
+        if (!aov) return Error{"output.aovs: unknown AOV '" + name + "'"};  // parse_job lets none through
+        tiles.aovs.push_back(*aov);
+    }
     if (job.image.region) {
         const auto& r = *job.image.region;
         tiles.region = PixelRect{r[0], r[1], r[2], r[3]};
@@ -580,7 +582,7 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     stats.cancelled = rendered.cancelled;
     stats.tiles_restored = rendered.tiles_restored;
     stats.total_seconds = seconds_since(start);
-    result.layers.beauty = std::move(rendered.image);
+    result.layers = std::move(rendered.layers);
     return result;
 }
 

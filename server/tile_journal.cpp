@@ -4,6 +4,7 @@
 #include <bit>
 #include <cstring>
 #include <system_error>
+#include <vector>
 
 #include "core/util/sha256.h"
 #include "server/atomic_file.h"
@@ -40,20 +41,30 @@ fs::path TileJournal::file_of(const PixelRect& rect) const {
     return directory_ / (std::to_string(rect.x0) + "-" + std::to_string(rect.y0) + ".tile");
 }
 
-Status TileJournal::save(const PixelRect& rect, const Image& frame) const {
-    if (rect.empty() || !frame.bounds().contains(rect)) return Error{"tile outside the frame"};
+/// The frame's layers in file order: the beauty pass, then the AOVs in the job's order.
+template <typename Layers>
+auto layers_of(Layers& frame) {
+    std::vector<decltype(&frame.beauty)> layers{&frame.beauty};
+    for (auto& aov : frame.aovs) layers.push_back(&aov.second);
+    return layers;
+}
+
+Status TileJournal::save(const PixelRect& rect, const ImageLayers& frame) const {
+    if (rect.empty() || !frame.beauty.bounds().contains(rect)) return Error{"tile outside the frame"};
+    const auto layers = layers_of(frame);
     std::string bytes;
-    bytes.reserve(header_size(job_digest_) + size_t(rect.area()) * 12 + kDigestSize);
+    bytes.reserve(header_size(job_digest_) + layers.size() * size_t(rect.area()) * 12 + kDigestSize);
     bytes.append(kMagic, sizeof kMagic);
     append_u32(bytes, kFormatVersion);
     append_u32(bytes, static_cast<uint32_t>(job_digest_.size()));
     bytes += job_digest_;
     for (int v : {rect.x0, rect.y0, rect.x1, rect.y1}) append_u32(bytes, static_cast<uint32_t>(v));
-    for (int y = rect.y0; y < rect.y1; ++y)
-        for (int x = rect.x0; x < rect.x1; ++x) {
-            const Color& c = frame.at(x, y);
-            for (float channel : {c.x, c.y, c.z}) append_u32(bytes, std::bit_cast<uint32_t>(channel));
-        }
+    for (const Image* layer : layers)
+        for (int y = rect.y0; y < rect.y1; ++y)
+            for (int x = rect.x0; x < rect.x1; ++x) {
+                const Color& c = layer->at(x, y);
+                for (float channel : {c.x, c.y, c.z}) append_u32(bytes, std::bit_cast<uint32_t>(channel));
+            }
     const Sha256Digest digest =
         sha256({reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()});
     bytes.append(reinterpret_cast<const char*>(digest.data()), digest.size());
@@ -64,7 +75,7 @@ Status TileJournal::save(const PixelRect& rect, const Image& frame) const {
     return write_file_atomically(file_of(rect), bytes);
 }
 
-TileJournal::Restored TileJournal::restore(const PixelRect& rect, Image& frame, std::string* problem) const {
+TileJournal::Restored TileJournal::restore(const PixelRect& rect, ImageLayers& frame, std::string* problem) const {
     const fs::path file = file_of(rect);
     std::error_code error;
     if (!fs::exists(file, error)) return Restored::Missing;
@@ -74,10 +85,11 @@ TileJournal::Restored TileJournal::restore(const PixelRect& rect, Image& frame, 
         fs::rename(file, file.string() + ".damaged", ignored);
         return Restored::Damaged;
     };
-    if (rect.empty() || !frame.bounds().contains(rect)) return damaged("the tile lies outside the frame");
+    if (rect.empty() || !frame.beauty.bounds().contains(rect)) return damaged("the tile lies outside the frame");
+    const auto layers = layers_of(frame);
     const std::optional<std::vector<uint8_t>> bytes = read_file_bytes(file);
     if (!bytes) return damaged("cannot be read");
-    const size_t expected = header_size(job_digest_) + size_t(rect.area()) * 12 + kDigestSize;
+    const size_t expected = header_size(job_digest_) + layers.size() * size_t(rect.area()) * 12 + kDigestSize;
     if (bytes->size() != expected)
         return damaged(std::to_string(bytes->size()) + " bytes where " + std::to_string(expected) +
                        " were expected (truncated, or another tile size)");
@@ -99,10 +111,11 @@ TileJournal::Restored TileJournal::restore(const PixelRect& rect, Image& frame, 
     if (stored[0] != rect.x0 || stored[1] != rect.y0 || stored[2] != rect.x1 || stored[3] != rect.y1)
         return damaged("written for another rectangle");
     p += 16;
-    for (int y = rect.y0; y < rect.y1; ++y)
-        for (int x = rect.x0; x < rect.x1; ++x, p += 12)
-            frame.at(x, y) = Color(std::bit_cast<float>(read_u32(p)), std::bit_cast<float>(read_u32(p + 4)),
-                                   std::bit_cast<float>(read_u32(p + 8)));
+    for (Image* layer : layers)
+        for (int y = rect.y0; y < rect.y1; ++y)
+            for (int x = rect.x0; x < rect.x1; ++x, p += 12)
+                layer->at(x, y) = Color(std::bit_cast<float>(read_u32(p)), std::bit_cast<float>(read_u32(p + 4)),
+                                        std::bit_cast<float>(read_u32(p + 8)));
     return Restored::Restored;
 }
 

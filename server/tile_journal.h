@@ -3,7 +3,8 @@
 // of starting over:
 //   <cache-dir>/jobs/<id>/tiles/<x0>-<y0>.tile
 // One file per tile: a header (magic, format version, the job's digest, the rectangle), the
-// tile's float RGB pixels as the renderer left them (little-endian), then the SHA-256 of all that.
+// tile's float RGB pixels as the renderer left them (little-endian), layer after layer (the
+// beauty pass, then the job's AOVs in its order), then the SHA-256 of all that.
 // Each file is written to a temporary name and renamed, so a crash leaves a whole tile or none;
 // a file damaged afterwards (a bad disk, a power loss before the data reached it) fails its
 // checksum, is moved aside (".damaged") and its tile is rendered again. Since every pixel's
@@ -32,14 +33,15 @@ public:
     /// job description (JobSubmission::request_digest).
     TileJournal(std::filesystem::path directory, std::string job_digest);
 
-    /// Keeps the pixels of `rect` of `frame`.
-    Status save(const PixelRect& rect, const Image& frame) const;
+    /// Keeps the pixels of `rect` of every layer of `frame`.
+    Status save(const PixelRect& rect, const ImageLayers& frame) const;
 
     enum class Restored { Missing, Restored, Damaged };
-    /// Copies a tile kept earlier into `rect` of `frame`. Damaged: the file was unreadable,
+    /// Copies a tile kept earlier into `rect` of every layer of `frame` (which has the job's
+    /// layers). Damaged: the file was unreadable,
     /// failed its checksum or belongs to another job or rectangle; it was moved aside and
     /// `problem` says why.
-    Restored restore(const PixelRect& rect, Image& frame, std::string* problem = nullptr) const;
+    Restored restore(const PixelRect& rect, ImageLayers& frame, std::string* problem = nullptr) const;
 
     /// How many tile files are kept now.
     size_t count() const;

@@ -5,23 +5,27 @@ namespace photond {
 DirectIntegrator::DirectIntegrator(std::shared_ptr<const RenderScene> scene, int max_specular_depth)
     : scene_(std::move(scene)), max_specular_depth_(max_specular_depth) {}
 
-Color DirectIntegrator::radiance(const CameraRay& ray, SampleContext& context) const {
+RadianceParts DirectIntegrator::radiance_parts(const CameraRay& ray, SampleContext& context) const {
     return radiance_along(primary_ray(*scene_, ray), 0, context, 0.0f, pixel_spread(ray));
 }
 
-Color DirectIntegrator::radiance_along(const Ray& ray, int depth, SampleContext& context,
-                                       float path_length, float spread) const {
+RadianceParts DirectIntegrator::radiance_along(const Ray& ray, int depth, SampleContext& context,
+                                               float path_length, float spread) const {
     const RenderScene& rs = *scene_;
     const std::optional<Hit> hit = trace_ray(rs, ray, context.counters);
     // A camera ray or a delta bounce that leaves the scene sees the sky whole.
-    if (!hit) return rs.lights->escaped_radiance(ray.direction, 0.0f);
+    RadianceParts radiance;
+    if (!hit) {
+        radiance.add_emission(rs.lights->escaped_radiance(ray.direction, 0.0f));
+        return radiance;
+    }
     // The camera's ray cone, widened along ideal specular bounces, picks the texture level.
     const float length = path_length + hit->t;
     const SurfaceInteraction si = make_interaction(*rs.scene, *hit, ray.direction, length * spread);
     const Vec3 wo = -ray.direction;
-    Color radiance = rs.lights->emitted_radiance(si, wo);
+    radiance.add_emission(rs.lights->emitted_radiance(si, wo));
     const Bsdf bsdf = make_bsdf(rs, si, wo);
-    if (bsdf.has_non_delta()) radiance += sample_direct_light(rs, si, bsdf, wo, context, false);
+    if (bsdf.has_non_delta()) radiance.add_direct(sample_direct_light(rs, si, bsdf, wo, context, false));
     if (bsdf.has_delta() && depth < max_specular_depth_) {
         radiance += follow_delta_lobes(bsdf, wo, depth < kBranchDepth, context.rng, [&](const BsdfSample& s) {
             return radiance_along(spawn_ray(rs, si, s.wi), depth + 1, context, length, spread);

@@ -6,6 +6,7 @@
 #include <string_view>
 
 #include "core/accel/ray_tracer.h"
+#include "core/integrators/radiance_parts.h"
 #include "core/camera/camera.h"
 #include "core/material/bsdf.h"
 #include "core/math/low_discrepancy.h"
@@ -62,7 +63,11 @@ class Integrator {
 public:
     virtual ~Integrator() = default;
     virtual std::string_view name() const = 0;
-    virtual Color radiance(const CameraRay& ray, SampleContext& context) const = 0;
+    /// The scene it renders (the tile renderer reads the camera rays' first surfaces from it).
+    virtual const RenderScene& scene() const = 0;
+    /// The radiance along a camera ray, and its parts by how the light arrived (AOVs).
+    virtual RadianceParts radiance_parts(const CameraRay& ray, SampleContext& context) const = 0;
+    Color radiance(const CameraRay& ray, SampleContext& context) const { return radiance_parts(ray, context).total; }
 };
 
 /// The camera-ray footprint: the width of one pixel per unit of distance along the ray.

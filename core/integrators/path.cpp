@@ -6,9 +6,16 @@ PathIntegrator::PathIntegrator(std::shared_ptr<const RenderScene> scene, int max
                                int roulette_start_depth)
     : scene_(std::move(scene)), max_depth_(max_depth), roulette_start_depth_(roulette_start_depth) {}
 
-Color PathIntegrator::radiance(const CameraRay& camera_ray, SampleContext& context) const {
+RadianceParts PathIntegrator::radiance_parts(const CameraRay& camera_ray, SampleContext& context) const {
     const RenderScene& rs = *scene_;
-    Color radiance(0.0f);
+    RadianceParts radiance;
+    int rough_bounces = 0;  // non-delta BSDF samples so far
+    // The part emission found along the path counts in, and light sampled at the current vertex.
+    const auto emission_part = [&](bool after_delta) {
+        if (rough_bounces == 0) return &RadianceParts::emission;
+        if (rough_bounces == 1) return after_delta ? &RadianceParts::caustic : &RadianceParts::direct;
+        return &RadianceParts::indirect;
+    };
     Color throughput(1.0f);
     Ray ray = primary_ray(rs, camera_ray);
     bool previous_was_delta = true;  // the camera ray counts as specular: emission is taken whole
@@ -26,8 +33,9 @@ Color PathIntegrator::radiance(const CameraRay& camera_ray, SampleContext& conte
             // Left the scene: the environment and soft suns, weighted against their light
             // samples at the previous vertex (whole after the camera or a delta bounce).
             if (rs.lights->has_distant_area_lights())
-                radiance += throughput * rs.lights->escaped_radiance(ray.direction,
-                                                                     previous_was_delta ? 0.0f : previous_bsdf_pdf);
+                radiance.add(throughput * rs.lights->escaped_radiance(ray.direction,
+                                                                      previous_was_delta ? 0.0f : previous_bsdf_pdf),
+                             emission_part(previous_was_delta));
             break;
         }
         cone_length += hit->t;
@@ -43,12 +51,13 @@ Color PathIntegrator::radiance(const CameraRay& camera_ray, SampleContext& conte
                 const float light_pdf = rs.lights->pdf_incident_triangle(si.triangle, previous_point, si.p);
                 weight = power_heuristic(previous_bsdf_pdf, light_pdf);
             }
-            radiance += throughput * emitted * weight;
+            radiance.add(throughput * emitted * weight, emission_part(previous_was_delta));
         }
 
         const Bsdf bsdf = make_bsdf(rs, si, wo);
         if (bsdf.has_non_delta())
-            radiance += throughput * sample_direct_light(rs, si, bsdf, wo, context, true);
+            radiance.add(throughput * sample_direct_light(rs, si, bsdf, wo, context, true),
+                         rough_bounces == 0 ? &RadianceParts::direct : &RadianceParts::indirect);
 
         const float u_lobe = context.next_1d();
         const Vec2 u = context.next_2d();
@@ -56,6 +65,7 @@ Color PathIntegrator::radiance(const CameraRay& camera_ray, SampleContext& conte
         if (!s || !(s->pdf > 0.0f) || is_black(s->weight)) break;
         throughput *= s->weight;
         previous_was_delta = s->kind == LobeKind::Delta;
+        if (!previous_was_delta) ++rough_bounces;
         cone_alive = cone_alive && previous_was_delta;
         previous_bsdf_pdf = s->pdf;
         previous_point = si.p;

@@ -15,7 +15,12 @@ public:
     explicit PathIntegrator(std::shared_ptr<const RenderScene> scene, int max_depth = 256,
                             int roulette_start_depth = 3);
     std::string_view name() const override { return "path"; }
-    Color radiance(const CameraRay& ray, SampleContext& context) const override;
+    const RenderScene& scene() const override { return *scene_; }
+    /// The parts by the path's shape: emission through ideal specular bounces only; direct at the
+    /// first rough (non-delta) bounce, by light sampling or the emitter its BSDF sample hits;
+    /// caustic when ideal specular bounces lead from that surface to the emitter; indirect after
+    /// more rough bounces.
+    RadianceParts radiance_parts(const CameraRay& ray, SampleContext& context) const override;
 
 private:
     std::shared_ptr<const RenderScene> scene_;

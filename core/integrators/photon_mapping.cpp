@@ -89,7 +89,7 @@ std::string PhotonMapIntegrator::render_cache_key(const std::string& photon_map_
     return "rc1-" + Sha256::hex(hasher.finish());
 }
 
-Color PhotonMapIntegrator::radiance(const CameraRay& ray, SampleContext& context) const {
+RadianceParts PhotonMapIntegrator::radiance_parts(const CameraRay& ray, SampleContext& context) const {
     return radiance_along(primary_ray(*scene_, ray), 0, 0.0f, camera_footprint(ray), context);
 }
 
@@ -110,17 +110,21 @@ Color PhotonMapIntegrator::indirect_irradiance(const DiffusePoint& point, Sample
     return g.irradiance;
 }
 
-Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_length, RayFootprint footprint,
-                                          SampleContext& context) const {
+RadianceParts PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_length,
+                                                  RayFootprint footprint, SampleContext& context) const {
     const RenderScene& rs = *scene_;
     const std::optional<Hit> hit = trace_ray(rs, ray, context.counters);
     // A camera ray or a delta bounce that leaves the scene sees the sky whole.
-    if (!hit) return rs.lights->escaped_radiance(ray.direction, 0.0f);
+    RadianceParts radiance;
+    if (!hit) {
+        radiance.add_emission(rs.lights->escaped_radiance(ray.direction, 0.0f));
+        return radiance;
+    }
     const float length = path_length + hit->t;
     // The camera's ray cone, widened along ideal specular bounces, picks the texture level.
     const SurfaceInteraction si = make_interaction(*rs.scene, *hit, ray.direction, footprint.at(length));
     const Vec3 wo = -ray.direction;
-    Color radiance = rs.lights->emitted_radiance(si, wo);
+    radiance.add_emission(rs.lights->emitted_radiance(si, wo));
     const Bsdf bsdf = make_bsdf(rs, si, wo);
     if (bsdf.has_non_delta()) {
         // Glossy and rough lobes are also BSDF-sampled below: emitters those rays hit are
@@ -128,21 +132,21 @@ Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_
         const bool glossy = gatherer_ && bsdf.has_non_lambertian_non_delta();
         const LobeMask glossy_lobes = kNonDeltaLobes | kExcludeLambertian;
         const int glossy_rays = std::max(settings_.glossy_rays, 1);
-        radiance += sample_direct_light(rs, *direct_lights_, si, bsdf, wo, context, false, kAllLobes,
-                                        glossy ? glossy_lobes : LobeMask(0), static_cast<float>(glossy_rays));
+        radiance.add_direct(sample_direct_light(rs, *direct_lights_, si, bsdf, wo, context, false, kAllLobes,
+                                                glossy ? glossy_lobes : LobeMask(0), static_cast<float>(glossy_rays)));
         // Photon discs and cache records follow the surface, not its normal map; estimates weight
         // their photons by the mapped normal (RadianceEstimateOptions::shading_normal; README).
         const bool front = glm::dot(si.surface_normal, wo) >= 0.0f;
         const Vec3 normal = front ? si.surface_normal : -si.surface_normal;
         if (maps_->caustic)
-            radiance += maps_->caustic->estimate_radiance(si.p, normal, bsdf, wo,
-                                                          estimate_options_at(caustic_options_, si, bsdf, front));
+            radiance.add_caustic(maps_->caustic->estimate_radiance(si.p, normal, bsdf, wo,
+                                                                   estimate_options_at(caustic_options_, si, bsdf, front)));
         if (gatherer_) {
             const Color rho = bsdf.diffuse_reflectance(wo);
             if (max_component(rho) > 0.0f) {
                 const Vec3 ng = glm::dot(si.geometric_normal, wo) >= 0.0f ? si.geometric_normal : -si.geometric_normal;
                 const DiffusePoint point{si.p, normal, ng, footprint.at(length)};
-                radiance += rho * kInvPi * indirect_irradiance(point, context);
+                radiance.add_indirect(rho * kInvPi * indirect_irradiance(point, context));
             }
             if (glossy) {
                 // Glossy and rough lobes: BSDF-sampled rays reading the photon maps where they land
@@ -153,7 +157,9 @@ Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_
                 // one ray per sample alone, and stayed grainy at 16 spp.
                 const EnvironmentLight* sky = rs.lights_with_sky_peaks ? rs.diffuse_sky.get() : nullptr;
                 const float rays = static_cast<float>(glossy_rays);
-                Color sum(0.0f);
+                // `sum` is the total as it always was; the parts beside it: what the rays found at
+                // once (emitters, the sky) is direct light, what they gathered beyond, indirect.
+                Color sum(0.0f), sum_direct(0.0f), sum_indirect(0.0f);
                 if (sky) {
                     float pdf = 0.0f;
                     const Vec3 wi = sky->sample(context.next_2d(), &pdf);
@@ -163,8 +169,8 @@ Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_
                         const Ray shadow{rs.tracer->offset_origin(si.p, si.geometric_normal, wi), wi};
                         if (!rs.tracer->occluded(shadow)) {
                             const float weight = power_heuristic(pdf, rays * bsdf.pdf(wo, wi, glossy_lobes));
-                            radiance += f * sky->radiance(wi) *
-                                        (std::abs(glm::dot(wi, si.shading_normal)) * weight / pdf);
+                            radiance.add_direct(f * sky->radiance(wi) *
+                                                (std::abs(glm::dot(wi, si.shading_normal)) * weight / pdf));
                         }
                     }
                 }
@@ -185,16 +191,20 @@ Color PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_
                     if (sky && !std::isfinite(distance) && s->kind != LobeKind::Delta)
                         gathered *= power_heuristic(rays * s->pdf, sky->pdf(s->wi));
                     sum += s->weight * gathered;
+                    (std::isfinite(distance) ? sum_indirect : sum_direct) += s->weight * gathered;
                     if (!is_black(emitted.radiance) && s->kind != LobeKind::Delta) {
                         const float light_pdf = direct_lights_->pdf_incident_triangle(emitted.triangle, si.p, emitted.point);
                         sum += s->weight * emitted.radiance * power_heuristic(rays * s->pdf, light_pdf);
+                        sum_direct += s->weight * emitted.radiance * power_heuristic(rays * s->pdf, light_pdf);
                     }
                 }
-                radiance += sum / static_cast<float>(glossy_rays);
+                radiance.total += sum / static_cast<float>(glossy_rays);
+                radiance.direct += sum_direct / static_cast<float>(glossy_rays);
+                radiance.indirect += sum_indirect / static_cast<float>(glossy_rays);
             }
         } else if (maps_->global) {
-            radiance += maps_->global->estimate_radiance(si.p, normal, bsdf, wo,
-                                                         estimate_options_at(global_options_, si, bsdf, front));
+            radiance.add_indirect(maps_->global->estimate_radiance(si.p, normal, bsdf, wo,
+                                                                   estimate_options_at(global_options_, si, bsdf, front)));
         }
     }
     if (bsdf.has_delta() && depth < settings_.max_specular_depth) {

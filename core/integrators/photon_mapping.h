@@ -63,14 +63,19 @@ public:
     std::string render_cache_key(const std::string& photon_map_key, const CameraDesc& camera, int width, int height,
                                  const std::string& start_key = "") const;
 
-    Color radiance(const CameraRay& ray, SampleContext& context) const override;
+    const RenderScene& scene() const override { return *scene_; }
+    /// The parts by estimator: emission seen through ideal specular surfaces; direct from light
+    /// sampling (and the emitters and the sky the glossy rays find at once); caustic from the
+    /// caustic map; indirect from final gathering (or the global map read directly), which also
+    /// holds the diffuse part of a sky (final gathering collects it, light sampling only its peaks).
+    RadianceParts radiance_parts(const CameraRay& ray, SampleContext& context) const override;
 
     const IrradianceCache* cache() const { return cache_.get(); }
     const std::shared_ptr<const IrradianceCache>& shared_cache() const { return cache_; }
 
 private:
-    Color radiance_along(const Ray& ray, int depth, float path_length, RayFootprint footprint,
-                         SampleContext& context) const;
+    RadianceParts radiance_along(const Ray& ray, int depth, float path_length, RayFootprint footprint,
+                                 SampleContext& context) const;
     Color indirect_irradiance(const DiffusePoint& point, SampleContext& context) const;
 
     std::shared_ptr<const RenderScene> scene_;

@@ -4,7 +4,10 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <mutex>
+
+#include "core/render/aov_sample.h"
 
 namespace photond {
 
@@ -33,7 +36,12 @@ TileRenderResult render_tiles(const Integrator& integrator, const Camera& camera
     const int spp = std::max(settings.samples_per_pixel, 1);
 
     TileRenderResult result;
-    result.image = Image(width, height);
+    ImageLayers& layers = result.layers;
+    layers.beauty = Image(width, height);
+    for (Aov aov : settings.aovs) layers.aovs.emplace_back(std::string(aov_name(aov)), Image(width, height));
+    const bool first_surface_wanted =
+        std::any_of(settings.aovs.begin(), settings.aovs.end(), [](Aov aov) { return needs_first_surface(aov); });
+    const size_t aov_count = settings.aovs.size();
     result.tiles_total = tiles.size();
     std::atomic<size_t> tiles_done{0};
     std::atomic<size_t> tiles_restored{0};
@@ -43,10 +51,12 @@ TileRenderResult render_tiles(const Integrator& integrator, const Camera& camera
     auto render_tile = [&](const PixelRect& tile) {
         enable_flush_denormals();
         RayCounters& local = counters.local();
+        std::vector<DVec3> aov_sums(aov_count);
         for (int y = tile.y0; y < tile.y1; ++y) {
             for (int x = tile.x0; x < tile.x1; ++x) {
                 const uint64_t pixel = static_cast<uint64_t>(y) * static_cast<uint64_t>(width) + x;
                 DVec3 sum(0.0);
+                std::fill(aov_sums.begin(), aov_sums.end(), DVec3(0.0));
                 // The pixel's sample pattern (never 0, which means "none").
                 const uint64_t pattern_seed = hash_indices(settings.seed, pixel, kPatternStream) | 1u;
                 for (int s = 0; s < spp; ++s) {
@@ -55,12 +65,24 @@ TileRenderResult render_tiles(const Integrator& integrator, const Camera& camera
                     const Vec2 jitter = context.next_2d();
                     const CameraRay ray = camera.generate_ray(static_cast<float>(x) + jitter.x,
                                                               static_cast<float>(y) + jitter.y);
-                    const Color L = integrator.radiance(ray, context);
+                    const RadianceParts parts = integrator.radiance_parts(ray, context);
+                    const Color& L = parts.total;
                     // A non-finite sample (a numerical failure) is dropped rather than poisoning
                     // the pixel; every pixel of the output stays finite.
-                    if (is_finite(L)) sum += DVec3(L);
+                    if (!is_finite(L)) continue;
+                    sum += DVec3(L);
+                    if (aov_count == 0) continue;
+                    // After the sample's own draws: the beauty pass is the same with or without AOVs.
+                    const FirstSurface surface =
+                        first_surface_wanted ? first_surface(integrator.scene(), ray, local) : FirstSurface{};
+                    for (size_t a = 0; a < aov_count; ++a) {
+                        const Color value = aov_value(settings.aovs[a], parts, surface);
+                        if (is_finite(value)) aov_sums[a] += DVec3(value);
+                    }
                 }
-                result.image.at(x, y) = Color(sum / static_cast<double>(spp));
+                layers.beauty.at(x, y) = Color(sum / static_cast<double>(spp));
+                for (size_t a = 0; a < aov_count; ++a)
+                    layers.aovs[a].second.at(x, y) = Color(aov_sums[a] / static_cast<double>(spp));
             }
         }
     };
@@ -76,13 +98,13 @@ TileRenderResult render_tiles(const Integrator& integrator, const Camera& camera
                         cancelled = true;
                         return;
                     }
-                    const bool restored = callbacks.restore_tile && callbacks.restore_tile(tiles[i], result.image);
+                    const bool restored = callbacks.restore_tile && callbacks.restore_tile(tiles[i], layers);
                     if (restored)
                         tiles_restored.fetch_add(1);
                     else
                         render_tile(tiles[i]);
                     const size_t done = tiles_done.fetch_add(1) + 1;
-                    if (callbacks.on_tile) callbacks.on_tile({tiles[i], done, tiles.size(), restored}, result.image);
+                    if (callbacks.on_tile) callbacks.on_tile({tiles[i], done, tiles.size(), restored}, layers);
                 }
             },
             tbb::simple_partitioner());

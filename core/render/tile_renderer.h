@@ -13,6 +13,7 @@
 #include "core/camera/camera.h"
 #include "core/image/image.h"
 #include "core/integrators/integrator.h"
+#include "core/render/aov.h"
 
 namespace photond {
 
@@ -22,6 +23,7 @@ struct TileSettings {
     uint64_t seed = 1;
     int threads = 0;                     // 0 = every core
     std::optional<PixelRect> region;     // render only this part of the frame (others stay black)
+    std::vector<Aov> aovs;               // layers beside the beauty pass, in this order
 };
 
 /// The tiles covering `area`, row by row.
@@ -36,18 +38,18 @@ struct TileEvent {
 
 struct RenderCallbacks {
     /// Called after each tile, from the worker thread that finished it (calls may overlap);
-    /// `frame` holds the finished tile's pixels (and other tiles' in any state).
-    std::function<void(const TileEvent&, const Image& frame)> on_tile;
+    /// `frame` holds the finished tile's pixels in every layer (and other tiles' in any state).
+    std::function<void(const TileEvent&, const ImageLayers& frame)> on_tile;
     /// Called before each tile renders, from the worker thread that would render it (calls may
-    /// overlap): when it fills `rect` of `frame` with the tile's pixels from an earlier,
-    /// interrupted run of the same render and returns true, the tile is not rendered again.
-    std::function<bool(const PixelRect& rect, Image& frame)> restore_tile;
+    /// overlap): when it fills `rect` of `frame` (every layer) with the tile's pixels from an
+    /// earlier, interrupted run of the same render and returns true, the tile is not rendered again.
+    std::function<bool(const PixelRect& rect, ImageLayers& frame)> restore_tile;
     /// Checked before each tile starts: when set, the remaining tiles are skipped.
     const std::atomic<bool>* cancel = nullptr;
 };
 
 struct TileRenderResult {
-    Image image;
+    ImageLayers layers;  // the beauty pass and TileSettings::aovs, named by aov_name
     RayCounters counters;
     size_t tiles_done = 0;      // rendered or restored
     size_t tiles_restored = 0;  // of those, filled by RenderCallbacks::restore_tile
@@ -55,7 +57,8 @@ struct TileRenderResult {
     bool cancelled = false;
 };
 
-/// Renders with `integrator` through `camera` (whose size is the frame's).
+/// Renders with `integrator` through `camera` (whose size is the frame's). Each pixel of each
+/// layer is the average of its samples (an AOV's value per sample: aov_value).
 TileRenderResult render_tiles(const Integrator& integrator, const Camera& camera,
                               const TileSettings& settings, const RenderCallbacks& callbacks = {});
 

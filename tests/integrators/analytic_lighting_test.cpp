@@ -149,8 +149,8 @@ TEST(AnalyticLighting, FurnaceRadianceIsEmissionOverOneMinusAlbedo) {
     settings.samples_per_pixel = 64;
     const TileRenderResult result = render_tiles(path, camera, settings);
     double sum = 0.0;
-    for (const Color& c : result.image.pixels()) sum += average(c);
-    const double mean = sum / static_cast<double>(result.image.pixel_count());
+    for (const Color& c : result.layers.beauty.pixels()) sum += average(c);
+    const double mean = sum / static_cast<double>(result.layers.beauty.pixel_count());
     const double relative_error = std::abs(mean - kFurnaceRadiance) / kFurnaceRadiance;
     RecordProperty("furnace_relative_error", std::to_string(relative_error));
     std::printf("furnace: mean radiance %.5f, expected %.5f, relative error %.4f %%\n", mean,

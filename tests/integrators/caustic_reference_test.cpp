@@ -55,7 +55,7 @@ TEST(CausticReference, PhotonMapCausticMatchesThePathTracedReference) {
     TileSettings tiles;
     tiles.samples_per_pixel = 16;
     tiles.region = kRegion;
-    const Image image = render_tiles(integrator, camera, tiles).image;
+    const Image image = render_tiles(integrator, camera, tiles).layers.beauty;
 
     const ImageError error = compare_images(downsample(image, kBlock), downsample(reference, kBlock), kBlockRegion).value();
     const ImageError per_pixel = compare_images(image, reference, kRegion).value();

@@ -54,14 +54,14 @@ Image render_photon_map(const std::shared_ptr<const RenderScene>& rs, const Came
     photon_map.prepare(camera, nullptr);
     TileSettings tiles;
     tiles.samples_per_pixel = 16;
-    return render_tiles(photon_map, camera, tiles).image;
+    return render_tiles(photon_map, camera, tiles).layers.beauty;
 }
 
 /// A path render at `samples_per_pixel`.
 Image render_path(const std::shared_ptr<const RenderScene>& rs, const Camera& camera, int samples_per_pixel) {
     TileSettings tiles;
     tiles.samples_per_pixel = samples_per_pixel;
-    return render_tiles(PathIntegrator(rs), camera, tiles).image;
+    return render_tiles(PathIntegrator(rs), camera, tiles).layers.beauty;
 }
 
 /// The image means of a converged path render (1024 spp).

@@ -54,7 +54,7 @@ TEST(GlossyEmitter, EmitterBehindRoughGlassAgreesWithPath) {
 
     TileSettings path_tiles;
     path_tiles.samples_per_pixel = 1024;
-    const double reference = mean_luminance(render_tiles(PathIntegrator(rs), camera, path_tiles).image);
+    const double reference = mean_luminance(render_tiles(PathIntegrator(rs), camera, path_tiles).layers.beauty);
 
     PhotonTracingSettings tracing;
     tracing.global_photons = 100000;
@@ -67,7 +67,7 @@ TEST(GlossyEmitter, EmitterBehindRoughGlassAgreesWithPath) {
     const PhotonMapIntegrator photon_map(rs, std::make_shared<const PhotonMaps>(std::move(maps).value()), settings);
     TileSettings tiles;
     tiles.samples_per_pixel = 64;
-    const double estimate = mean_luminance(render_tiles(photon_map, camera, tiles).image);
+    const double estimate = mean_luminance(render_tiles(photon_map, camera, tiles).layers.beauty);
     std::printf("emitter behind rough glass, 32x32: path %.4f, photon-map %.4f\n", reference, estimate);
     EXPECT_NEAR(estimate / reference, 1.0, 0.03);
 }

@@ -52,7 +52,7 @@ TEST(GlossyGather, GlossyLobesFollowedBySamplingAgreeWithPathPerPixel) {
     const Camera camera = Camera::create(rs->scene->cameras.at(0), 48, 32).value();
     TileSettings path_tiles;
     path_tiles.samples_per_pixel = 1024;
-    const Image reference = render_tiles(PathIntegrator(rs), camera, path_tiles).image;
+    const Image reference = render_tiles(PathIntegrator(rs), camera, path_tiles).layers.beauty;
 
     const RenderPlan plan = plan_photon_passes(*rs->scene, *rs->lights, {100000, 20000});
     EXPECT_FALSE(plan.caustic_map) << "light glossy lobes reflect is final gathering's, not a caustic";
@@ -70,7 +70,7 @@ TEST(GlossyGather, GlossyLobesFollowedBySamplingAgreeWithPathPerPixel) {
         const PhotonMapIntegrator photon_map(rs, maps, settings);
         TileSettings tiles;
         tiles.samples_per_pixel = 32;
-        const Image image = render_tiles(photon_map, camera, tiles).image;
+        const Image image = render_tiles(photon_map, camera, tiles).layers.beauty;
         for (const Color& c : image.pixels()) EXPECT_TRUE(is_finite(c));
         return compare_images(image, reference).value();
     };
@@ -108,10 +108,10 @@ TEST(GlossyGather, RoughMetalUnderAUniformSkyIsAsSmoothAsPath) {
     const Camera camera = Camera::create(rs->scene->cameras.at(0), 32, 32).value();
     TileSettings path_tiles;
     path_tiles.samples_per_pixel = 4096;
-    const Image reference = render_tiles(PathIntegrator(rs), camera, path_tiles).image;
+    const Image reference = render_tiles(PathIntegrator(rs), camera, path_tiles).layers.beauty;
     TileSettings tiles;
     tiles.samples_per_pixel = 16;
-    const Image path16 = render_tiles(PathIntegrator(rs), camera, tiles).image;
+    const Image path16 = render_tiles(PathIntegrator(rs), camera, tiles).layers.beauty;
 
     PhotonTracingSettings tracing;
     tracing.global_photons = 20000;
@@ -122,7 +122,7 @@ TEST(GlossyGather, RoughMetalUnderAUniformSkyIsAsSmoothAsPath) {
     settings.gather.rays = 64;
     settings.irradiance_cache = false;
     const PhotonMapIntegrator photon_map(rs, std::make_shared<const PhotonMaps>(std::move(traced).value()), settings);
-    const Image image = render_tiles(photon_map, camera, tiles).image;
+    const Image image = render_tiles(photon_map, camera, tiles).layers.beauty;
     const ImageError ours = compare_images(image, reference).value();
     const ImageError theirs = compare_images(path16, reference).value();
     std::printf("rough metal plane under a uniform sky, 16 spp: photon-map relMSE %.6f, path %.6f\n",

@@ -167,7 +167,7 @@ Image render_with_threads(const Fixture& f, int threads) {
     tiles.tile_size = 8;
     tiles.samples_per_pixel = 2;
     tiles.threads = threads;
-    return render_tiles(integrator, camera, tiles).image;
+    return render_tiles(integrator, camera, tiles).layers.beauty;
 }
 
 TEST(IrradianceCache, ImagesAreBitIdenticalForOneTwoAndSevenThreads) {

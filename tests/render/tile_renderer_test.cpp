@@ -57,24 +57,24 @@ TEST(TileRenderer, BitIdenticalForAnyThreadCount) {
     const TileRenderResult one = render_tiles(*f.integrator, f.camera, small_settings(1));
     const TileRenderResult two = render_tiles(*f.integrator, f.camera, small_settings(2));
     const TileRenderResult seven = render_tiles(*f.integrator, f.camera, small_settings(7));
-    EXPECT_TRUE(one.image == two.image);
-    EXPECT_TRUE(one.image == seven.image);
+    EXPECT_TRUE(one.layers.beauty == two.layers.beauty);
+    EXPECT_TRUE(one.layers.beauty == seven.layers.beauty);
     EXPECT_EQ(one.counters.rays, two.counters.rays);
     ImageLayers a, b;
-    a.beauty = one.image;
-    b.beauty = two.image;
+    a.beauty = one.layers.beauty;
+    b.beauty = two.layers.beauty;
     EXPECT_EQ(encode_exr(a).value(), encode_exr(b).value());
     // A different seed gives a different image: the comparison above can fail.
     TileSettings other = small_settings(2);
     other.seed = 43;
-    EXPECT_FALSE(render_tiles(*f.integrator, f.camera, other).image == one.image);
+    EXPECT_FALSE(render_tiles(*f.integrator, f.camera, other).layers.beauty == one.layers.beauty);
 }
 
 TEST(TileRenderer, EveryPixelFiniteAndNonNegative) {
     const auto& f = cornell();
     const TileRenderResult r = render_tiles(*f.integrator, f.camera, small_settings(2));
     double sum = 0.0;
-    for (const Color& c : r.image.pixels()) {
+    for (const Color& c : r.layers.beauty.pixels()) {
         ASSERT_TRUE(is_finite(c));
         ASSERT_GE(min_component(c), 0.0f);
         sum += average(c);
@@ -91,9 +91,9 @@ TEST(TileRenderer, RegionRendersOnlyItsPixelsAndMatchesTheFullFrame) {
     for (int y = 0; y < f.camera.height(); ++y) {
         for (int x = 0; x < f.camera.width(); ++x) {
             if (s.region->contains(x, y)) {
-                ASSERT_EQ(part.image.at(x, y), full.image.at(x, y));
+                ASSERT_EQ(part.layers.beauty.at(x, y), full.layers.beauty.at(x, y));
             } else {
-                ASSERT_EQ(part.image.at(x, y), Color(0.0f));
+                ASSERT_EQ(part.layers.beauty.at(x, y), Color(0.0f));
             }
         }
     }
@@ -103,7 +103,7 @@ TEST(TileRenderer, ProgressReportsEveryTileAndCancelStops) {
     const auto& f = cornell();
     std::atomic<size_t> events{0};
     RenderCallbacks callbacks;
-    callbacks.on_tile = [&](const TileEvent& e, const Image&) {
+    callbacks.on_tile = [&](const TileEvent& e, const ImageLayers&) {
         ++events;
         EXPECT_LE(e.tiles_done, e.tiles_total);
     };
@@ -114,7 +114,7 @@ TEST(TileRenderer, ProgressReportsEveryTileAndCancelStops) {
     std::atomic<bool> cancel{false};
     RenderCallbacks cancelling;
     cancelling.cancel = &cancel;
-    cancelling.on_tile = [&](const TileEvent& e, const Image&) {
+    cancelling.on_tile = [&](const TileEvent& e, const ImageLayers&) {
         if (e.tiles_done >= 2) cancel = true;
     };
     TileSettings one_thread = small_settings(1);
@@ -127,23 +127,23 @@ TEST(TileRenderer, RestoredTilesAreNotRenderedAndTheImageIsBitIdentical) {
     // What a resumed job does: tiles kept by an interrupted run are filled in, the rest rendered.
     const auto& f = cornell();
     const TileRenderResult whole = render_tiles(*f.integrator, f.camera, small_settings(2));
-    const std::vector<PixelRect> tiles = make_tiles(whole.image.bounds(), 16);
+    const std::vector<PixelRect> tiles = make_tiles(whole.layers.beauty.bounds(), 16);
     ASSERT_EQ(tiles.size(), 9u);
     std::mutex mutex;
     std::vector<PixelRect> restored_seen, rendered_seen;
     RenderCallbacks callbacks;
-    callbacks.restore_tile = [&](const PixelRect& rect, Image& frame) {
+    callbacks.restore_tile = [&](const PixelRect& rect, ImageLayers& frame) {
         const size_t index = static_cast<size_t>(std::find(tiles.begin(), tiles.end(), rect) - tiles.begin());
         if (index % 2 != 0) return false;  // "not kept": rendered
-        frame.paste(whole.image.copy_rect(rect), rect.x0, rect.y0);
+        frame.beauty.paste(whole.layers.beauty.copy_rect(rect), rect.x0, rect.y0);
         return true;
     };
-    callbacks.on_tile = [&](const TileEvent& event, const Image&) {
+    callbacks.on_tile = [&](const TileEvent& event, const ImageLayers&) {
         std::lock_guard lock(mutex);
         (event.restored ? restored_seen : rendered_seen).push_back(event.rect);
     };
     const TileRenderResult resumed = render_tiles(*f.integrator, f.camera, small_settings(2), callbacks);
-    EXPECT_TRUE(resumed.image == whole.image);
+    EXPECT_TRUE(resumed.layers.beauty == whole.layers.beauty);
     EXPECT_EQ(resumed.tiles_done, 9u);
     EXPECT_EQ(resumed.tiles_restored, 5u);
     EXPECT_EQ(restored_seen.size(), 5u);

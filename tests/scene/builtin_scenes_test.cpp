@@ -605,12 +605,12 @@ TEST(BuiltinScenes, SpheresRoomRendersFiniteAndFillsTheFrame) {
     settings.samples_per_pixel = 8;
     settings.seed = 7;
     const TileRenderResult r = render_tiles(integrator, *camera, settings);
-    ASSERT_EQ(r.image.width(), kSize);
+    ASSERT_EQ(r.layers.beauty.width(), kSize);
     double total = 0.0;
     std::vector<double> row_sum(kSize, 0.0);
     for (int y = 0; y < kSize; ++y) {
         for (int x = 0; x < kSize; ++x) {
-            const Color c = r.image.pixels()[static_cast<size_t>(y) * kSize + x];
+            const Color c = r.layers.beauty.pixels()[static_cast<size_t>(y) * kSize + x];
             ASSERT_TRUE(std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z));
             ASSERT_GE(min_component(c), 0.0f);
             row_sum[y] += average(c);

@@ -52,7 +52,7 @@ Image render(const Scene& scene) {
     settings.tile_size = 16;
     settings.samples_per_pixel = 4;
     settings.seed = 3;
-    return render_tiles(integrator, camera, settings).image;
+    return render_tiles(integrator, camera, settings).layers.beauty;
 }
 
 ImageError compare(const Image& image, const Image& reference) {

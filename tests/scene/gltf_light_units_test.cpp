@@ -26,7 +26,7 @@ double mean_radiance(const std::shared_ptr<const RenderScene>& rs, Vec3 from, Ve
     const DirectIntegrator integrator(rs);
     TileSettings settings;
     settings.samples_per_pixel = 256;  // each sample picks one of the three lights at random
-    const Image image = render_tiles(integrator, camera, settings).image;
+    const Image image = render_tiles(integrator, camera, settings).layers.beauty;
     double sum = 0.0;
     for (const Color& c : image.pixels()) sum += c.x;
     return sum / double(image.pixel_count());

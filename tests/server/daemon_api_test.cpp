@@ -159,6 +159,71 @@ TEST_F(DaemonApi, SubmitEventsTilesAndImageEqualToPhotondRender) {
     EXPECT_EQ(daemon.stop(), 0) << daemon.log();
 }
 
+TEST_F(DaemonApi, AovLayersReachTilesTheStreamAndTheImage) {
+    // The job's AOVs as named EXR layers in every tile, every part of the multipart stream and the
+    // final image, which is the same bytes as `photond render` of the job; the radiance parts sum
+    // to the beauty pass.
+    json job = kJob;
+    job["output"] = {{"pixel_type", "float"}, {"aovs", {"emission", "direct", "indirect", "caustic", "normal"}}};
+    Daemon daemon(dir_.path() / "cache");
+    ASSERT_TRUE(daemon.started()) << daemon.first_line() << daemon.log();
+    const HttpClient client = daemon.client();
+    const HttpResponse submitted = client.post("/v1/jobs", job.dump(), {{"Content-Type", "application/json"}});
+    ASSERT_EQ(submitted.status, 202) << submitted.body;
+    const std::string id = submitted.json_body().at("id");
+    const HttpResponse image = client.get("/v1/jobs/" + id + "/image.exr?wait=true");
+    ASSERT_EQ(image.status, 200) << image.body;
+    const auto final_image = decode_exr(bytes_of(image.body));
+    ASSERT_TRUE(final_image.has_value()) << final_image.error().message;
+    std::set<std::string> names;
+    for (const auto& [name, layer] : final_image->aovs) names.insert(name);
+    EXPECT_EQ(names, (std::set<std::string>{"emission", "direct", "indirect", "caustic", "normal"}));
+    double worst = 0.0;
+    for (size_t p = 0; p < final_image->beauty.pixel_count(); ++p) {
+        Color sum(0.0f);
+        for (const char* part : {"emission", "direct", "indirect", "caustic"})
+            sum += final_image->find_aov(part)->pixels()[p];
+        const Color beauty = final_image->beauty.pixels()[p];
+        for (int ch = 0; ch < 3; ++ch)
+            worst = std::max(worst, double(std::abs(sum[ch] - beauty[ch])) / std::max(1.0, double(beauty[ch])));
+    }
+    EXPECT_LT(worst, 1e-5);
+
+    // A tile: every layer, equal to the final image's rectangle.
+    const HttpResponse tile = client.get("/v1/jobs/" + id + "/tiles/1/2.exr");
+    ASSERT_EQ(tile.status, 200) << tile.body;
+    const auto decoded = decode_tile_exr(bytes_of(tile.body));
+    ASSERT_TRUE(decoded.has_value()) << decoded.error().message;
+    EXPECT_EQ(decoded->rect, (PixelRect{16, 32, 32, 48}));
+    ASSERT_EQ(decoded->tile.aovs.size(), 5u);
+    EXPECT_TRUE(decoded->tile.beauty == final_image->beauty.copy_rect(decoded->rect));
+    for (const auto& [name, layer] : decoded->tile.aovs)
+        EXPECT_TRUE(layer == final_image->find_aov(name)->copy_rect(decoded->rect)) << name;
+
+    // The multipart stream: the same tile bytes.
+    const HttpResponse stream = client.get("/v1/jobs/" + id + "/tiles");
+    ASSERT_EQ(stream.status, 200);
+    const std::string type = stream.header("content-type");
+    const auto parts = parse_multipart(stream.body, type.substr(type.find('=') + 1));
+    ASSERT_EQ(parts.size(), 12u);
+    bool found = false;
+    for (const MultipartPart& part : parts) {
+        if (part.headers.at("x-tile-x") == "1" && part.headers.at("x-tile-y") == "2") {
+            found = true;
+            EXPECT_TRUE(part.body == tile.body);
+        }
+    }
+    EXPECT_TRUE(found);
+
+    write_file(dir_.path() / "job.json", job.dump());
+    const auto [code, output] =
+        run_command(kPhotondBinary + " render --job " + (dir_.path() / "job.json").string() +
+                    " --threads 1 --quiet -o " + (dir_.path() / "cli.exr").string());
+    ASSERT_EQ(code, 0) << output;
+    EXPECT_TRUE(image.body == read_file(dir_.path() / "cli.exr")) << "the daemon's EXR differs from photond render's";
+    EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+}
+
 TEST_F(DaemonApi, PreviewPngHonoursTheJobsExposure) {
     Daemon daemon(dir_.path() / "cache");
     ASSERT_TRUE(daemon.started()) << daemon.log();

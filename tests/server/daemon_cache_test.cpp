@@ -428,11 +428,12 @@ TEST_F(DaemonCache, TwoDaemonsShareOneCacheDirectoryAndBuildEachKeyOnce) {
 TEST_F(DaemonCache, AJobKilledMidRenderResumesFromItsTilesWithTheSameBytes) {
     // kill -9 in the middle of the render pass: the restarted daemon takes the tiles finished
     // before the kill, takes the photon maps from the cache, rebuilds the irradiance cache and
-    // renders the rest; the image is byte-identical to an uninterrupted run's.
+    // renders the rest; the image, AOV layers included, is byte-identical to an uninterrupted
+    // run's.
     const json job = {{"scene", {{"builtin", "cornell-box"}}},
                       {"integrator", "photon-map"},
                       {"image", {{"width", 256}, {"height", 192}, {"spp", 32}, {"tile_size", 16}}},
-                      {"output", {{"pixel_type", "float"}}}};
+                      {"output", {{"pixel_type", "float"}, {"aovs", {"caustic", "albedo", "depth"}}}}};
     const fs::path cache = dir_.path() / "cache";
     std::string id;
     uint64_t done_before_kill = 0;
@@ -476,6 +477,9 @@ TEST_F(DaemonCache, AJobKilledMidRenderResumesFromItsTilesWithTheSameBytes) {
         uninterrupted.client().get("/v1/jobs/" + reference.at("id").get<std::string>() + "/image.exr").body;
     ASSERT_GT(reference_image.size(), 100000u);  // a whole float image (compressed)
     EXPECT_TRUE(resumed_image == reference_image) << "the resumed image differs from the uninterrupted one";
+    const auto layers = decode_exr({reinterpret_cast<const uint8_t*>(resumed_image.data()), resumed_image.size()});
+    ASSERT_TRUE(layers.has_value()) << layers.error().message;
+    EXPECT_EQ(layers->aovs.size(), 3u);
 }
 
 TEST_F(DaemonCache, AJobRunningAtThreeDeathsOfTheDaemonIsFailedAsPoison) {

@@ -112,7 +112,7 @@ inline Expected<StressRender> render_scene(std::shared_ptr<const Scene> scene,
     tiles.seed = s.seed;
     tiles.threads = s.threads;
     TileRenderResult rendered = render_tiles(*integrator, *camera, tiles);
-    out.image = std::move(rendered.image);
+    out.image = std::move(rendered.layers.beauty);
     out.counters = rendered.counters;
     return out;
 }
