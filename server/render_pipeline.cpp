@@ -492,60 +492,37 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     if (!integrator) return integrator.error();
     stats.plan.insert(stats.plan.begin(), environment_decision);
 
-    auto* photon_map = dynamic_cast<PhotonMapIntegrator*>(integrator->get());
-    if (!job.irradiance_cache.start_from.empty() && !(photon_map && photon_map->uses_irradiance_cache()))
+    Integrator& renderer = **integrator;
+    const std::string_view preparation = renderer.preparation_pass();
+    if (!job.irradiance_cache.start_from.empty() && preparation != "irradiance_cache")
         stats.warnings.push_back("irradiance_cache.start_from is ignored: this job has no irradiance cache (it needs the "
                                  "photon-map integrator with irradiance_cache.enabled)");
-    if (photon_map && photon_map->uses_irradiance_cache()) {
-        if (options.on_pass) options.on_pass("irradiance_cache");
+    if (!preparation.empty()) {
+        if (options.on_pass) options.on_pass(std::string(preparation));
         pass_start = Clock::now();
-        CacheBuildStatistics cache_stats;
-        RenderStatistics::IrradianceCacheFigures figures;
-        // An earlier view's cache to start from (irradiance_cache.start_from), from the store.
-        std::shared_ptr<const IrradianceCache> start_cache;
-        if (!job.irradiance_cache.start_from.empty()) {
-            const std::string& start_key = job.irradiance_cache.start_from;
-            if (!options.render_caches || stats.photon_map_key.empty())
-                return Error{"irradiance_cache.start_from: this render keeps no render caches to start from (photond "
-                             "render needs --cache-dir)"};
-            start_cache = options.render_caches->find_cache(start_key);
-            if (!start_cache)
-                return Error{"irradiance_cache.start_from: no render cache " + start_key +
-                             " here (render that view first, or import its cache with PUT /v1/render-caches/" +
-                             start_key + ")"};
-            if (!start_matches(*start_cache, **render_scene, photon_map->cache_settings()))
-                return Error{"irradiance_cache.start_from: render cache " + start_key +
-                             " was built for another scene or other irradiance_cache.a/gradients"};
-            figures.start_from = start_key;
-        }
-        if (options.render_caches && !stats.photon_map_key.empty()) {
-            // Built once per key: other views' jobs, other regions of the frame and other nodes
-            // sharing the cache directory take it instead of running the prepass.
-            figures.key = photon_map->render_cache_key(stats.photon_map_key, *camera_desc, job.image.width,
-                                                       job.image.height, job.irradiance_cache.start_from);
-            const auto build = [&]() -> Expected<std::shared_ptr<const IrradianceCache>> {
-                photon_map->prepare(*camera, &cache_stats, start_cache.get());
-                if (options.callbacks.cancel && options.callbacks.cancel->load())
-                    return Error{"cancelled during the irradiance-cache prepass"};  // incomplete: not kept
-                return photon_map->shared_cache();
-            };
-            bool hit = false;
-            auto cache = options.render_caches->get_or_build(figures.key, build, &hit);
-            if (cache) photon_map->use_cache(*cache);
-            else if (!(options.callbacks.cancel && options.callbacks.cancel->load())) return cache.error();
-            figures.cache = hit ? "hit" : "miss";
-        } else {
-            photon_map->prepare(*camera, &cache_stats);
-        }
-        if (photon_map->cache()) {
-            figures.records = photon_map->cache()->size();
-            if (start_cache) figures.records_reused = start_cache->size();
-            figures.waves = cache_stats.waves;
+        const PrepareContext context{.camera = *camera,
+                                     .camera_desc = *camera_desc,
+                                     .width = job.image.width,
+                                     .height = job.image.height,
+                                     .photon_map_key = stats.photon_map_key,
+                                     .render_caches = options.render_caches,
+                                     .start_from = job.irradiance_cache.start_from,
+                                     .cancel = options.callbacks.cancel};
+        auto prepared = renderer.prepare(context);
+        if (!prepared) return prepared.error();
+        if (prepared->built) {
+            RenderStatistics::IrradianceCacheFigures figures;
+            figures.records = prepared->records;
+            figures.records_reused = prepared->records_reused;
+            figures.waves = prepared->waves;
+            figures.cache = prepared->cache_outcome;
+            figures.key = prepared->cache_key;
+            figures.start_from = prepared->start_from;
             figures.seconds = seconds_since(pass_start);
             stats.irradiance_cache = figures;
-            stats.passes.push_back({"irradiance_cache", figures.seconds});
-            stats.rays += cache_stats.counters.rays;
-            stats.shadow_rays += cache_stats.counters.shadow_rays;
+            stats.passes.push_back({std::string(preparation), figures.seconds});
+            stats.rays += prepared->counters.rays;
+            stats.shadow_rays += prepared->counters.shadow_rays;
         }
     }
 

@@ -16,6 +16,7 @@
 #include "core/image/exr_io.h"
 #include "core/image/image.h"
 #include "core/integrators/irradiance_cache.h"
+#include "core/integrators/render_cache_store.h"
 #include "core/render/render_plan.h"
 #include "core/render/statistics.h"
 #include "core/render/tile_renderer.h"
@@ -33,18 +34,6 @@ public:
     virtual ~PhotonMapStore() = default;
     virtual Expected<std::shared_ptr<const PhotonMaps>> get_or_build(
         const std::string& key, const std::function<Expected<PhotonMaps>()>& build, bool* cache_hit) = 0;
-};
-
-/// Where irradiance caches (render caches) are kept between jobs, by render-cache key
-/// (PhotonMapIntegrator::render_cache_key): as PhotonMapStore.
-class RenderCacheStore {
-public:
-    virtual ~RenderCacheStore() = default;
-    virtual Expected<std::shared_ptr<const IrradianceCache>> get_or_build(
-        const std::string& key, const std::function<Expected<std::shared_ptr<const IrradianceCache>>()>& build,
-        bool* cache_hit) = 0;
-    /// The cache kept under `key`; nullptr when there is none.
-    virtual std::shared_ptr<const IrradianceCache> find_cache(const std::string& key) = 0;
 };
 
 /// Resolves {"id": "sha256:..."} scenes (uploaded to the daemon).

@@ -1,8 +1,10 @@
 // The interface every integrator implements, and the per-sample context it receives.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
 
 #include "core/accel/ray_tracer.h"
@@ -13,6 +15,7 @@
 #include "core/math/rng.h"
 #include "core/render/render_scene.h"
 #include "core/scene/interaction.h"
+#include "core/util/expected.h"
 
 namespace photond {
 
@@ -56,6 +59,32 @@ struct SampleContext {
     }
 };
 
+class RenderCacheStore;
+
+/// What Integrator::prepare may use: the view, and where what it builds is kept between jobs.
+struct PrepareContext {
+    const Camera& camera;
+    const CameraDesc& camera_desc;
+    int width = 0;
+    int height = 0;
+    std::string photon_map_key;                 // the content key of the maps it builds on; empty: none
+    RenderCacheStore* render_caches = nullptr;  // null: what it builds serves this render only
+    std::string start_from;                     // an earlier view's render-cache key to start from
+    const std::atomic<bool>* cancel = nullptr;  // set: stop early (what was built is not kept)
+};
+
+/// What Integrator::prepare did, for the statistics.
+struct PrepareReport {
+    bool built = false;          // a cache is in use (built here or taken from the store)
+    std::string cache_key;       // its render-cache key (with a store)
+    std::string cache_outcome;   // "hit": taken from the store; "miss": built and kept; "": no store
+    std::string start_from;      // the key of the cache it started from, if any
+    uint64_t records = 0;
+    uint64_t records_reused = 0;  // records taken from that cache
+    int waves = 0;
+    RayCounters counters;        // rays the preparation traced
+};
+
 /// Computes the radiance arriving at the camera along a ray. Implementations are immutable
 /// during a render and called concurrently from every worker thread; all randomness comes from
 /// the SampleContext, so a pixel's value depends only on its random stream.
@@ -68,6 +97,13 @@ public:
     /// The radiance along a camera ray, and its parts by how the light arrived (AOVs).
     virtual RadianceParts radiance_parts(const CameraRay& ray, SampleContext& context) const = 0;
     Color radiance(const CameraRay& ray, SampleContext& context) const { return radiance_parts(ray, context).total; }
+
+    /// The name of the pass prepare() runs before the tiles (timed and reported under it), or
+    /// empty when this integrator needs none.
+    virtual std::string_view preparation_pass() const { return {}; }
+    /// Builds what the render of this view reads (the photon-map integrator's irradiance cache),
+    /// or takes it from the store. Called once, before render_tiles, from one thread.
+    virtual Expected<PrepareReport> prepare(const PrepareContext&) { return PrepareReport{}; }
 };
 
 /// The camera-ray footprint: the width of one pixel per unit of distance along the ray.

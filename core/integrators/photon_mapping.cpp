@@ -1,6 +1,7 @@
 #include "core/integrators/photon_mapping.h"
 
 #include "core/integrators/direct.h"
+#include "core/integrators/render_cache_store.h"
 #include "core/util/sha256.h"
 
 namespace photond {
@@ -38,12 +39,63 @@ PhotonMapIntegrator::PhotonMapIntegrator(std::shared_ptr<const RenderScene> scen
                                                                   : scene_->lights.get();
 }
 
-void PhotonMapIntegrator::prepare(const Camera& camera, CacheBuildStatistics* statistics,
-                                  const IrradianceCache* start) {
+void PhotonMapIntegrator::build_cache(const Camera& camera, CacheBuildStatistics* statistics,
+                                      const IrradianceCache* start) {
     if (!gatherer_ || !settings_.irradiance_cache) return;
     CacheBuildSettings build = settings_.cache;
     build.max_specular_depth = settings_.max_specular_depth;
     cache_ = build_irradiance_cache(*scene_, *gatherer_, camera, build, statistics, start);
+}
+
+Expected<PrepareReport> PhotonMapIntegrator::prepare(const PrepareContext& context) {
+    PrepareReport report;
+    if (!uses_irradiance_cache()) return report;
+    const bool kept_between_jobs = context.render_caches && !context.photon_map_key.empty();
+    const auto cancelled = [&] { return context.cancel && context.cancel->load(); };
+    // An earlier view's cache to start from (irradiance_cache.start_from), from the store.
+    std::shared_ptr<const IrradianceCache> start_cache;
+    if (!context.start_from.empty()) {
+        const std::string& start_key = context.start_from;
+        if (!kept_between_jobs)
+            return Error{"irradiance_cache.start_from: this render keeps no render caches to start from (photond "
+                         "render needs --cache-dir)"};
+        start_cache = context.render_caches->find_cache(start_key);
+        if (!start_cache)
+            return Error{"irradiance_cache.start_from: no render cache " + start_key +
+                         " here (render that view first, or import its cache with PUT /v1/render-caches/" + start_key +
+                         ")"};
+        if (!start_matches(*start_cache, *scene_, settings_.cache))
+            return Error{"irradiance_cache.start_from: render cache " + start_key +
+                         " was built for another scene or other irradiance_cache.a/gradients"};
+        report.start_from = start_key;
+    }
+    CacheBuildStatistics build_statistics;
+    if (kept_between_jobs) {
+        // Built once per key: other views' jobs, other regions of the frame and other nodes
+        // sharing the cache directory take it instead of running the prepass.
+        report.cache_key = render_cache_key(context.photon_map_key, context.camera_desc, context.width, context.height,
+                                            context.start_from);
+        const auto build = [&]() -> Expected<std::shared_ptr<const IrradianceCache>> {
+            build_cache(context.camera, &build_statistics, start_cache.get());
+            if (cancelled()) return Error{"cancelled during the irradiance-cache prepass"};  // incomplete: not kept
+            return cache_;
+        };
+        bool hit = false;
+        auto cache = context.render_caches->get_or_build(report.cache_key, build, &hit);
+        if (cache) use_cache(*cache);
+        else if (!cancelled()) return cache.error();
+        report.cache_outcome = hit ? "hit" : "miss";
+    } else {
+        build_cache(context.camera, &build_statistics);
+    }
+    if (cache_) {
+        report.built = true;
+        report.records = cache_->size();
+        if (start_cache) report.records_reused = start_cache->size();
+        report.waves = build_statistics.waves;
+        report.counters = build_statistics.counters;
+    }
+    return report;
 }
 
 std::string PhotonMapIntegrator::render_cache_key(const std::string& photon_map_key, const CameraDesc& camera,

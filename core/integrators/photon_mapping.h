@@ -50,13 +50,20 @@ public:
 
     /// Whether this integrator fills an irradiance cache (final gathering with the cache on).
     bool uses_irradiance_cache() const { return gatherer_ && settings_.irradiance_cache; }
+    /// "irradiance_cache" when it fills one, else none.
+    std::string_view preparation_pass() const override { return uses_irradiance_cache() ? "irradiance_cache" : ""; }
+    /// The irradiance cache of this view (a no-op without one): with a store and a photon-map key,
+    /// taken from the store by render_cache_key or built once and kept there; else built for this
+    /// render. `start_from` names an earlier view's cache in the store to start from (an error
+    /// when there is no store, no such cache, or it was built for another scene or settings).
+    Expected<PrepareReport> prepare(const PrepareContext& context) override;
     /// Fills the irradiance cache for this camera (a no-op without final gathering or cache),
     /// starting from `start` when given (build_irradiance_cache; check start_matches first).
-    void prepare(const Camera& camera, CacheBuildStatistics* statistics, const IrradianceCache* start = nullptr);
+    void build_cache(const Camera& camera, CacheBuildStatistics* statistics, const IrradianceCache* start = nullptr);
     const CacheBuildSettings& cache_settings() const { return settings_.cache; }
-    /// Takes a cache prepare() built earlier for the same render_cache_key (another job or node).
+    /// Takes a cache built earlier for the same render_cache_key (another job or node).
     void use_cache(std::shared_ptr<const IrradianceCache> cache) { cache_ = std::move(cache); }
-    /// The content key of the cache prepare() builds for this camera over maps of
+    /// The content key of the cache build_cache() builds for this camera over maps of
     /// `photon_map_key`: "rc1-" + 64 hex digits, from the photon-map key, the camera and image
     /// size, the cache's and gathering's settings, the seed, the key of the cache it starts from
     /// (if any) and kRenderCacheAlgorithmVersion.

@@ -51,7 +51,7 @@ TEST(CausticReference, PhotonMapCausticMatchesThePathTracedReference) {
     settings.gather.rays = 1024;
     settings.cache.region = kRegion;
     PhotonMapIntegrator integrator(rs, maps, settings);
-    integrator.prepare(camera, nullptr);
+    integrator.build_cache(camera, nullptr);
     TileSettings tiles;
     tiles.samples_per_pixel = 16;
     tiles.region = kRegion;

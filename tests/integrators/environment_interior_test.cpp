@@ -51,7 +51,7 @@ Image render_photon_map(const std::shared_ptr<const RenderScene>& rs, const Came
     settings.gather.rays = 256;
     settings.cache.cache.accuracy = 0.3f;
     PhotonMapIntegrator photon_map(rs, std::make_shared<const PhotonMaps>(std::move(maps).value()), settings);
-    photon_map.prepare(camera, nullptr);
+    photon_map.build_cache(camera, nullptr);
     TileSettings tiles;
     tiles.samples_per_pixel = 16;
     return render_tiles(photon_map, camera, tiles).layers.beauty;

@@ -162,7 +162,7 @@ Image render_with_threads(const Fixture& f, int threads) {
     settings.cache.threads = threads;
     settings.cache.seed = 3;
     PhotonMapIntegrator integrator(f.scene, f.maps, settings);
-    integrator.prepare(camera, nullptr);
+    integrator.build_cache(camera, nullptr);
     TileSettings tiles;
     tiles.tile_size = 8;
     tiles.samples_per_pixel = 2;

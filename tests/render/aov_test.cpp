@@ -99,7 +99,7 @@ TEST(Aov, PhotonMapPartsSumToTheBeautyPassAndEachPartHoldsLight) {
     PhotonMapIntegratorSettings settings;
     settings.gather.rays = 64;
     PhotonMapIntegrator integrator(c.render_scene, maps, settings);
-    integrator.prepare(c.camera, nullptr);
+    integrator.build_cache(c.camera, nullptr);
     expect_parts_sum_to_beauty(integrator, "photon-map");
 
     // The Cornell box has all four: the light seen from the camera, direct light on the walls,

@@ -101,7 +101,7 @@ inline Expected<StressRender> render_scene(std::shared_ptr<const Scene> scene,
         pm.cache.seed = s.seed;
         pm.cache.threads = s.threads;
         auto photon_map = std::make_unique<PhotonMapIntegrator>(*rs, maps, pm);
-        photon_map->prepare(*camera, &out.cache);
+        photon_map->build_cache(*camera, &out.cache);
         integrator = std::move(photon_map);
     } else {
         return Error{"stress render: unknown integrator '" + s.integrator + "'"};
