@@ -1,5 +1,5 @@
 // The daemon's photon-map cache: built photon maps by content key (photon_map_key in
-// core/scene/scene_hash.h), so that further camera views of a scene skip photon tracing. Memory
+// core/photon/photon_map_key.h), so that further camera views of a scene skip photon tracing. Memory
 // and disk (<directory>/<key>.pm), as every ArtifactCache (server/artifact_cache.h).
 #pragma once
 

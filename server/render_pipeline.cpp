@@ -11,11 +11,11 @@
 #include "core/integrators/path.h"
 #include "core/integrators/photon_mapping.h"
 #include "core/render/render_plan.h"
-#include "core/render/render_scene.h"
+#include "core/shading/render_scene.h"
 #include "core/scene/builtin_scenes.h"
 #include "core/image/environment_image.h"
 #include "core/scene/gltf_loader.h"
-#include "core/scene/scene_hash.h"
+#include "core/photon/photon_map_key.h"
 
 namespace photond::service {
 namespace {

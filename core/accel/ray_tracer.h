@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "core/math/ray.h"
 #include "core/math/vec.h"
 #include "core/scene/scene.h"
 #include "core/util/expected.h"
@@ -42,23 +43,6 @@ private:
 /// Sets flush-to-zero and denormals-are-zero for the calling thread, as Embree recommends for
 /// every thread that traces rays. Cheap; call it at the start of each parallel task.
 void enable_flush_denormals();
-
-struct Ray {
-    Vec3 origin{0.0f};
-    Vec3 direction{0.0f, 0.0f, 1.0f};  // need not be unit for occlusion, must be for intersect's t
-    float tmin = 0.0f;
-    float tmax = std::numeric_limits<float>::infinity();
-    /// The origin is a viewpoint (a camera's exact position), not a point computed on a surface;
-    /// RayTracer::intersect then puts a viewpoint that lies on a surface on its front side.
-    bool from_viewpoint = false;
-};
-
-struct Hit {
-    float t = 0.0f;
-    uint32_t triangle = 0;
-    float u = 0.0f;  // barycentric weight of the triangle's second vertex
-    float v = 0.0f;  // barycentric weight of the third vertex
-};
 
 /// Embree's ray records for a Ray: no hit yet, every mask bit set.
 inline RTCRay to_rtc_ray(const Ray& ray) {

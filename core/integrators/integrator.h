@@ -13,27 +13,12 @@
 #include "core/material/bsdf.h"
 #include "core/math/low_discrepancy.h"
 #include "core/math/rng.h"
-#include "core/render/render_scene.h"
+#include "core/shading/render_scene.h"
+#include "core/shading/scene_queries.h"
 #include "core/scene/interaction.h"
 #include "core/util/expected.h"
 
 namespace photond {
-
-/// Ray counts of one thread's work; summed after the pass (sums do not depend on the order).
-struct RayCounters {
-    uint64_t rays = 0;         // intersection queries
-    uint64_t shadow_rays = 0;  // occlusion queries
-    uint64_t irradiance_lookups = 0;  // indirect irradiance asked of the irradiance cache
-    uint64_t irradiance_misses = 0;   // ... that no record covered (gathered on the spot)
-
-    RayCounters& operator+=(const RayCounters& o) {
-        rays += o.rays;
-        shadow_rays += o.shadow_rays;
-        irradiance_lookups += o.irradiance_lookups;
-        irradiance_misses += o.irradiance_misses;
-        return *this;
-    }
-};
 
 /// What one camera sample may use: its own random stream and counters. A camera sample also
 /// carries its place in its pixel's sample pattern: then its first kStratifiedDraws draws of
@@ -121,40 +106,10 @@ struct RayFootprint {
 
 inline RayFootprint camera_footprint(const CameraRay& ray) { return {ray.pixel_width, pixel_spread(ray)}; }
 
-/// Intersection query that counts itself.
-inline std::optional<Hit> trace_ray(const RenderScene& rs, const Ray& ray, RayCounters& counters) {
-    ++counters.rays;
-    return rs.tracer->intersect(ray);
-}
-
 /// The ray of a camera sample: from the camera itself, which RayTracer::intersect puts on the front
 /// side of a surface it lies on (so a camera on a floor sees the room, and the floor below it).
 inline Ray primary_ray(const RenderScene&, const CameraRay& ray) {
     return RayTracer::viewpoint_ray(ray.origin, ray.direction);
-}
-
-/// A ray leaving the surface point of `si` in `direction`, offset against self-intersection.
-inline Ray spawn_ray(const RenderScene& rs, const SurfaceInteraction& si, const Vec3& direction) {
-    return Ray{rs.tracer->offset_origin(si.p, si.geometric_normal, direction), direction};
-}
-
-/// The BSDF at a hit seen from direction wo. Opaque materials are shaded two-sided (normals turned
-/// towards wo); transmissive ones keep the mesh's orientation, so the outside is the front side.
-inline Bsdf make_bsdf(const RenderScene& rs, const SurfaceInteraction& si, const Vec3& wo) {
-    const Material& material = rs.scene->materials[si.material];
-    Vec3 ng = si.geometric_normal, ns = si.shading_normal;
-    if (material.transmission <= 0.0f && glm::dot(wo, ng) < 0.0f) {
-        ng = -ng;
-        ns = -ns;
-    }
-    if (!material.textured() && rs.scene->colors.empty())
-        return Bsdf(rs.bsdf_materials[si.material], material.base_color, Frame(ns), ng);
-    const MaterialPoint mp = rs.scene->material_point(si.material, si.tex);
-    if (!material.varying_bsdf())
-        return Bsdf(rs.bsdf_materials[si.material], mp.base_color, Frame(ns), ng);
-    // Metallic, roughness or the clearcoat vary over the surface: the constants are derived here.
-    return Bsdf(BsdfMaterial(material, mp.metallic, mp.roughness, mp.clearcoat, mp.clearcoat_roughness),
-                mp.base_color, Frame(ns), ng);
 }
 
 /// Next-event estimation: one light sample with a shadow ray, lobes in `mask` only. With

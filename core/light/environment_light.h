@@ -8,6 +8,7 @@
 #include <optional>
 #include <vector>
 
+#include "core/math/equirectangular.h"
 #include "core/math/sampling.h"
 #include "core/scene/scene.h"
 
@@ -28,11 +29,6 @@ inline constexpr float kEnvironmentPeakFactor = 16.0f;
 
 EnvironmentSplit split_environment_peaks(const Environment& environment,
                                          float peak_factor = kEnvironmentPeakFactor);
-
-/// The equirectangular map of Environment (no rotation): image coordinates (u, v) in [0, 1)^2
-/// of a unit direction, and the direction at (u, v).
-Vec2 equirectangular_uv(const Vec3& d);
-Vec3 equirectangular_direction(const Vec2& uv);
 
 class EnvironmentLight {
 public:

@@ -1,5 +1,5 @@
 // Photon maps on disk: a versioned binary format with a SHA-256 checksum, so a photon pass can be
-// cached per scene (key: photon_map_key in core/scene/scene_hash.h) and later camera views skip
+// cached per scene (key: photon_map_key in core/photon/photon_map_key.h) and later camera views skip
 // photon tracing. The photons are stored in the kd-tree's order and adopted without a rebuild.
 //
 // Layout (integers little-endian; photons raw, in the writer's byte order, which the marker

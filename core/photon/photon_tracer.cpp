@@ -7,7 +7,8 @@
 
 #include <chrono>
 
-#include "core/integrators/integrator.h"
+#include "core/math/rng.h"
+#include "core/shading/scene_queries.h"
 
 namespace photond {
 namespace {

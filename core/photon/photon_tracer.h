@@ -26,7 +26,7 @@
 #include <string>
 
 #include "core/photon/photon_map.h"
-#include "core/render/render_scene.h"
+#include "core/shading/render_scene.h"
 
 namespace photond {
 

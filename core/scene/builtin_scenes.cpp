@@ -6,7 +6,7 @@
 #include <string>
 #include <utility>
 
-#include "core/light/environment_light.h"
+#include "core/math/equirectangular.h"
 #include "core/math/frame.h"
 #include "core/scene/shapes.h"
 

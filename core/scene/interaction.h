@@ -1,7 +1,7 @@
 // The local geometry at a ray hit: position, normals, texture coordinates, material.
 #pragma once
 
-#include "core/accel/ray_tracer.h"
+#include "core/math/ray.h"
 #include "core/math/frame.h"
 #include "core/scene/scene.h"
 

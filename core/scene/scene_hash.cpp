@@ -2,13 +2,12 @@
 
 #include <bit>
 
-#include "core/photon/photon_tracer.h"
 
 namespace photond {
 namespace {
 
 // These fire when a field is added to a struct the hashes read: hash the new field (if it affects
-// light transport) in scene_content_hash or photon_map_key, then update the size here.
+// light transport) in scene_content_hash, then update the size here.
 static_assert(sizeof(Material) == sizeof(std::string) + 288,
               "Material changed: hash the new field in scene_content_hash");
 static_assert(sizeof(PunctualLight) == sizeof(std::string) + 56,
@@ -23,9 +22,6 @@ static_assert(sizeof(Environment) == sizeof(std::string) + sizeof(std::vector<Co
 static_assert(sizeof(Scene) == sizeof(std::string) + 15 * sizeof(std::vector<int>) +
                                    sizeof(std::optional<Environment>) + sizeof(Bounds3),
               "Scene changed: hash the new field in scene_content_hash");
-static_assert(sizeof(void*) != 8 || sizeof(PhotonTracingSettings) == 48,
-              "PhotonTracingSettings changed: add the new field to photon_map_key if the maps "
-              "depend on it");
 
 void hash_float(Sha256& hasher, float value) {
     uint32_t bits = std::bit_cast<uint32_t>(value);
@@ -134,21 +130,6 @@ Sha256Digest scene_content_hash(const Scene& scene) {
         hash_float(hasher, e->rotation);
     }
     return hasher.finish();
-}
-
-std::string photon_map_key(const Scene& scene, const PhotonTracingSettings& settings) {
-    Sha256 hasher;
-    hasher.update_string("photond photon-map key");
-    hasher.update_value(kPhotonMapAlgorithmVersion);
-    hasher.update(scene_content_hash(scene));
-    hasher.update_value(uint32_t(settings.global_photons));
-    hasher.update_value(uint32_t(settings.caustic_photons));
-    hasher.update_value(uint64_t(settings.seed));
-    hasher.update_value(int32_t(settings.max_bounces));
-    hasher.update_value(uint32_t(settings.max_emitted_per_stored));
-    hasher.update_value(uint32_t(settings.irradiance_stride));
-    hasher.update_value(uint32_t(settings.k_irradiance));
-    return "pm1-" + Sha256::hex(hasher.finish());
 }
 
 }  // namespace photond

@@ -18,6 +18,7 @@
 #include "core/math/rng.h"
 #include "core/photon/photon_tracer.h"
 #include "core/scene/builtin_scenes.h"
+#include "core/photon/photon_map_key.h"
 #include "core/scene/scene_hash.h"
 #include "core/util/sha256.h"
 

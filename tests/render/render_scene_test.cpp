@@ -1,4 +1,4 @@
-#include "core/render/render_scene.h"
+#include "core/shading/render_scene.h"
 
 #include <gtest/gtest.h>
 

@@ -23,7 +23,7 @@
 #include "core/integrators/photon_mapping.h"
 #include "core/photon/photon_tracer.h"
 #include "core/render/render_plan.h"
-#include "core/render/render_scene.h"
+#include "core/shading/render_scene.h"
 #include "core/render/tile_renderer.h"
 #include "core/scene/scene.h"
 #include "core/scene/shapes.h"

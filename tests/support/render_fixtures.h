@@ -5,7 +5,7 @@
 #include <memory>
 
 #include "core/integrators/integrator.h"
-#include "core/render/render_scene.h"
+#include "core/shading/render_scene.h"
 
 namespace photond::test_support {
 
