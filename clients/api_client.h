@@ -1,4 +1,4 @@
-// The daemon's HTTP API v1 (README.md, "Using the daemon with curl"; docs/DESIGN.md) as C++ calls, for photonctl. Every
+// The daemon's HTTP API v1 (README.md, "Using the daemon with curl"; docs/ARCHITECTURE.md) as C++ calls, for photonctl. Every
 // failure comes back as an Error whose message is ready for a user: problem+json answers as
 // "<title>: <detail> (field: <field>)", connection failures naming the server's URL.
 #pragma once

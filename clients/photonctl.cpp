@@ -1,4 +1,4 @@
-// photonctl: the command-line client of `photond serve` (README.md; docs/DESIGN.md, "Programs").
+// photonctl: the command-line client of `photond serve` (README.md; docs/ARCHITECTURE.md, "Programs").
 //
 // Results go to stdout (job ids, status text, JSON); progress and errors to stderr. Exit codes:
 // 0 success, 1 a failure (an error answer, an unreachable server, a failed or cancelled job),

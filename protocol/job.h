@@ -1,6 +1,7 @@
 // The job description v1 of the render service (README.md, "Job description v1"): plain structs,
 // their JSON mapping, validation with the offending field's path, and a JSON Schema built from the
-// same limits. Versioned by adding fields, never by changing what a field means.
+// same limits, all walking one table of the fields (protocol/job_fields.h). Versioned by adding
+// fields, never by changing what a field means.
 //
 // A job is read in two steps: the preset named by "preset" (default "final", see presets.h)
 // supplies every default, then each field present in the document overrides its default. Unknown

@@ -1,4 +1,4 @@
-// The daemon's answers (README.md, "Using the daemon with curl"; docs/DESIGN.md): a job's status, the events of its SSE stream
+// The daemon's answers (README.md, "Using the daemon with curl"; docs/ARCHITECTURE.md): a job's status, the events of its SSE stream
 // and RFC 9457 problem details, as plain structs with their JSON mapping, plus JSON Schemas of
 // them for the OpenAPI document. Shared by the daemon and its clients. Versioned by adding
 // fields, never by changing what a field means.

@@ -16,6 +16,7 @@
 #include "core/image/environment_image.h"
 #include "core/scene/gltf_loader.h"
 #include "core/photon/photon_map_key.h"
+#include "protocol/render_settings.h"
 
 namespace photond::service {
 namespace {
@@ -105,13 +106,14 @@ std::string describe_colour(const std::array<double, 3>& c) {
 
 /// Plans the photon pass of a photon-map job and gets its maps: from the store when one is
 /// given (a hit skips tracing), else traced for this job. Records it all in the statistics.
-Expected<std::shared_ptr<const PhotonMaps>> build_photon_maps(const protocol::Job& job, const RenderScene& scene,
+Expected<std::shared_ptr<const PhotonMaps>> build_photon_maps(const protocol::RenderSettings& render_settings, const RenderScene& scene,
                                                               const PipelineOptions& options,
                                                               RenderStatistics& stats) {
-    const RenderPlan plan = plan_photon_passes(*scene.scene, *scene.lights, {job.photons.global, job.photons.caustic},
+    const RenderPlan plan = plan_photon_passes(*scene.scene, *scene.lights,
+                                               {render_settings.photon_tracing.global_photons, render_settings.photon_tracing.caustic_photons},
                                                scene.lights_with_sky_peaks.get());
     stats.plan = plan.decisions;
-    const PhotonTracingSettings settings = photon_settings(job, plan, options);
+    const PhotonTracingSettings settings = photon_settings(render_settings, plan, options);
     if (settings.global_photons == 0 && settings.caustic_photons == 0) {
         stats.photons = PhotonTracingStatistics{};
         return std::make_shared<const PhotonMaps>();
@@ -173,32 +175,21 @@ Expected<std::shared_ptr<const PhotonMaps>> build_photon_maps(const protocol::Jo
     return maps;
 }
 
-Expected<std::unique_ptr<Integrator>> make_integrator(const protocol::Job& job,
+Expected<std::unique_ptr<Integrator>> make_integrator(const protocol::RenderSettings& render_settings,
                                                       std::shared_ptr<const RenderScene> scene,
                                                       const PipelineOptions& options,
                                                       RenderStatistics& stats) {
-    if (job.integrator == "path") return std::unique_ptr<Integrator>(new PathIntegrator(scene));
-    if (job.integrator == "direct") return std::unique_ptr<Integrator>(new DirectIntegrator(scene));
-    if (job.integrator == "photon-map") {
-        auto maps = build_photon_maps(job, *scene, options, stats);
+    if (render_settings.integrator == "path") return std::unique_ptr<Integrator>(new PathIntegrator(scene));
+    if (render_settings.integrator == "direct") return std::unique_ptr<Integrator>(new DirectIntegrator(scene));
+    if (render_settings.integrator == "photon-map") {
+        auto maps = build_photon_maps(render_settings, *scene, options, stats);
         if (!maps) return maps.error();
-        PhotonMapIntegratorSettings settings;
-        settings.k_global = job.photons.k_global;
-        settings.k_caustic = job.photons.k_caustic;
-        settings.gather.rays = job.gather.rays;
-        settings.irradiance_cache = job.irradiance_cache.enabled;
-        settings.cache.cache.accuracy = static_cast<float>(job.irradiance_cache.a);
-        settings.cache.cache.gradients = job.irradiance_cache.gradients;
-        settings.cache.min_spacing_px = static_cast<float>(job.irradiance_cache.min_spacing_px);
-        settings.cache.max_spacing_px = static_cast<float>(job.irradiance_cache.max_spacing_px);
-        settings.cache.seed = job.seed;
-        settings.cache.threads = options.threads;
-        settings.cache.cancel = options.callbacks.cancel;
-        // A region render builds the whole frame's irradiance cache: its pixels are then those of
-        // the frame rendered at once, and regions rendered apart assemble without seams.
+        PhotonMapIntegratorSettings settings = render_settings.photon_map;
+        settings.irradiance_cache.threads = options.threads;
+        settings.irradiance_cache.cancel = options.callbacks.cancel;
         return std::unique_ptr<Integrator>(new PhotonMapIntegrator(scene, *maps, settings));
     }
-    return Error{"integrator: unknown integrator '" + job.integrator + "'"};
+    return Error{"integrator: unknown integrator '" + render_settings.integrator + "'"};
 }
 
 }  // namespace
@@ -253,12 +244,11 @@ std::vector<std::string> incomplete_photon_map_warnings(const PhotonTracingStati
     return warnings;
 }
 
-PhotonTracingSettings photon_settings(const protocol::Job& job, const RenderPlan& plan,
+PhotonTracingSettings photon_settings(const protocol::RenderSettings& render_settings, const RenderPlan& plan,
                                       const PipelineOptions& options) {
-    PhotonTracingSettings settings;
-    settings.global_photons = plan.global_map ? job.photons.global : 0;
-    settings.caustic_photons = plan.caustic_map ? job.photons.caustic : 0;
-    settings.seed = job.photons.seed;
+    PhotonTracingSettings settings = render_settings.photon_tracing;
+    if (!plan.global_map) settings.global_photons = 0;
+    if (!plan.caustic_map) settings.caustic_photons = 0;
     settings.threads = options.threads;
     settings.cancel = options.callbacks.cancel;
     return settings;
@@ -448,6 +438,7 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     stats.height = job.image.height;
     stats.samples_per_pixel = job.image.spp;
     stats.threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
+    const protocol::RenderSettings settings = protocol::to_render_settings(job);
 
     Clock::time_point pass_start = Clock::now();
     if (options.on_pass) options.on_pass("scene");
@@ -488,7 +479,7 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     if (!camera_desc) return camera_desc.error();
     auto camera = Camera::create(*camera_desc, job.image.width, job.image.height);
     if (!camera) return camera.error();
-    auto integrator = make_integrator(job, *render_scene, options, stats);
+    auto integrator = make_integrator(settings, *render_scene, options, stats);
     if (!integrator) return integrator.error();
     stats.plan.insert(stats.plan.begin(), environment_decision);
 
@@ -531,20 +522,8 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
         return result;
     }
 
-    TileSettings tiles;
-    tiles.tile_size = job.image.tile_size;
-    tiles.samples_per_pixel = job.image.spp;
-    tiles.seed = job.seed;
+    TileSettings tiles = settings.tiles;
     tiles.threads = options.threads;
-    for (const std::string& name : job.output.aovs) {
-        const std::optional<Aov> aov = aov_from_name(name);
-        if (!aov) return Error{"output.aovs: unknown AOV '" + name + "'"};  // parse_job lets none through
-        tiles.aovs.push_back(*aov);
-    }
-    if (job.image.region) {
-        const auto& r = *job.image.region;
-        tiles.region = PixelRect{r[0], r[1], r[2], r[3]};
-    }
     pass_start = Clock::now();
     if (options.on_pass) options.on_pass("render");
     TileRenderResult rendered = render_tiles(**integrator, *camera, tiles, options.callbacks);
@@ -563,21 +542,10 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     return result;
 }
 
-ExrWriteOptions exr_options(const protocol::Job& job) {
-    ExrWriteOptions exr;
-    exr.pixel_type = job.output.pixel_type == "float" ? ExrPixelType::Float : ExrPixelType::Half;
-    exr.tile_size = job.image.tile_size;
-    if (job.image.region) {
-        const auto& r = *job.image.region;
-        exr.data_window = PixelRect{r[0], r[1], r[2], r[3]}.intersect({0, 0, job.image.width, job.image.height});
-    }
-    return exr;
-}
+ExrWriteOptions exr_options(const protocol::Job& job) { return protocol::to_render_settings(job).exr; }
 
 Expected<std::vector<uint8_t>> encode_job_preview(const protocol::Job& job, const Image& image) {
-    std::optional<float> exposure_ev;
-    if (job.output.exposure_ev) exposure_ev = static_cast<float>(*job.output.exposure_ev);
-    return encode_render_preview(image, exposure_ev);
+    return encode_render_preview(image, protocol::to_render_settings(job).preview_exposure_ev);
 }
 
 }  // namespace photond::service

@@ -23,6 +23,7 @@
 #include "core/scene/scene.h"
 #include "core/scene/scene_lighting.h"
 #include "protocol/job.h"
+#include "protocol/render_settings.h"
 
 namespace photond::service {
 
@@ -67,7 +68,7 @@ Expected<std::shared_ptr<const Scene>> load_job_scene(const protocol::SceneRef& 
                                                       const PipelineOptions& options);
 
 /// The photon tracing settings of a photon-map job under its plan.
-PhotonTracingSettings photon_settings(const protocol::Job& job, const RenderPlan& plan,
+PhotonTracingSettings photon_settings(const protocol::RenderSettings& render_settings, const RenderPlan& plan,
                                       const PipelineOptions& options);
 
 /// The lights and environment a job adds to `scene` (reading an environment image under the

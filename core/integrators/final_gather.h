@@ -1,4 +1,4 @@
-// Final gathering (ALGORITHMS.md section 4 and 5): indirect irradiance at a surface point by
+// Final gathering (docs/ARCHITECTURE.md, "Where each algorithm lives"): indirect irradiance at a surface point by
 // stratified, cosine-weighted hemisphere sampling in M x N cells,
 //   theta_j = asin(sqrt((j + X) / M)),  phi_k = 2 pi (k + Y) / N,  E = pi / (M N) sum L_jk,
 // with the radiance L_jk at each gather ray's hit read from the photon maps. The same samples

@@ -4,7 +4,7 @@
 // Records hold indirect irradiance E_i at P_i with normal N_i and radius R_i (harmonic mean of the
 // gather distances, clamped). At a point P with normal N, record i is usable when
 //   eps_i(P) = |P - P_i| / R_i + sqrt(1 - N . N_i) < a
-// and is not in front of P. Interpolation with gradients (ALGORITHMS.md section 5):
+// and is not in front of P. Interpolation with gradients (docs/ARCHITECTURE.md, "Where each algorithm lives"):
 //   E(P) = sum w_i [E_i + (N_i x N) . grad_r E_i + (P - P_i) . grad_t E_i] / sum w_i,
 // with Ward's weight shifted to vanish at the validity boundary, w_i = 1/eps_i - 1/a (it keeps
 // Ward's threshold w > 1/a, and the interpolated field stays continuous where a record's domain
@@ -43,7 +43,7 @@ struct IrradianceRecord {
 };
 
 struct IrradianceCacheSettings {
-    float accuracy = 0.15f;  // a
+    float accuracy = 0.3f;  // Ward's a (CacheBuildSettings)
     bool gradients = true;
 };
 

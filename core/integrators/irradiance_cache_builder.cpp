@@ -59,7 +59,7 @@ void collect_diffuse_points(const RenderScene& rs, const Ray& ray, float path_le
 IrradianceRecord make_irradiance_record(const FinalGatherer& gatherer, const DiffusePoint& point,
                                         const CacheBuildSettings& settings, Rng& rng, RayCounters& counters) {
     const GatherResult g = gatherer.gather(point.position, point.normal, point.geometric_normal, rng, counters,
-                                           settings.cache.gradients);
+                                           settings.gradients);
     float min_radius = 0.0f, max_radius = 0.0f;
     record_radius_limits(settings, point.footprint, &min_radius, &max_radius);
     IrradianceRecord r;
@@ -75,22 +75,22 @@ IrradianceRecord make_irradiance_record(const FinalGatherer& gatherer, const Dif
     // distances near zero and return enormous translation gradients; extrapolated over a radius
     // raised to the pixel minimum they would blow up (Krivanek et al. 2006 limit R by the
     // gradient; here R is pinned to the pixel limits, so the gradient yields instead).
-    const float reach = settings.cache.accuracy * r.radius;
+    const float reach = settings.accuracy * r.radius;
     for (int c = 0; c < 3; ++c) {
         const float limit = r.irradiance[c];
         const float translation = glm::length(r.translation_gradient[c]) * reach;
         if (translation > limit) r.translation_gradient[c] *= translation > 0.0f ? limit / translation : 0.0f;
-        const float rotation = glm::length(r.rotation_gradient[c]) * settings.cache.accuracy;
+        const float rotation = glm::length(r.rotation_gradient[c]) * settings.accuracy;
         if (rotation > limit) r.rotation_gradient[c] *= rotation > 0.0f ? limit / rotation : 0.0f;
     }
     return r;
 }
 
 bool start_matches(const IrradianceCache& start, const RenderScene& rs, const CacheBuildSettings& settings) {
-    const IrradianceCache empty(rs.scene->bounds, settings.cache);
+    const IrradianceCache empty(rs.scene->bounds, settings.interpolation());
     const IrradianceCache::Node& root = empty.nodes().front();
     const IrradianceCache::Node& start_root = start.nodes().front();
-    return start.settings().accuracy == settings.cache.accuracy && start.settings().gradients == settings.cache.gradients &&
+    return start.settings().accuracy == settings.accuracy && start.settings().gradients == settings.gradients &&
            start_root.center == root.center && start_root.half_size == root.half_size;
 }
 
@@ -99,7 +99,7 @@ std::unique_ptr<IrradianceCache> build_irradiance_cache(const RenderScene& rs, c
                                                         CacheBuildStatistics* statistics, const IrradianceCache* start) {
     const auto started = std::chrono::steady_clock::now();
     auto cache = start ? std::make_unique<IrradianceCache>(*start)
-                       : std::make_unique<IrradianceCache>(rs.scene->bounds, settings.cache);
+                       : std::make_unique<IrradianceCache>(rs.scene->bounds, settings.interpolation());
     CacheBuildStatistics stats;
     stats.records_reused = cache->size();
     const PixelRect frame{0, 0, camera.width(), camera.height()};

@@ -16,8 +16,11 @@
 
 namespace photond {
 
+/// How a view's irradiance cache is built. The defaults are the `final` preset's (the job field
+/// table, protocol/job_fields.cpp).
 struct CacheBuildSettings {
-    IrradianceCacheSettings cache;
+    float accuracy = 0.3f;  // Ward's a: the largest error estimate a record may be used at
+    bool gradients = true;  // extrapolate records with their rotation and translation gradients
     float min_spacing_px = 1.5f;  // record spacing a R_i limits, in pixels at the record
     float max_spacing_px = 24.0f;
     uint64_t seed = 1;
@@ -25,6 +28,9 @@ struct CacheBuildSettings {
     int threads = 0;
     std::optional<PixelRect> region;
     const std::atomic<bool>* cancel = nullptr;
+
+    /// What the cache itself keeps of these (its interpolation rule).
+    IrradianceCacheSettings interpolation() const { return {accuracy, gradients}; }
 };
 
 struct CacheBuildStatistics {
@@ -46,8 +52,8 @@ struct DiffusePoint {
 
 /// Radius limits from the pixel spacing limits at a point: a R_i in [min, max] pixels.
 inline void record_radius_limits(const CacheBuildSettings& s, float footprint, float* min_radius, float* max_radius) {
-    *min_radius = s.min_spacing_px * footprint / s.cache.accuracy;
-    *max_radius = s.max_spacing_px * footprint / s.cache.accuracy;
+    *min_radius = s.min_spacing_px * footprint / s.accuracy;
+    *max_radius = s.max_spacing_px * footprint / s.accuracy;
 }
 
 /// Gathers a new record at a point, its radius clamped to the pixel limits.

@@ -41,8 +41,8 @@ PhotonMapIntegrator::PhotonMapIntegrator(std::shared_ptr<const RenderScene> scen
 
 void PhotonMapIntegrator::build_cache(const Camera& camera, CacheBuildStatistics* statistics,
                                       const IrradianceCache* start) {
-    if (!gatherer_ || !settings_.irradiance_cache) return;
-    CacheBuildSettings build = settings_.cache;
+    if (!gatherer_ || !settings_.use_irradiance_cache) return;
+    CacheBuildSettings build = settings_.irradiance_cache;
     build.max_specular_depth = settings_.max_specular_depth;
     cache_ = build_irradiance_cache(*scene_, *gatherer_, camera, build, statistics, start);
 }
@@ -64,7 +64,7 @@ Expected<PrepareReport> PhotonMapIntegrator::prepare(const PrepareContext& conte
             return Error{"irradiance_cache.start_from: no render cache " + start_key +
                          " here (render that view first, or import its cache with PUT /v1/render-caches/" + start_key +
                          ")"};
-        if (!start_matches(*start_cache, *scene_, settings_.cache))
+        if (!start_matches(*start_cache, *scene_, settings_.irradiance_cache))
             return Error{"irradiance_cache.start_from: render cache " + start_key +
                          " was built for another scene or other irradiance_cache.a/gradients"};
         report.start_from = start_key;
@@ -122,9 +122,9 @@ std::string PhotonMapIntegrator::render_cache_key(const std::string& photon_map_
     hasher.update_value(int32_t(height));
     // What the prepass does at each record (CacheBuildSettings, GatherSettings); threads, cancel
     // and region do not change the cache.
-    const CacheBuildSettings& cache = settings_.cache;
-    hash_float(cache.cache.accuracy);
-    hasher.update_value(uint8_t(cache.cache.gradients));
+    const CacheBuildSettings& cache = settings_.irradiance_cache;
+    hash_float(cache.accuracy);
+    hasher.update_value(uint8_t(cache.gradients));
     hash_float(cache.min_spacing_px);
     hash_float(cache.max_spacing_px);
     hasher.update_value(uint64_t(cache.seed));

@@ -1,4 +1,4 @@
-// Integrator `photon-map` (ALGORITHMS.md section 4): emitted light, direct light by light
+// Integrator `photon-map` (docs/ARCHITECTURE.md, "Where each algorithm lives"): emitted light, direct light by light
 // sampling, ideal specular reflection and refraction by recursion, caustics from the caustic map
 // at visible points, and indirect light by final gathering from the global map through the
 // shared irradiance cache:
@@ -29,8 +29,8 @@ struct PhotonMapIntegratorSettings {
     int max_specular_depth = 16;
     bool final_gather = true;
     GatherSettings gather;
-    bool irradiance_cache = true;
-    CacheBuildSettings cache;
+    bool use_irradiance_cache = true;
+    CacheBuildSettings irradiance_cache;
     int glossy_rays = 1;  // BSDF-sampled rays per visible point for non-Lambertian lobes
 };
 
@@ -49,7 +49,7 @@ public:
     std::string_view name() const override { return "photon-map"; }
 
     /// Whether this integrator fills an irradiance cache (final gathering with the cache on).
-    bool uses_irradiance_cache() const { return gatherer_ && settings_.irradiance_cache; }
+    bool uses_irradiance_cache() const { return gatherer_ && settings_.use_irradiance_cache; }
     /// "irradiance_cache" when it fills one, else none.
     std::string_view preparation_pass() const override { return uses_irradiance_cache() ? "irradiance_cache" : ""; }
     /// The irradiance cache of this view (a no-op without one): with a store and a photon-map key,
@@ -60,7 +60,7 @@ public:
     /// Fills the irradiance cache for this camera (a no-op without final gathering or cache),
     /// starting from `start` when given (build_irradiance_cache; check start_matches first).
     void build_cache(const Camera& camera, CacheBuildStatistics* statistics, const IrradianceCache* start = nullptr);
-    const CacheBuildSettings& cache_settings() const { return settings_.cache; }
+    const CacheBuildSettings& cache_settings() const { return settings_.irradiance_cache; }
     /// Takes a cache built earlier for the same render_cache_key (another job or node).
     void use_cache(std::shared_ptr<const IrradianceCache> cache) { cache_ = std::move(cache); }
     /// The content key of the cache build_cache() builds for this camera over maps of

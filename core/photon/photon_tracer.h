@@ -1,5 +1,5 @@
 // Pass 1 of photon mapping: photons emitted from the lights by power and traced through the
-// scene (ALGORITHMS.md section 2; Jensen 2001, ch. 5). Russian roulette on the BSDF's
+// scene (docs/ARCHITECTURE.md, "Where each algorithm lives"; Jensen 2001, ch. 5). Russian roulette on the BSDF's
 // reflectivities, importance-sampled directions, no flux change at refraction, storage at every
 // non-delta interaction. Paths are classified by the light-path grammar: the global map gets
 // L[S|D]*D, the caustic map L S+ D with S an ideal specular (delta) bounce: glossy bounces

@@ -49,7 +49,7 @@ TEST(CausticReference, PhotonMapCausticMatchesThePathTracedReference) {
     // Gather rays that pass through the sphere land in the caustic: with few of them the records
     // in the shadow turn blotchy (256 rays: block relMSE 0.048; 1024 rays: 0.024).
     settings.gather.rays = 1024;
-    settings.cache.region = kRegion;
+    settings.irradiance_cache.region = kRegion;
     PhotonMapIntegrator integrator(rs, maps, settings);
     integrator.build_cache(camera, nullptr);
     TileSettings tiles;

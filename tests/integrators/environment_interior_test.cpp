@@ -49,7 +49,7 @@ Image render_photon_map(const std::shared_ptr<const RenderScene>& rs, const Came
     EXPECT_TRUE(maps) << maps.error().message;
     PhotonMapIntegratorSettings settings;
     settings.gather.rays = 256;
-    settings.cache.cache.accuracy = 0.3f;
+    settings.irradiance_cache.accuracy = 0.3f;
     PhotonMapIntegrator photon_map(rs, std::make_shared<const PhotonMaps>(std::move(maps).value()), settings);
     photon_map.build_cache(camera, nullptr);
     TileSettings tiles;

@@ -63,7 +63,7 @@ TEST(GlossyEmitter, EmitterBehindRoughGlassAgreesWithPath) {
     ASSERT_TRUE(maps) << maps.error().message;
     PhotonMapIntegratorSettings settings;
     settings.gather.rays = 128;
-    settings.irradiance_cache = false;
+    settings.use_irradiance_cache = false;
     const PhotonMapIntegrator photon_map(rs, std::make_shared<const PhotonMaps>(std::move(maps).value()), settings);
     TileSettings tiles;
     tiles.samples_per_pixel = 64;

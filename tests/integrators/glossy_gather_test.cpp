@@ -66,7 +66,7 @@ TEST(GlossyGather, GlossyLobesFollowedBySamplingAgreeWithPathPerPixel) {
         PhotonMapIntegratorSettings settings;
         settings.gather.rays = 128;
         settings.gather.max_glossy_bounces = max_glossy_bounces;
-        settings.irradiance_cache = false;
+        settings.use_irradiance_cache = false;
         const PhotonMapIntegrator photon_map(rs, maps, settings);
         TileSettings tiles;
         tiles.samples_per_pixel = 32;
@@ -120,7 +120,7 @@ TEST(GlossyGather, RoughMetalUnderAUniformSkyIsAsSmoothAsPath) {
     ASSERT_TRUE(traced) << traced.error().message;
     PhotonMapIntegratorSettings settings;
     settings.gather.rays = 64;
-    settings.irradiance_cache = false;
+    settings.use_irradiance_cache = false;
     const PhotonMapIntegrator photon_map(rs, std::make_shared<const PhotonMaps>(std::move(traced).value()), settings);
     const Image image = render_tiles(photon_map, camera, tiles).layers.beauty;
     const ImageError ours = compare_images(image, reference).value();

@@ -49,7 +49,7 @@ const BuiltCache& cornell_cache() {
         gather.rays = 64;
         const FinalGatherer gatherer(b.scene, maps, gather);
         CacheBuildSettings settings;
-        settings.cache.accuracy = 0.2f;
+        settings.accuracy = 0.2f;
         settings.threads = 2;
         CacheBuildStatistics statistics;
         b.cache = build_irradiance_cache(*b.scene, gatherer, *b.camera, settings, &statistics);

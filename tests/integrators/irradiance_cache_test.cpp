@@ -55,7 +55,7 @@ TEST(IrradianceCache, InterpolationMatchesBruteForceGatheringAtEveryVisiblePoint
     gather.rays = 512;
     const FinalGatherer gatherer(f.scene, f.maps, gather);
     CacheBuildSettings build;
-    build.cache.accuracy = 0.15f;
+    build.accuracy = 0.15f;
     CacheBuildStatistics stats;
     const auto cache = build_irradiance_cache(*f.scene, gatherer, camera, build, &stats);
     ASSERT_GT(cache->size(), 10u);
@@ -159,8 +159,8 @@ Image render_with_threads(const Fixture& f, int threads) {
     const Camera camera = Camera::create(f.scene->scene->cameras.at(0), 40, 32).value();
     PhotonMapIntegratorSettings settings;
     settings.gather.rays = 64;
-    settings.cache.threads = threads;
-    settings.cache.seed = 3;
+    settings.irradiance_cache.threads = threads;
+    settings.irradiance_cache.seed = 3;
     PhotonMapIntegrator integrator(f.scene, f.maps, settings);
     integrator.build_cache(camera, nullptr);
     TileSettings tiles;

@@ -111,7 +111,7 @@ TEST(NormalMap, PhotonEstimatesLieOnTheSurfaceAndWeightPhotonsByTheBentNormal) {
         auto maps = std::make_shared<const PhotonMaps>(trace_photons(*rs, tracing).value());
         PhotonMapIntegratorSettings settings;
         settings.final_gather = false;
-        settings.irradiance_cache = false;
+        settings.use_irradiance_cache = false;
         settings.k_global = 400;
         PhotonMapIntegrator photon_map(rs, maps, settings);
         Rng rng(1, 1);

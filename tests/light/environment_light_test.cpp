@@ -255,7 +255,7 @@ TEST(EnvironmentLight, ConvexLambertianUnderUniformSkyIsAlbedoTimesRadiance) {
     auto maps = trace_photons(*rs, tracing);
     ASSERT_TRUE(maps) << maps.error().message;
     PhotonMapIntegratorSettings settings;
-    settings.irradiance_cache = false;
+    settings.use_irradiance_cache = false;
     settings.gather.rays = 64;
     const PhotonMapIntegrator photon_map(rs, std::make_shared<const PhotonMaps>(std::move(maps).value()), settings);
 

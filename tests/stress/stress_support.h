@@ -95,11 +95,11 @@ inline Expected<StressRender> render_scene(std::shared_ptr<const Scene> scene,
         PhotonMapIntegratorSettings pm;
         pm.final_gather = s.final_gather;
         pm.gather.rays = s.gather_rays;
-        pm.irradiance_cache = s.irradiance_cache;
-        pm.cache.cache.accuracy = s.cache_accuracy;
-        pm.cache.cache.gradients = s.cache_gradients;
-        pm.cache.seed = s.seed;
-        pm.cache.threads = s.threads;
+        pm.use_irradiance_cache = s.irradiance_cache;
+        pm.irradiance_cache.accuracy = s.cache_accuracy;
+        pm.irradiance_cache.gradients = s.cache_gradients;
+        pm.irradiance_cache.seed = s.seed;
+        pm.irradiance_cache.threads = s.threads;
         auto photon_map = std::make_unique<PhotonMapIntegrator>(*rs, maps, pm);
         photon_map->build_cache(*camera, &out.cache);
         integrator = std::move(photon_map);

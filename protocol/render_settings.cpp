@@ -1,0 +1,50 @@
+#include "protocol/render_settings.h"
+
+#include <stdexcept>
+
+namespace photond::protocol {
+
+RenderSettings to_render_settings(const Job& job) {
+    RenderSettings settings;
+    settings.integrator = job.integrator;
+
+    settings.photon_tracing.global_photons = job.photons.global;
+    settings.photon_tracing.caustic_photons = job.photons.caustic;
+    settings.photon_tracing.seed = job.photons.seed;
+
+    PhotonMapIntegratorSettings& photon_map = settings.photon_map;
+    photon_map.k_global = job.photons.k_global;
+    photon_map.k_caustic = job.photons.k_caustic;
+    photon_map.gather.rays = job.gather.rays;
+    photon_map.use_irradiance_cache = job.irradiance_cache.enabled;
+    CacheBuildSettings& cache = photon_map.irradiance_cache;
+    cache.accuracy = static_cast<float>(job.irradiance_cache.a);
+    cache.gradients = job.irradiance_cache.gradients;
+    cache.min_spacing_px = static_cast<float>(job.irradiance_cache.min_spacing_px);
+    cache.max_spacing_px = static_cast<float>(job.irradiance_cache.max_spacing_px);
+    cache.seed = job.seed;
+    // A region render builds the whole frame's irradiance cache: its pixels are then those of
+    // the frame rendered at once, and regions rendered apart assemble without seams.
+
+    TileSettings& tiles = settings.tiles;
+    tiles.tile_size = job.image.tile_size;
+    tiles.samples_per_pixel = job.image.spp;
+    tiles.seed = job.seed;
+    for (const std::string& name : job.output.aovs) {
+        const std::optional<Aov> aov = aov_from_name(name);
+        if (!aov) throw std::invalid_argument("output.aovs: unknown AOV '" + name + "'");  // parse_job lets none through
+        tiles.aovs.push_back(*aov);
+    }
+
+    settings.exr.pixel_type = job.output.pixel_type == "float" ? ExrPixelType::Float : ExrPixelType::Half;
+    settings.exr.tile_size = job.image.tile_size;
+    if (job.image.region) {
+        const auto& [x0, y0, x1, y1] = *job.image.region;
+        tiles.region = PixelRect{x0, y0, x1, y1};
+        settings.exr.data_window = tiles.region->intersect({0, 0, job.image.width, job.image.height});
+    }
+    if (job.output.exposure_ev) settings.preview_exposure_ev = static_cast<float>(*job.output.exposure_ev);
+    return settings;
+}
+
+}  // namespace photond::protocol

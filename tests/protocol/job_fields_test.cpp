@@ -1,0 +1,187 @@
+// The job's field table (protocol/job_fields.h): every field, set to a value other than its
+// default, survives the reader, the writer and the JSON Schema; every preset is its table column.
+#include "protocol/job_fields.h"
+
+#include <gtest/gtest.h>
+
+#include <map>
+#include <regex>
+#include <set>
+
+#include "protocol/presets.h"
+
+namespace photond::protocol {
+namespace {
+
+using nlohmann::json;
+
+/// Checks `value` against the JSON Schema keywords the job schema uses (type, bounds, enum,
+/// const, pattern, array and object rules, oneOf, not); the first violation, with its path.
+std::string schema_violation(const json& schema, const json& value, const std::string& at) {
+    if (schema.contains("oneOf")) {
+        int matches = 0;
+        for (const json& alternative : schema["oneOf"]) matches += schema_violation(alternative, value, at).empty();
+        if (matches != 1) return at + ": matches " + std::to_string(matches) + " of oneOf";
+    }
+    if (schema.contains("not") && schema_violation(schema["not"], value, at).empty()) return at + ": matches not";
+    if (schema.contains("const") && value != schema["const"]) return at + ": not the const";
+    if (schema.contains("enum") && std::find(schema["enum"].begin(), schema["enum"].end(), value) == schema["enum"].end())
+        return at + ": not in enum";
+    if (schema.contains("type")) {
+        const std::string type = schema["type"];
+        const bool ok = (type == "integer" && value.is_number_integer()) || (type == "number" && value.is_number()) ||
+                        (type == "boolean" && value.is_boolean()) || (type == "string" && value.is_string()) ||
+                        (type == "array" && value.is_array()) || (type == "object" && value.is_object()) ||
+                        (type == "null" && value.is_null());
+        if (!ok) return at + ": not of type " + type;
+    }
+    if (value.is_number()) {
+        const double v = value.get<double>();
+        if (schema.contains("minimum") && v < schema["minimum"].get<double>()) return at + ": below minimum";
+        if (schema.contains("maximum") && v > schema["maximum"].get<double>()) return at + ": above maximum";
+        if (schema.contains("exclusiveMinimum") && v <= schema["exclusiveMinimum"].get<double>()) return at + ": at minimum";
+        if (schema.contains("exclusiveMaximum") && v >= schema["exclusiveMaximum"].get<double>()) return at + ": at maximum";
+    }
+    if (value.is_string() && schema.contains("pattern") &&
+        !std::regex_search(value.get<std::string>(), std::regex(schema["pattern"].get<std::string>())))
+        return at + ": does not match the pattern";
+    if (value.is_array()) {
+        if (schema.contains("minItems") && value.size() < schema["minItems"].get<size_t>()) return at + ": too few items";
+        if (schema.contains("maxItems") && value.size() > schema["maxItems"].get<size_t>()) return at + ": too many items";
+        if (schema.value("uniqueItems", false) && std::set<json>(value.begin(), value.end()).size() != value.size())
+            return at + ": items repeat";
+        for (size_t i = 0; i < value.size() && schema.contains("items"); ++i)
+            if (auto v = schema_violation(schema["items"], value[i], at + "[" + std::to_string(i) + "]"); !v.empty()) return v;
+    }
+    if (value.is_object()) {
+        for (const json& key : schema.value("required", json::array()))
+            if (!value.contains(key.get<std::string>())) return at + ": lacks " + key.get<std::string>();
+        for (const auto& [key, item] : value.items()) {
+            const std::string path = at.empty() ? key : at + "." + key;
+            if (schema.contains("properties") && schema["properties"].contains(key)) {
+                if (auto v = schema_violation(schema["properties"][key], item, path); !v.empty()) return v;
+            } else if (schema.value("additionalProperties", true) == false) {
+                return path + ": not in the schema";
+            }
+        }
+    }
+    return "";
+}
+
+/// A valid value of each field other than the final preset's. A field of the table without one
+/// fails the test below: a new field comes with its value here.
+const std::map<std::string, json>& changed_values() {
+    static const std::map<std::string, json> values{
+        {"preset", "preview"},
+        {"scene", {{"path", "models/box.glb"}}},
+        {"camera", {{"look_from", {0, 1, 5}}, {"look_at", {0, 1, 0}}, {"up", {0, 1, 0}}, {"vfov_deg", 35.0}}},
+        {"image.width", 640},
+        {"image.height", 360},
+        {"image.tile_size", 64},
+        {"image.spp", 3},
+        {"image.region", {8, 16, 200, 100}},
+        {"integrator", "direct"},
+        {"photons.global", 1234},
+        {"photons.caustic", 0},
+        {"photons.k_global", 80},
+        {"photons.k_caustic", 9},
+        {"photons.seed", 77},
+        {"gather.rays", 100},
+        {"irradiance_cache.enabled", false},
+        {"irradiance_cache.a", 0.25},
+        {"irradiance_cache.gradients", false},
+        {"irradiance_cache.min_spacing_px", 2.5},
+        {"irradiance_cache.max_spacing_px", 30.0},
+        {"irradiance_cache.start_from", "rc1-" + std::string(64, 'a')},
+        {"output.pixel_type", "float"},
+        {"output.aovs", {"depth", "albedo"}},
+        {"output.exposure_ev", -1.5},
+        {"environment", {{"image", "sky.hdr"}, {"intensity", 2.0}, {"rotation_deg", 90.0}}},
+        {"lights", {{{"type", "point"}, {"position", {1, 2, 3}}, {"intensity", 40.0}, {"color", {1, 0.5, 0.25}}}}},
+        {"priority", 7},
+        {"seed", 99},
+    };
+    return values;
+}
+
+json::json_pointer pointer_of(std::string_view path) {
+    std::string pointer = "/" + std::string(path);
+    std::replace(pointer.begin(), pointer.end(), '.', '/');
+    return json::json_pointer(pointer);
+}
+
+/// The schema node of a field: properties.<key>, or properties.<group>.properties.<key>.
+const json& schema_node(const json& schema, const JobField& field) {
+    const json& properties = schema.at("properties");
+    if (field.group().empty()) return properties.at(std::string(field.key()));
+    return properties.at(std::string(field.group())).at("properties").at(std::string(field.key()));
+}
+
+TEST(JobFields, EveryFieldChangedSurvivesReaderWriterAndSchema) {
+    const json schema = job_json_schema();
+    const Job defaults = *parse_job(json{{"scene", {{"builtin", "cornell-box"}}}});
+    for (const JobField& field : job_fields()) {
+        SCOPED_TRACE(std::string(field.path));
+        auto sample = changed_values().find(std::string(field.path));
+        ASSERT_NE(sample, changed_values().end()) << "no changed value for this field in the test";
+        json document = {{"scene", {{"builtin", "cornell-box"}}}};
+        document[pointer_of(field.path)] = sample->second;
+
+        Expected<Job> job = parse_job(document);
+        ASSERT_TRUE(job) << job.error().message;
+        EXPECT_NE(*job, defaults) << "the value did not reach the job";
+        const json written = to_json(*job);
+        ASSERT_TRUE(written.contains(pointer_of(field.path)));
+        EXPECT_EQ(written[pointer_of(field.path)], sample->second) << "the writer changed the value";
+        EXPECT_EQ(schema_violation(schema, written, ""), "");
+        Expected<Job> again = parse_job(written);
+        ASSERT_TRUE(again) << again.error().message;
+        EXPECT_EQ(*again, *job);
+    }
+}
+
+TEST(JobFields, EachPresetIsItsColumnAndSurvivesTheRoundTrip) {
+    const json schema = job_json_schema();
+    for (size_t column = 0; column < kPresetNames.size(); ++column) {
+        SCOPED_TRACE(std::string(kPresetNames[column]));
+        Job preset = *preset_defaults(kPresetNames[column]);
+        preset.scene = {SceneRef::Kind::Builtin, "cornell-box"};
+        const json written = to_json(preset);
+        EXPECT_EQ(schema_violation(schema, written, ""), "");
+        EXPECT_EQ(*parse_job(written), preset);
+        for (const JobField& field : job_fields()) {
+            if (field.preset_defaults[column].empty()) continue;
+            EXPECT_EQ(written[pointer_of(field.path)], json::parse(field.preset_defaults[column])) << field.path;
+            EXPECT_EQ(schema_node(schema, field)["x-preset-defaults"][std::string(kPresetNames[column])],
+                      json::parse(field.preset_defaults[column]))
+                << field.path;
+        }
+    }
+}
+
+TEST(JobFields, EveryFieldIsReadFromItsOwnPathAndNamedInErrors) {
+    for (const JobField& field : job_fields()) {
+        if (field.path == "preset") continue;  // read before the others; tested in job_test
+        SCOPED_TRACE(std::string(field.path));
+        json document = {{"scene", {{"builtin", "cornell-box"}}}};
+        document[pointer_of(field.path)] = json::object({{"not", "a value of any field"}});
+        auto result = parse_job_detailed(document);
+        ASSERT_TRUE(std::holds_alternative<FieldError>(result));
+        EXPECT_TRUE(std::get<FieldError>(result).path.starts_with(std::string(field.path)))
+            << describe(std::get<FieldError>(result));
+    }
+}
+
+TEST(JobFields, KeysComeFromTheTable) {
+    std::set<std::string> top;
+    for (std::string_view key : job_field_keys()) top.insert(std::string(key));
+    EXPECT_EQ(top, (std::set<std::string>{"preset", "scene", "camera", "image", "integrator", "photons", "gather",
+                                          "irradiance_cache", "output", "environment", "lights", "priority", "seed"}));
+    for (const JobFieldGroup& group : job_field_groups()) EXPECT_FALSE(job_field_keys(group.name).empty()) << group.name;
+    const std::vector<std::string_view> photons = job_field_keys("photons");
+    EXPECT_EQ(std::vector<std::string>(photons.begin(), photons.end()),
+              (std::vector<std::string>{"global", "caustic", "k_global", "k_caustic", "seed"}));
+}
+
+}  // namespace
+}  // namespace photond::protocol
