@@ -2,6 +2,7 @@
 
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
+#include <tbb/parallel_sort.h>
 #include <tbb/scalable_allocator.h>
 #include <tbb/task_arena.h>
 
@@ -165,6 +166,35 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
     }
 }
 
+/// Spreads the low 10 bits of v so that two zero bits follow each (a Morton code's axis).
+uint32_t spread_bits(uint32_t v) {
+    v &= 0x3ffu;
+    v = (v | (v << 16)) & 0x030000ffu;
+    v = (v | (v << 8)) & 0x0300f00fu;
+    v = (v | (v << 4)) & 0x030c30c3u;
+    v = (v | (v << 2)) & 0x09249249u;
+    return v;
+}
+
+/// The indices of `sites` sorted by the Morton code of their positions in the sites' bounds
+/// (ties by index, so the order is the same on every run).
+std::vector<uint32_t> morton_order(const std::vector<const TracedPhoton*>& sites) {
+    Bounds3 bounds;
+    for (const TracedPhoton* t : sites) bounds.extend(t->position);
+    const Vec3 extent = glm::max(bounds.extent(), Vec3(1e-30f));
+    std::vector<std::pair<uint32_t, uint32_t>> keyed(sites.size());
+    tbb::parallel_for(size_t(0), sites.size(), [&](size_t i) {
+        const Vec3 cell = glm::clamp((sites[i]->position - bounds.lower) / extent, 0.0f, 1.0f) * 1023.0f;
+        const uint32_t code = (spread_bits(static_cast<uint32_t>(cell.x)) << 2) |
+                              (spread_bits(static_cast<uint32_t>(cell.y)) << 1) | spread_bits(static_cast<uint32_t>(cell.z));
+        keyed[i] = {code, static_cast<uint32_t>(i)};
+    });
+    tbb::parallel_sort(keyed.begin(), keyed.end());
+    std::vector<uint32_t> order(sites.size());
+    for (size_t j = 0; j < keyed.size(); ++j) order[j] = keyed[j].second;
+    return order;
+}
+
 /// Irradiance at every stride-th global photon (in photon order), estimated from the global map,
 /// packed as photons whose flux is the irradiance and whose direction is the surface normal.
 std::shared_ptr<const PhotonMap> precompute_irradiance(const PhotonMap& global, const MapBuilder& traced,
@@ -173,7 +203,12 @@ std::shared_ptr<const PhotonMap> precompute_irradiance(const PhotonMap& global, 
     sites.reserve((traced.count + settings.irradiance_stride - 1) / settings.irradiance_stride);
     traced.for_each_strided(settings.irradiance_stride, [&](const TracedPhoton& t) { sites.push_back(&t); });
     std::vector<Photon> points(sites.size());
-    tbb::parallel_for(size_t(0), sites.size(), [&](size_t i) {
+    // Estimated in spatial (Morton) order rather than photon order: neighbouring estimates then
+    // walk the same kd-tree nodes and photons while they are in cache. Each estimate is
+    // independent, so the result is the same in any order.
+    const std::vector<uint32_t> order = morton_order(sites);
+    tbb::parallel_for(size_t(0), sites.size(), [&](size_t j) {
+        const size_t i = order[j];
         const TracedPhoton& t = *sites[i];
         const Color e = global.estimate_irradiance(t.position, t.normal, settings.k_irradiance, max_radius);
         points[i] = make_photon(t.position, t.normal, e, 0, t.normal);
