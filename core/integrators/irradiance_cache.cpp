@@ -229,11 +229,14 @@ bool IrradianceCache::interpolate(const Vec3& p, const Vec3& n, Color* irradianc
 }
 
 int32_t IrradianceCache::child_for(int32_t node_index, const Vec3& p) {
-    const Node node = nodes_[static_cast<size_t>(node_index)];
-    const int octant = (p.x > node.center.x ? 1 : 0) | (p.y > node.center.y ? 2 : 0) | (p.z > node.center.z ? 4 : 0);
-    int32_t child = node.children[static_cast<size_t>(octant)];
+    // The node's geometry by value (not the node: that would copy its record list, and push_back
+    // below may move the nodes).
+    const Vec3 center = nodes_[static_cast<size_t>(node_index)].center;
+    const float half_size = nodes_[static_cast<size_t>(node_index)].half_size;
+    const int octant = (p.x > center.x ? 1 : 0) | (p.y > center.y ? 2 : 0) | (p.z > center.z ? 4 : 0);
+    int32_t child = nodes_[static_cast<size_t>(node_index)].children[static_cast<size_t>(octant)];
     if (child < 0) {
-        Node n{octant_center(node.center, node.half_size, octant), 0.5f * node.half_size, {}, {}};
+        Node n{octant_center(center, half_size, octant), 0.5f * half_size, {}, {}};
         n.children.fill(-1);
         child = static_cast<int32_t>(nodes_.size());
         nodes_.push_back(std::move(n));

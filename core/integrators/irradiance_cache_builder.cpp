@@ -3,7 +3,9 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <chrono>
+#include <string>
 
 #include "core/integrators/direct.h"
 
@@ -106,13 +108,24 @@ std::unique_ptr<IrradianceCache> build_irradiance_cache(const RenderScene& rs, c
     const PixelRect area = settings.region ? settings.region->intersect(frame) : frame;
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
 
-    struct Candidate {
+    // A wave's candidates are handed out in chunks of consecutive pixels; each chunk keeps the
+    // records it gathers in candidate order, so merging the chunks in order inserts every record
+    // in pixel order, whatever thread made it, at a cost per record rather than per pixel.
+    struct PixelCandidate {
         int x, y;
-        std::vector<IrradianceRecord> records;
-        std::vector<float> min_radii;
+    };
+    struct NewRecord {
+        IrradianceRecord record;
+        float min_radius;
+    };
+    struct Chunk {
+        std::vector<NewRecord> records;
         RayCounters counters;
         uint64_t points = 0;
     };
+    // Chunks of up to 64 candidates, at least 256 chunks a wave where there are enough candidates
+    // (the first waves are sparse and slow per candidate), fixed by the wave alone.
+    constexpr size_t kMaxCandidatesPerChunk = 64, kMinChunksPerWave = 256;
     // Waves at steps 32, 16, ..., 1, then a repair wave over every pixel: neighbour clamping in
     // later waves can shrink a record that covered a pixel centre when it was visited.
     struct Wave {
@@ -122,45 +135,68 @@ std::unique_ptr<IrradianceCache> build_irradiance_cache(const RenderScene& rs, c
     std::vector<Wave> waves;
     for (int step = kFirstWaveStep; step >= 1; step /= 2) waves.push_back({step, false});
     waves.push_back({1, true});
+    using Clock = std::chrono::steady_clock;
+    const auto seconds_since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
+    std::vector<PixelCandidate> candidates;
+    std::vector<Chunk> chunks;
     for (const auto [step, repair] : waves) {
         if (settings.cancel && settings.cancel->load()) break;
+        Clock::time_point serial_start = Clock::now();
         // This wave's pixels: multiples of `step` not visited by a coarser wave (all in repair).
-        std::vector<Candidate> candidates;
+        candidates.clear();
         for (int y = area.y0 - area.y0 % step; y < area.y1; y += step) {
             for (int x = area.x0 - area.x0 % step; x < area.x1; x += step) {
                 if (x < area.x0 || y < area.y0) continue;
                 const bool visited = !repair && step < kFirstWaveStep && x % (2 * step) == 0 && y % (2 * step) == 0;
-                if (!visited) candidates.push_back({x, y, {}, {}, {}, 0});
+                if (!visited) candidates.push_back({x, y});
             }
         }
+        const size_t per_chunk = std::clamp<size_t>(candidates.size() / kMinChunksPerWave, 1, kMaxCandidatesPerChunk);
+        chunks.assign((candidates.size() + per_chunk - 1) / per_chunk, Chunk{});
+        WorkLog::Phase* phase = nullptr;
+        if (settings.work_log) {
+            settings.work_log->phases.push_back({"wave " + std::to_string(step) + (repair ? " repair" : ""),
+                                                 std::vector<double>(chunks.size(), 0.0), 0.0});
+            phase = &settings.work_log->phases.back();
+            phase->serial_seconds = seconds_since(serial_start);
+        }
         arena.execute([&] {
-            tbb::parallel_for(size_t(0), candidates.size(), [&](size_t i) {
+            tbb::parallel_for(size_t(0), chunks.size(), [&](size_t chunk_index) {
                 enable_flush_denormals();
-                Candidate& c = candidates[i];
-                const CameraRay ray = camera.generate_ray(c.x + kCandidateX, c.y + kCandidateY);
+                const Clock::time_point chunk_start = phase ? Clock::now() : Clock::time_point{};
+                Chunk& chunk = chunks[chunk_index];
+                const size_t end = std::min(candidates.size(), (chunk_index + 1) * per_chunk);
                 std::vector<DiffusePoint> points;
-                collect_diffuse_points(rs, primary_ray(rs, ray), 0.0f, camera_footprint(ray), 0,
-                                       settings.max_specular_depth, c.counters, points);
-                c.points = points.size();
-                for (size_t k = 0; k < points.size(); ++k) {
-                    Color unused;
-                    if (cache->interpolate(points[k].position, points[k].normal, &unused)) continue;
-                    const uint64_t pixel = static_cast<uint64_t>(c.y) * camera.width() + c.x;
-                    Rng rng = Rng::for_stream(settings.seed, kRecordStreamTag, pixel, k);
-                    c.records.push_back(make_irradiance_record(gatherer, points[k], settings, rng, c.counters));
-                    float min_radius = 0.0f, max_radius = 0.0f;
-                    record_radius_limits(settings, points[k].footprint, &min_radius, &max_radius);
-                    c.min_radii.push_back(min_radius);
+                for (size_t i = chunk_index * per_chunk; i < end; ++i) {
+                    const PixelCandidate& c = candidates[i];
+                    const CameraRay ray = camera.generate_ray(c.x + kCandidateX, c.y + kCandidateY);
+                    points.clear();
+                    collect_diffuse_points(rs, primary_ray(rs, ray), 0.0f, camera_footprint(ray), 0,
+                                           settings.max_specular_depth, chunk.counters, points);
+                    chunk.points += points.size();
+                    for (size_t k = 0; k < points.size(); ++k) {
+                        Color unused;
+                        if (cache->interpolate(points[k].position, points[k].normal, &unused)) continue;
+                        const uint64_t pixel = static_cast<uint64_t>(c.y) * camera.width() + c.x;
+                        Rng rng = Rng::for_stream(settings.seed, kRecordStreamTag, pixel, k);
+                        NewRecord& added = chunk.records.emplace_back();
+                        added.record = make_irradiance_record(gatherer, points[k], settings, rng, chunk.counters);
+                        float max_radius = 0.0f;
+                        record_radius_limits(settings, points[k].footprint, &added.min_radius, &max_radius);
+                    }
                 }
+                if (phase) phase->item_seconds[chunk_index] = seconds_since(chunk_start);
             });
         });
+        serial_start = Clock::now();
         // Merge in candidate order: one writer, no readers.
-        for (Candidate& c : candidates) {
-            for (size_t k = 0; k < c.records.size(); ++k) cache->insert(c.records[k], c.min_radii[k]);
-            stats.counters += c.counters;
-            stats.candidates += c.points;
+        for (const Chunk& chunk : chunks) {
+            for (const NewRecord& added : chunk.records) cache->insert(added.record, added.min_radius);
+            stats.counters += chunk.counters;
+            stats.candidates += chunk.points;
         }
         ++stats.waves;
+        if (phase) phase->serial_seconds += seconds_since(serial_start);
     }
     stats.records = cache->size();
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();

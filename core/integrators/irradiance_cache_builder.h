@@ -13,6 +13,7 @@
 #include "core/image/image.h"
 #include "core/integrators/final_gather.h"
 #include "core/integrators/irradiance_cache.h"
+#include "core/util/work_log.h"
 
 namespace photond {
 
@@ -28,6 +29,9 @@ struct CacheBuildSettings {
     int threads = 0;
     std::optional<PixelRect> region;
     const std::atomic<bool>* cancel = nullptr;
+    /// Set: each wave's candidate durations and serial sections are recorded here (one phase a
+    /// wave), for the scheduling model of bench/schedule_simulation.cpp.
+    WorkLog* work_log = nullptr;
 
     /// What the cache itself keeps of these (its interpolation rule).
     IrradianceCacheSettings interpolation() const { return {accuracy, gradients}; }

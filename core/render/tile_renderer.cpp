@@ -5,6 +5,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <chrono>
 #include <mutex>
 
 #include "core/render/aov_sample.h"
@@ -87,6 +88,11 @@ TileRenderResult render_tiles(const Integrator& integrator, const Camera& camera
         }
     };
 
+    WorkLog::Phase* phase = nullptr;
+    if (settings.work_log) {
+        settings.work_log->phases.push_back({"tiles", std::vector<double>(tiles.size(), 0.0), 0.0});
+        phase = &settings.work_log->phases.back();
+    }
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
     arena.execute([&] {
         tbb::parallel_for(
@@ -101,8 +107,13 @@ TileRenderResult render_tiles(const Integrator& integrator, const Camera& camera
                     const bool restored = callbacks.restore_tile && callbacks.restore_tile(tiles[i], layers);
                     if (restored)
                         tiles_restored.fetch_add(1);
-                    else
+                    else if (phase) {
+                        const auto start = std::chrono::steady_clock::now();
                         render_tile(tiles[i]);
+                        phase->item_seconds[i] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+                    } else {
+                        render_tile(tiles[i]);
+                    }
                     const size_t done = tiles_done.fetch_add(1) + 1;
                     if (callbacks.on_tile) callbacks.on_tile({tiles[i], done, tiles.size(), restored}, layers);
                 }

@@ -13,6 +13,7 @@
 #include "core/camera/camera.h"
 #include "core/image/image.h"
 #include "core/integrators/integrator.h"
+#include "core/util/work_log.h"
 #include "core/render/aov.h"
 
 namespace photond {
@@ -24,6 +25,7 @@ struct TileSettings {
     int threads = 0;                     // 0 = every core
     std::optional<PixelRect> region;     // render only this part of the frame (others stay black)
     std::vector<Aov> aovs;               // layers beside the beauty pass, in this order
+    WorkLog* work_log = nullptr;         // set: each tile's duration, one phase (bench/schedule_simulation.cpp)
 };
 
 /// The tiles covering `area`, row by row.

@@ -1,0 +1,50 @@
+// A model of how a pass recorded in a WorkLog (core/util/work_log.h) would run on P workers: each
+// phase's items are handed out in their order to whichever worker is free first (as a dynamic
+// scheduler does), the phase ends when its last item does (a barrier), then its serial section
+// runs on one thread. Scheduling overheads and memory bandwidth are not modelled, so the figures
+// are an upper bound of what the pass's structure allows.
+#pragma once
+
+#include <algorithm>
+#include <functional>
+#include <queue>
+#include <vector>
+
+#include "core/util/work_log.h"
+
+namespace photond {
+
+/// The time P workers take for `items` handed out in order (list scheduling).
+inline double list_schedule_makespan(const std::vector<double>& items, int workers) {
+    std::priority_queue<double, std::vector<double>, std::greater<double>> free_at;
+    for (int w = 0; w < workers; ++w) free_at.push(0.0);
+    double makespan = 0.0;
+    for (double item : items) {
+        const double start = free_at.top();
+        free_at.pop();
+        free_at.push(start + item);
+        makespan = std::max(makespan, start + item);
+    }
+    return makespan;
+}
+
+/// The modelled time of the whole pass on P workers: every phase's makespan plus its serial part.
+inline double modelled_seconds(const WorkLog& log, int workers) {
+    double total = 0.0;
+    for (const WorkLog::Phase& phase : log.phases)
+        total += list_schedule_makespan(phase.item_seconds, workers) + phase.serial_seconds;
+    return total;
+}
+
+/// The share of one worker's time that is serial (Amdahl's s).
+inline double serial_share(const WorkLog& log) {
+    double serial = 0.0, all = 0.0;
+    for (const WorkLog::Phase& phase : log.phases) {
+        serial += phase.serial_seconds;
+        all += phase.serial_seconds;
+        for (double item : phase.item_seconds) all += item;
+    }
+    return all > 0.0 ? serial / all : 0.0;
+}
+
+}  // namespace photond
