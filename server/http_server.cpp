@@ -28,6 +28,7 @@
 #include "server/routes.h"
 #include "server/scene_store.h"
 #include "server/service_error.h"
+#include "server/web_handlers.h"
 
 namespace photond::service {
 namespace {
@@ -313,7 +314,15 @@ void HttpServer::Impl::register_routes() {
     };
     std::set<std::string> unused;
     for (const auto& [id, member] : handlers) unused.insert(id);
+    for (const auto& [id, handler] : web_handlers()) unused.insert(id);
     for (const Route& r : api_routes()) {
+        // The web page's handlers (server/web_handlers.h) are kept in their own file.
+        if (const auto web = web_handlers().find(r.operation_id); web != web_handlers().end() && unused.erase(r.operation_id)) {
+            route(r.method, r.path_regex(),
+                  [this, handler = web->second](const Request& req, Response& res) { handler(services, req, res); },
+                  !r.authenticated);
+            continue;
+        }
         const auto it = handlers.find(r.operation_id);
         if (it == handlers.end() || !unused.erase(r.operation_id))
             throw std::logic_error(r.method + " " + r.path + ": no handler for operation '" +

@@ -230,6 +230,25 @@ std::vector<Route> build_routes() {
              {"404", problem("unknown job, tile outside the grid, or not finished yet")}}});
     routes.push_back(
         {.method = "GET",
+         .path = "/v1/jobs/{id}/tiles/{tx}/{ty}.png",
+         .operation_id = "jobTilePng",
+         .summary =
+             "One finished tile as an 8-bit sRGB PNG made as preview.png is (exposure, filmic tone "
+             "curve, sRGB; server/tile_png.h). Exposure: exposure_ev if given, else the job's "
+             "output.exposure_ev, else the preview's automatic exposure at this moment; "
+             "X-Exposure-EV says which was used, X-Tile-Rect where the tile lies (x0,y0,x1,y1)",
+         .path_parameters = {kJobId,
+                             {"tx", "[0-9]{1,9}", "tile column"},
+                             {"ty", "[0-9]{1,9}", "tile row"}},
+         .query_and_header_parameters = json::array({query_parameter(
+             "exposure_ev", "exposure in stops, e.g. the X-Exposure-EV of an earlier tile",
+             {{"type", "number"}, {"minimum", -64}, {"maximum", 64}})}),
+         .responses = {
+             {"200", binary_response("the tile", "image/png")},
+             {"400", problem("exposure_ev is not a number of stops in [-64, 64]")},
+             {"404", problem("unknown job, tile outside the grid, or not finished yet")}}});
+    routes.push_back(
+        {.method = "GET",
          .path = "/v1/jobs/{id}/image.exr",
          .operation_id = "jobImage",
          .summary = "The assembled image (tiled OpenEXR, as `photond render` writes it)",
@@ -326,6 +345,26 @@ std::vector<Route> build_routes() {
          .summary = "This document",
          .responses = {
              {"200", response("OpenAPI 3.1", content("application/json", {{"type", "object"}}))}}});
+    // The web page (server/web_handlers.h): public files without data; the data it shows comes
+    // through the routes above, with the token.
+    routes.push_back(
+        {.method = "GET",
+         .path = "/",
+         .operation_id = "webPage",
+         .summary = "The web page: jobs, submission, a job's image assembling live (asks for the "
+                    "token when the daemon has one)",
+         .authenticated = false,
+         .responses = {{"200", response("the page", content("text/html", {{"type", "string"}}))}}});
+    routes.push_back(
+        {.method = "GET",
+         .path = "/web/{file}",
+         .operation_id = "webAsset",
+         .summary = "The web page's script and style sheet",
+         .authenticated = false,
+         .path_parameters = {{"file", "[A-Za-z0-9_.-]{1,64}", "app.js or app.css"}},
+         .responses = {{"200", response("the file", {{"text/javascript", {{"schema", {{"type", "string"}}}}},
+                                                     {"text/css", {{"schema", {{"type", "string"}}}}}})},
+                       {"404", problem("no such file")}}});
     return routes;
 }
 
