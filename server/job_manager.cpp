@@ -857,9 +857,13 @@ std::vector<uint8_t> JobManager::preview_png(const std::string& id) {
         entry = find_locked(lock, id);
         done = entry->status.state == JobState::Done;
     }
-    if (done && verify_image(entry))
+    if (done) {
+        if (!verify_image(entry)) {
+            std::lock_guard lock(mutex_);
+            throw ServiceError(ErrorKind::Conflict, "job " + id + " failed: " + entry->status.error);
+        }
         if (auto bytes = read_file_bytes(store_.preview_path(id))) return std::move(*bytes);
-    // Checks the state (a damaged image failed the job above) and reads the image.
+    }
     const std::shared_ptr<const Image> frame = preview_frame(id);
     auto png = encode_job_preview(entry->submission.job, *frame);
     if (!png) throw ServiceError(ErrorKind::Internal, png.error().message);

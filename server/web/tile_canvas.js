@@ -15,6 +15,12 @@ import { apiFetch } from "./api.js";
 
 const MAX_IN_FLIGHT = 6;
 
+/// A PNG response as an ImageBitmap (close() it after), without colour conversion: the PNG and the
+/// canvas are sRGB.
+async function decodePng(response) {
+  return createImageBitmap(await response.blob(), { colorSpaceConversion: "none", premultiplyAlpha: "none" });
+}
+
 export class TileCanvas {
   /// `status`: the job's status document (its job description gives the frame and exposure).
   constructor(canvas, status) {
@@ -38,6 +44,7 @@ export class TileCanvas {
     // Figures the browser test reads (tests/server/web_page_browser.mjs).
     this.tilesDrawn = 0;
     this.latencies = [];   // ms from the tile's event to its pixels on the canvas
+    this.phases = [];      // per tile: [queued, request, read and decode, draw] in ms
     this.finalSource = "tiles";
     this.errors = [];
   }
@@ -89,18 +96,22 @@ export class TileCanvas {
   }
 
   async draw(tile) {
+    const started = performance.now();
     let path = `${this.base()}/tiles/${tile.tx}/${tile.ty}.png`;
     if (!this.fixedExposure && this.exposure !== null) path += `?exposure_ev=${encodeURIComponent(this.exposure)}`;
     const response = await apiFetch(path);
     if (!this.fixedExposure && this.exposure === null) this.exposure = response.headers.get("X-Exposure-EV");
-    const bitmap = await createImageBitmap(await response.blob(), {
-      colorSpaceConversion: "none",
-      premultiplyAlpha: "none",
-    });
-    if (!this.closed) this.context.drawImage(bitmap, tile.rect[0], tile.rect[1]);
-    bitmap.close();
+    const answered = performance.now();
+    const image = await decodePng(response);
+    const decoded = performance.now();
+    if (!this.closed) this.context.drawImage(image, tile.rect[0], tile.rect[1]);
+    image.close();
     this.tilesDrawn += 1;
-    this.latencies.push(performance.now() - tile.at);
+    const drawn = performance.now();
+    this.latencies.push(drawn - tile.at);
+    // Where the time went: waiting for a free request, the request, reading and decoding the
+    // PNG, drawing.
+    this.phases.push([started - tile.at, answered - started, decoded - answered, drawn - decoded]);
   }
 
   /// Resolves when every tile announced so far is drawn.
@@ -112,12 +123,9 @@ export class TileCanvas {
   /// Draws a whole image (preview.png) over the canvas.
   async drawPreview() {
     const response = await apiFetch(`${this.base()}/preview.png`);
-    const bitmap = await createImageBitmap(await response.blob(), {
-      colorSpaceConversion: "none",
-      premultiplyAlpha: "none",
-    });
-    if (!this.closed) this.context.drawImage(bitmap, 0, 0);
-    bitmap.close();
+    const image = await decodePng(response);
+    if (!this.closed) this.context.drawImage(image, 0, 0);
+    image.close();
     this.finalSource = "preview";
   }
 

@@ -71,25 +71,31 @@ class MemorySampler {
   constructor(browser, cdp) {
     this.root = browser.process().pid;
     this.cdp = cdp;
-    this.peak = { pss_mb: 0, largest_process_rss_mb: 0, js_heap_used_mb: 0, js_heap_total_mb: 0 };
+    this.peak = { pss_mb: 0, page_renderer_rss_mb: 0, gpu_process_rss_mb: 0, js_heap_used_mb: 0, js_heap_total_mb: 0 };
   }
 
+  /// The page's renderer is the renderer process with the most memory (it holds the canvas);
+  /// the GPU process rasterises it.
   async sample() {
     let pss = 0;
-    let largest = 0;
+    let renderer = 0;
+    let gpu = 0;
     const processes = [];
     for (const pid of browserProcesses(this.root)) {
       const own = memoryKb(pid, "Pss");
+      const type = processType(pid);
       pss += own;
-      largest = Math.max(largest, memoryKb(pid, "Rss"));
-      processes.push(`${processType(pid)} ${(own / 1024).toFixed(0)}`);
+      if (type === "renderer") renderer = Math.max(renderer, memoryKb(pid, "Rss"));
+      if (type === "gpu-process") gpu = Math.max(gpu, memoryKb(pid, "Rss"));
+      processes.push(`${type} ${(own / 1024).toFixed(0)}`);
     }
     if (pss / 1024 > this.peak.pss_mb) this.peak.processes_pss_mb = processes;
     const { metrics } = await this.cdp.send("Performance.getMetrics");
     const metric = (name) => (metrics.find((m) => m.name === name) || { value: 0 }).value;
     const now = {
       pss_mb: pss / 1024,
-      largest_process_rss_mb: largest / 1024,
+      page_renderer_rss_mb: renderer / 1024,
+      gpu_process_rss_mb: gpu / 1024,
       js_heap_used_mb: metric("JSHeapUsedSize") / 2 ** 20,
       js_heap_total_mb: metric("JSHeapTotalSize") / 2 ** 20,
     };
@@ -209,6 +215,7 @@ async function compareWithPreview(page, jobId) {
       exposure: pageState.exposure,
       tile_errors: pageState.errors,
       latencies_ms: pageState.latencies,
+      phases_ms: pageState.phases,
     };
   }, jobId);
 }
@@ -310,6 +317,8 @@ async function largeRun(page, sampler) {
   await enterToken(page, 1, options.token);
   await showQueue(page);
   const size = options.large_size || 4096;
+  // The browser with the page open and no job: what chromium takes whatever the page does.
+  result.memory_before_job = await sampler.sample();
   log(`${size}x${size} job`);
   sampler.start(250);
   const started = Date.now();
@@ -366,6 +375,11 @@ async function main() {
       if (result[key] && result[key].latencies_ms) {
         result[key].latency_ms = summary(result[key].latencies_ms);
         delete result[key].latencies_ms;
+        // Medians of where the time went.
+        const phases = result[key].phases_ms;
+        result[key].latency_phases_median_ms = Object.fromEntries(
+          ["queued", "request", "read_and_decode", "draw"].map((name, i) => [name, summary(phases.map((p) => p[i])).median]));
+        delete result[key].phases_ms;
       }
     }
   } catch (error) {
