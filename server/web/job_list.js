@@ -33,8 +33,10 @@ function jobRow(job) {
   bar.max = job.progress.tiles_total || 1;
   bar.value = job.progress.tiles_done;
   progress.append(bar, ` ${job.progress.tiles_done}/${job.progress.tiles_total}`);
-  tr.append(id, state, progress, cell(job.pass || ""), cell((job.created_at || "").replace("T", " ").replace("Z", "")),
-    cell(seconds(job.started_at, job.finished_at), "number"));
+  // The time of day (UTC) in the table, the whole timestamp on hover.
+  const created = cell((job.created_at || "").slice(11, 19));
+  created.title = job.created_at || "";
+  tr.append(id, state, progress, cell(job.pass || ""), created, cell(seconds(job.started_at, job.finished_at), "number"));
   return tr;
 }
 

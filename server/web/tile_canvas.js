@@ -1,19 +1,25 @@
-// A job's image assembling on a canvas the size of the frame, tile by tile as the event stream
-// announces them: each tile is fetched as a PNG (GET /v1/jobs/{id}/tiles/{tx}/{ty}.png, made as
-// preview.png is, server/tile_png.h) and drawn where its rectangle says.
+// A job's image assembling tile by tile as the event stream announces them: each tile is fetched
+// as a PNG (GET /v1/jobs/{id}/tiles/{tx}/{ty}.png, made as preview.png is, server/tile_png.h)
+// and drawn where its rectangle says into the frame, a canvas of the image's size.
+//
+// The frame is shown as it is when it is at most MAX_SHOWN pixels wide and high. A larger one is
+// kept off the page (an OffscreenCanvas, in the page's own memory) and shown through a canvas
+// smaller by a whole factor, each tile drawn into both: a 4096x4096 frame costs its 64 MB once,
+// instead of again in the compositor's and the GPU process's copies of a canvas that size.
 //
 // Exposure: with the job's own output.exposure_ev every tile uses it. Otherwise the first tile
 // is fetched without one and the server picks the preview's automatic exposure at that moment
 // (X-Exposure-EV); the page pins it for every later tile, so that the live image is of one
 // piece. When the job is done its automatic exposure is asked for again; if it differs, the
-// finished image is drawn from preview.png, so that the canvas ends as the preview.
+// finished image is drawn from preview.png, so that the frame ends as the preview.
 //
 // At most MAX_IN_FLIGHT tile requests run at once; a PNG's decoded bitmap is closed as soon as
-// it is drawn, so that a 4096x4096 job's 16,384 tiles cost the canvas and little else.
+// it is drawn.
 
 import { apiFetch } from "./api.js";
 
 const MAX_IN_FLIGHT = 6;
+const MAX_SHOWN = 1280;
 
 /// A PNG response as an ImageBitmap (close() it after), without colour conversion: the PNG and the
 /// canvas are sRGB.
@@ -27,11 +33,23 @@ export class TileCanvas {
     this.canvas = canvas;
     this.jobId = status.id;
     const image = status.job.image;
-    canvas.width = image.width;
-    canvas.height = image.height;
-    this.context = canvas.getContext("2d", { alpha: false });
-    this.context.fillStyle = "#000";
-    this.context.fillRect(0, 0, image.width, image.height);
+    // The frame's pixels stay on the CPU (willReadFrequently), where the test reads them back.
+    const options = { alpha: false, willReadFrequently: true };
+    this.shrink = Math.ceil(Math.max(image.width, image.height) / MAX_SHOWN);
+    canvas.width = Math.ceil(image.width / this.shrink);
+    canvas.height = Math.ceil(image.height / this.shrink);
+    if (this.shrink === 1) {
+      this.shown = canvas.getContext("2d", options);
+      this.frame = this.shown;
+    } else {
+      this.shown = canvas.getContext("2d", { alpha: false });
+      this.shown.imageSmoothingQuality = "high";
+      this.frame = new OffscreenCanvas(image.width, image.height).getContext("2d", options);
+    }
+    for (const context of [this.shown, this.frame]) {
+      context.fillStyle = "#000";
+      context.fillRect(0, 0, context.canvas.width, context.canvas.height);
+    }
     const own = status.job.output && status.job.output.exposure_ev;
     this.fixedExposure = own !== undefined && own !== null;
     this.exposure = null;  // the pinned X-Exposure-EV, as the server wrote it
@@ -104,7 +122,7 @@ export class TileCanvas {
     const answered = performance.now();
     const image = await decodePng(response);
     const decoded = performance.now();
-    if (!this.closed) this.context.drawImage(image, tile.rect[0], tile.rect[1]);
+    if (!this.closed) this.place(image, tile.rect);
     image.close();
     this.tilesDrawn += 1;
     const drawn = performance.now();
@@ -124,23 +142,54 @@ export class TileCanvas {
   async drawPreview() {
     const response = await apiFetch(`${this.base()}/preview.png`);
     const image = await decodePng(response);
-    if (!this.closed) this.context.drawImage(image, 0, 0);
+    if (!this.closed) {
+      this.frame.drawImage(image, 0, 0);
+      if (this.frame !== this.shown) this.shown.drawImage(this.frame.canvas, 0, 0, this.canvas.width, this.canvas.height);
+    }
     image.close();
     this.finalSource = "preview";
+  }
+
+  /// Draws a decoded tile into the frame at rect [x0, y0, x1, y1] and, when the frame is shown
+  /// smaller, into the shown canvas too (rounded so that neighbours share their edges).
+  place(image, rect) {
+    this.frame.drawImage(image, rect[0], rect[1]);
+    if (this.frame === this.shown) return;
+    const k = this.shrink;
+    const x0 = Math.floor(rect[0] / k);
+    const y0 = Math.floor(rect[1] / k);
+    this.shown.drawImage(image, x0, y0, Math.floor(rect[2] / k) - x0, Math.floor(rect[3] / k) - y0);
+  }
+
+  /// The frame's pixels (what the browser test compares with preview.png).
+  framePixels() {
+    return this.frame.getImageData(0, 0, this.frame.canvas.width, this.frame.canvas.height);
+  }
+
+  /// When the job is done: the shown canvas drawn again from the whole frame in one go.
+  refreshShown() {
+    if (this.frame !== this.shown && !this.closed) {
+      this.shown.drawImage(this.frame.canvas, 0, 0, this.canvas.width, this.canvas.height);
+    }
   }
 
   /// The job is done: the last tiles drawn, then the final exposure checked (see above).
   async finish() {
     await this.idle();
-    if (this.fixedExposure) return;
-    if (this.exposure !== null) {
-      const probe = await apiFetch(`${this.base()}/tiles/0/0.png`);
-      const finalExposure = probe.headers.get("X-Exposure-EV");
-      await probe.body.cancel();
-      if (finalExposure === this.exposure) return;
+    if (!this.fixedExposure) {
+      let finalExposure = null;
+      if (this.exposure !== null) {
+        const probe = await apiFetch(`${this.base()}/tiles/0/0.png`);
+        finalExposure = probe.headers.get("X-Exposure-EV");
+        await probe.body.cancel();
+      }
+      if (finalExposure !== this.exposure || finalExposure === null) {
+        this.exposure = null;
+        await this.drawPreview();
+        return;
+      }
     }
-    this.exposure = null;
-    await this.drawPreview();
+    this.refreshShown();
   }
 
   close() {

@@ -100,6 +100,8 @@ class MemorySampler {
       js_heap_total_mb: metric("JSHeapTotalSize") / 2 ** 20,
     };
     for (const key of Object.keys(now)) this.peak[key] = Math.max(this.peak[key], now[key]);
+    this.series = this.series || [];
+    this.series.push([Math.round(performance.now()), Math.round(now.page_renderer_rss_mb), Math.round(now.gpu_process_rss_mb), Math.round(now.pss_mb)]);
     this.samples = (this.samples || 0) + 1;
     return now;
   }
@@ -190,7 +192,8 @@ async function waitForImage(page, timeoutMs) {
 async function compareWithPreview(page, jobId) {
   return page.evaluate(async (id) => {
     const canvas = document.getElementById("job-canvas");
-    const shown = canvas.getContext("2d").getImageData(0, 0, canvas.width, canvas.height).data;
+    const frame = window.photondPage.canvas.framePixels();
+    const shown = frame.data;
     const token = sessionStorage.getItem("photond.token");
     const response = await fetch(`/v1/jobs/${id}/preview.png`, { headers: { Authorization: `Bearer ${token}` } });
     const bitmap = await createImageBitmap(await response.blob(), { colorSpaceConversion: "none", premultiplyAlpha: "none" });
@@ -205,8 +208,14 @@ async function compareWithPreview(page, jobId) {
       if (shown[i] === 0 && shown[i + 1] === 0 && shown[i + 2] === 0) black += 1;
     }
     const pageState = window.photondPage.canvas;
+    // The canvas on the page (the frame itself, or shown smaller): not black.
+    const onPage = canvas.getContext("2d").getImageData(0, 0, canvas.width, canvas.height).data;
+    let shownBlack = 0;
+    for (let i = 0; i < onPage.length; i += 4) shownBlack += onPage[i] === 0 && onPage[i + 1] === 0 && onPage[i + 2] === 0;
     return {
-      canvas: [canvas.width, canvas.height],
+      canvas: [frame.width, frame.height],
+      shown: [canvas.width, canvas.height],
+      shown_black_fraction: shownBlack / (canvas.width * canvas.height),
       preview: [bitmap.width, bitmap.height],
       differing_pixels: differing,
       black_pixels: black,
@@ -331,6 +340,7 @@ async function largeRun(page, sampler) {
   await sampler.sample();
   // The comparison's own copies of the pixels are the test's, not the page's: measured before.
   result.memory_peak = { ...sampler.peak };
+  result.memory_series = sampler.series.filter((_, i) => i % 8 === 0);
   result.large = { id, size, seconds, ...(await compareWithPreview(page, id)) };
   result.large.progress = (await serverStatus(page, id)).progress;
 }

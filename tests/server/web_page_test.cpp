@@ -291,6 +291,7 @@ TEST(WebPage, InChromium) {
     // The job with its own exposure: the canvas, made of its 10 x 8 tiles alone, is preview.png.
     const json& fixed = r["fixed_exposure"];
     EXPECT_EQ(fixed["canvas"], json({320, 240}));
+    EXPECT_EQ(fixed["shown"], json({320, 240}));  // small frames are shown as they are
     EXPECT_EQ(fixed["differing_pixels"], 0) << fixed.dump(2);
     EXPECT_EQ(fixed["tiles_drawn"], 80);
     EXPECT_EQ(fixed["final_source"], "tiles");
@@ -344,7 +345,12 @@ TEST(WebPage, DISABLED_LargeJobInChromium) {
     const json& large = r["large"];
     const int tiles = ((size + 31) / 32) * ((size + 31) / 32);
     EXPECT_EQ(large["tiles_drawn"], tiles);
+    EXPECT_EQ(large["canvas"], json({size, size}));
     EXPECT_EQ(large["differing_pixels"], 0);
+    // Shown smaller by a whole factor (server/web/tile_canvas.js), and not black.
+    const int shrink = (size + 1279) / 1280;
+    EXPECT_EQ(large["shown"], json({(size + shrink - 1) / shrink, (size + shrink - 1) / shrink}));
+    EXPECT_LT(large["shown_black_fraction"].get<double>(), 0.5);
     EXPECT_TRUE(large["tile_errors"].empty()) << large["tile_errors"];
     const json& peak = r["memory_peak"];
     const json& before = r["memory_before_job"];
