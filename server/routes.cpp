@@ -70,6 +70,8 @@ json binary_body(std::initializer_list<std::string> types) {
 
 const PathParameter kJobId{"id", "[A-Za-z0-9_-]{1,128}", "the job's id"};
 const PathParameter kSceneId{"id", "[^/]+", "sha256:<64 hex digits>"};
+const PathParameter kTileColumn{"tx", "[0-9]{1,9}", "tile column"};
+const PathParameter kTileRow{"ty", "[0-9]{1,9}", "tile row"};
 
 /// The routes of a cache of artifacts (photon maps, render caches): list, export, import.
 void add_artifact_routes(std::vector<Route>& routes, const std::string& base,
@@ -222,9 +224,7 @@ std::vector<Route> build_routes() {
          .summary =
              "One finished tile as a small EXR (data window = the tile, display window = the "
              "frame); tiles count from the rendered area's top-left corner",
-         .path_parameters = {kJobId,
-                             {"tx", "[0-9]{1,9}", "tile column"},
-                             {"ty", "[0-9]{1,9}", "tile row"}},
+         .path_parameters = {kJobId, kTileColumn, kTileRow},
          .responses = {
              {"200", binary_response("the tile", "image/x-exr")},
              {"404", problem("unknown job, tile outside the grid, or not finished yet")}}});
@@ -237,9 +237,7 @@ std::vector<Route> build_routes() {
              "curve, sRGB; server/tile_png.h). Exposure: exposure_ev if given, else the job's "
              "output.exposure_ev, else the preview's automatic exposure at this moment; "
              "X-Exposure-EV says which was used, X-Tile-Rect where the tile lies (x0,y0,x1,y1)",
-         .path_parameters = {kJobId,
-                             {"tx", "[0-9]{1,9}", "tile column"},
-                             {"ty", "[0-9]{1,9}", "tile row"}},
+         .path_parameters = {kJobId, kTileColumn, kTileRow},
          .query_and_header_parameters = json::array({query_parameter(
              "exposure_ev", "exposure in stops, e.g. the X-Exposure-EV of an earlier tile",
              {{"type", "number"}, {"minimum", -64}, {"maximum", 64}})}),
@@ -347,24 +345,22 @@ std::vector<Route> build_routes() {
              {"200", response("OpenAPI 3.1", content("application/json", {{"type", "object"}}))}}});
     // The web page (server/web_handlers.h): public files without data; the data it shows comes
     // through the routes above, with the token.
-    routes.push_back(
-        {.method = "GET",
-         .path = "/",
-         .operation_id = "webPage",
-         .summary = "The web page: jobs, submission, a job's image assembling live (asks for the "
-                    "token when the daemon has one)",
-         .authenticated = false,
-         .responses = {{"200", response("the page", content("text/html", {{"type", "string"}}))}}});
-    routes.push_back(
-        {.method = "GET",
-         .path = "/web/{file}",
-         .operation_id = "webAsset",
-         .summary = "The web page's script and style sheet",
-         .authenticated = false,
-         .path_parameters = {{"file", "[A-Za-z0-9_.-]{1,64}", "app.js or app.css"}},
-         .responses = {{"200", response("the file", {{"text/javascript", {{"schema", {{"type", "string"}}}}},
-                                                     {"text/css", {{"schema", {{"type", "string"}}}}}})},
-                       {"404", problem("no such file")}}});
+    const json text = {{"schema", {{"type", "string"}}}};
+    routes.push_back({.method = "GET",
+                      .path = "/",
+                      .operation_id = "webPage",
+                      .summary = "The web page: jobs, submission, a job's image assembling live "
+                                 "(asks for the token when the daemon has one)",
+                      .authenticated = false,
+                      .responses = {{"200", response("the page", {{"text/html", text}})}}});
+    routes.push_back({.method = "GET",
+                      .path = "/web/{file}",
+                      .operation_id = "webAsset",
+                      .summary = "The web page's scripts (ES modules) and style sheet",
+                      .authenticated = false,
+                      .path_parameters = {{"file", "[A-Za-z0-9_.-]{1,64}", "e.g. app.js, app.css"}},
+                      .responses = {{"200", response("the file", {{"text/javascript", text}, {"text/css", text}})},
+                                    {"404", problem("no such file")}}});
     return routes;
 }
 
