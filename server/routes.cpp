@@ -257,6 +257,16 @@ std::vector<Route> build_routes() {
                        {"404", problem("unknown job")},
                        {"409", problem("not done (without wait), failed or cancelled")},
                        {"503", problem("shutting down while waiting")}}});
+    routes.push_back(
+        {.method = "GET",
+         .path = "/v1/jobs/{id}/layers/{layer}.exr",
+         .operation_id = "jobLayer",
+         .summary = "One AOV layer the job asked for (output.aovs) as an EXR of its own, its values "
+                    "in R, G and B (image.exr holds it too, as <layer>.R, .G, .B)",
+         .path_parameters = {kJobId, {"layer", "[a-z_]{1,32}", "the layer's name, e.g. albedo"}},
+         .responses = {{"200", binary_response("the layer", "image/x-exr")},
+                       {"404", problem("unknown job, or a layer the job did not ask for")},
+                       {"409", problem("not done, failed or cancelled")}}});
     routes.push_back({.method = "GET",
                       .path = "/v1/jobs/{id}/preview.png",
                       .operation_id = "jobPreview",

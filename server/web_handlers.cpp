@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "server/http_server.h"
+#include "server/job_layer_exr.h"
 #include "server/service_error.h"
 #include "server/tile_png.h"
 #include "server/web_assets.h"
@@ -81,11 +82,21 @@ void job_tile_png(const HttpServices& services, const Request& req, Response& re
     res.set_content(reinterpret_cast<const char*>(png.bytes.data()), png.bytes.size(), "image/png");
 }
 
+void job_layer(const HttpServices& services, const Request& req, Response& res) {
+    const std::string id = req.matches[1];
+    const std::string layer = req.matches[2];
+    const std::vector<uint8_t> bytes = make_layer_exr(services.jobs, id, layer);
+    res.set_header("Content-Disposition", "attachment; filename=\"" + id + "." + layer + ".exr\"");
+    res.set_content(reinterpret_cast<const char*>(bytes.data()), bytes.size(), "image/x-exr");
+}
+
 }  // namespace
 
 const std::map<std::string, ServiceHandler>& web_handlers() {
-    static const std::map<std::string, ServiceHandler> handlers = {
-        {"webPage", web_page}, {"webAsset", web_asset}, {"jobTilePng", job_tile_png}};
+    static const std::map<std::string, ServiceHandler> handlers = {{"webPage", web_page},
+                                                                   {"webAsset", web_asset},
+                                                                   {"jobTilePng", job_tile_png},
+                                                                   {"jobLayer", job_layer}};
     return handlers;
 }
 

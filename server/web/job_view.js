@@ -1,6 +1,7 @@
 // The page of one job (#/jobs/{id}): its state and progress, the image assembling live
 // (tile_canvas.js), the plan with each pass that runs or is skipped and why, the pass timings,
-// the warnings, cancel, and the downloads (the EXR with its AOV layers, the PNG preview).
+// the warnings, cancel, and the downloads (the EXR with its AOV layers, each AOV layer as an EXR
+// of its own, the PNG preview).
 //
 // Every text from the daemon is put in with textContent, never parsed as HTML.
 
@@ -223,10 +224,17 @@ export class JobView {
     exr.type = "button";
     exr.id = "download-exr";
     exr.onclick = () => download(`${this.base()}/image.exr`, `${this.jobId}.exr`).catch((e) => this.showError(e.message));
+    const layers = aovs.map((name) => {
+      const button = element("button", `${name}.exr`);
+      button.type = "button";
+      button.onclick = () =>
+        download(`${this.base()}/layers/${name}.exr`, `${this.jobId}.${name}.exr`).catch((e) => this.showError(e.message));
+      return button;
+    });
     const png = element("button", "preview.png");
     png.type = "button";
     png.id = "download-png";
     png.onclick = () => download(`${this.base()}/preview.png`, `${this.jobId}.png`).catch((e) => this.showError(e.message));
-    links.append(element("span", "Download ", "hint"), exr, png);
+    links.append(element("span", "Download ", "hint"), exr, ...layers, png);
   }
 }

@@ -10,7 +10,8 @@
 // Steps that cannot go on throw; the error is in the result's "error".
 
 import { createRequire } from "node:module";
-import { readFileSync, readdirSync, mkdirSync } from "node:fs";
+import { readFileSync, readdirSync, mkdirSync, mkdtempSync, existsSync, rmSync } from "node:fs";
+import os from "node:os";
 import path from "node:path";
 
 const options = JSON.parse(process.argv[2]);
@@ -270,16 +271,33 @@ async function shortRun(page, sampler) {
   await showQueue(page);
   result.token_in_session_storage = await page.evaluate(() => sessionStorage.getItem("photond.token"));
 
-  // A job with its own exposure: the canvas is the tiles alone.
+  // A job with its own exposure: the canvas is the tiles alone. Its tiles come at a steady pace
+  // (16 spp), so that their latency is the page's and not that of a queue of tiles that arrive
+  // faster than any page fetches them.
   log("job with its own exposure");
   const fixed = await submitJob(page, {
-    scene: "builtin:cornell-box", preset: "final", width: 320, height: 240, tile: 32, spp: 4, exposure: 0.5,
+    scene: "builtin:cornell-box", preset: "final", width: 320, height: 240, tile: 32, spp: 16, exposure: 0.5,
     aovs: ["albedo", "normal"],
   });
   await waitForImage(page, 180000);
   result.fixed_exposure = { id: fixed, ...(await compareWithPreview(page, fixed)), texts: await pageTexts(page) };
   result.fixed_exposure.status = await serverStatus(page, fixed);
   await screenshot(page, "web-job.png");
+
+  // Downloads, fetched with the token: the EXR and one AOV layer, as files.
+  const downloads = mkdtempSync(path.join(os.tmpdir(), "photond_web_downloads_"));
+  const session = await page.browser().target().createCDPSession();
+  await session.send("Browser.setDownloadBehavior", { behavior: "allow", downloadPath: downloads });
+  result.downloads = {};
+  for (const [label, file] of [["image.exr", `${fixed}.exr`], ["albedo.exr", `${fixed}.albedo.exr`]]) {
+    await page.evaluate((text) => [...document.querySelectorAll("#downloads button")].find((b) => b.textContent.startsWith(text)).click(), label);
+    const target = path.join(downloads, file);
+    const deadline = Date.now() + 20000;
+    while (!existsSync(target) && Date.now() < deadline) await new Promise((resolve) => setTimeout(resolve, 100));
+    const bytes = existsSync(target) ? readFileSync(target) : Buffer.alloc(0);
+    result.downloads[label] = { bytes: bytes.length, exr_magic: bytes.length >= 4 && bytes.readUInt32LE(0) === 20000630 };
+  }
+  rmSync(downloads, { recursive: true, force: true });
 
   // Automatic exposure: live tiles at the first tile's exposure, the end as preview.png.
   log("job with automatic exposure");

@@ -18,6 +18,7 @@
 #include <iostream>
 #include <set>
 
+#include "core/image/exr_io.h"
 #include "tests/server/daemon_harness.h"
 #include "tests/support/decoded_png.h"
 
@@ -160,7 +161,9 @@ TEST(WebPage, PngTilesSideBySideArePreviewPng) {
         EXPECT_EQ(differing_pixels(tiles, preview), 0u);
         ASSERT_EQ(exposures.size(), 1u);  // one exposure for the whole frame
         const std::string exposure = *exposures.begin();
-        if (own_exposure) EXPECT_EQ(exposure, "1.5");
+        if (own_exposure) {
+            EXPECT_EQ(exposure, "1.5");
+        }
         // The exposure given back gives the same tiles; another one gives others.
         std::set<std::string> again;
         EXPECT_EQ(differing_pixels(assemble_tiles(client, id, kWidth, kHeight, kTile,
@@ -193,6 +196,41 @@ TEST(WebPage, PngTilesSideBySideArePreviewPng) {
         EXPECT_NE(answer.json_body().value("detail", "").find(r.says), std::string::npos)
             << r.path << ": " << answer.body;
     }
+}
+
+TEST(WebPage, LayerExrIsTheJobsAovAlone) {
+    TokenDaemon fixture;
+    Daemon& daemon = *fixture.daemon;
+    ASSERT_TRUE(daemon.started()) << daemon.first_line() << daemon.log();
+    const HttpClient client = daemon.client(kToken);
+    const json job = {{"scene", {{"builtin", "cornell-box"}}},
+                      {"integrator", "direct"},
+                      {"image", {{"width", 40}, {"height", 24}, {"tile_size", 16}, {"spp", 1}}},
+                      {"output", {{"aovs", {"albedo", "depth"}}, {"pixel_type", "float"}}}};
+    const HttpResponse submitted = client.post("/v1/jobs", job.dump());
+    ASSERT_EQ(submitted.status, 202) << submitted.body;
+    const std::string id = submitted.json_body().at("id");
+    const std::string base = "/v1/jobs/" + id;
+    ASSERT_EQ(client.get(base + "/image.exr?wait=true").status, 200);
+    const HttpResponse image = client.get(base + "/image.exr");
+    const auto whole = decode_exr({reinterpret_cast<const uint8_t*>(image.body.data()), image.body.size()});
+    ASSERT_TRUE(whole.has_value()) << whole.error().message;
+    for (const std::string layer : {"albedo", "depth"}) {
+        const HttpResponse answer = client.get(base + "/layers/" + layer + ".exr");
+        ASSERT_EQ(answer.status, 200) << answer.body;
+        EXPECT_EQ(answer.header("content-type"), "image/x-exr");
+        EXPECT_NE(answer.header("content-disposition").find(id + "." + layer + ".exr"), std::string::npos);
+        const auto alone = decode_exr({reinterpret_cast<const uint8_t*>(answer.body.data()), answer.body.size()});
+        ASSERT_TRUE(alone.has_value()) << alone.error().message;
+        EXPECT_TRUE(alone->aovs.empty());
+        ASSERT_NE(whole->find_aov(layer), nullptr);
+        EXPECT_TRUE(alone->beauty == *whole->find_aov(layer)) << layer;
+    }
+    const HttpResponse other = client.get(base + "/layers/normal.exr");
+    EXPECT_EQ(other.status, 404);
+    EXPECT_NE(other.json_body().value("detail", "").find("its output.aovs: albedo, depth"), std::string::npos)
+        << other.body;
+    EXPECT_EQ(daemon.client().get(base + "/layers/albedo.exr").status, 401);
 }
 
 /// puppeteer-core under PHOTOND_BINARY_DIR/npm-tools, installed with `npm` unless an earlier run
@@ -302,7 +340,12 @@ TEST(WebPage, InChromium) {
     EXPECT_FALSE(fixed["texts"]["plan_rows"].empty());
     EXPECT_EQ(fixed["texts"]["plan_rows"].size(), fixed["status"]["plan"].size());
     EXPECT_GE(fixed["texts"]["timing_rows"].size(), fixed["status"]["timings"].size());
-    EXPECT_EQ(fixed["texts"]["downloads"], json({"image.exr (beauty, albedo, normal)", "preview.png"}));
+    EXPECT_EQ(fixed["texts"]["downloads"],
+              json({"image.exr (beauty, albedo, normal)", "albedo.exr", "normal.exr", "preview.png"}));
+    for (const char* download : {"image.exr", "albedo.exr"}) {
+        EXPECT_GT(r["downloads"][download].value("bytes", 0), 1000) << download;
+        EXPECT_TRUE(r["downloads"][download].value("exr_magic", false)) << download;
+    }
 
     // Automatic exposure: the canvas ends as preview.png too.
     const json& automatic = r["automatic_exposure"];
