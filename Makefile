@@ -10,9 +10,11 @@ DEBIAN_PACKAGES := cmake g++ make pkg-config libembree-dev libtbb-dev libopenexr
 OUT ?= out
 # The tools of the interface checks that ctest runs (tests/server/metrics_exposition_test.cpp:
 # promtool; tests/server/openapi_document_test.cpp: npm, which installs the OpenAPI validator into
-# the build tree), as command:package. A command already on the PATH is kept, whatever package
-# brought it: NodeSource's nodejs carries its own npm and conflicts with Debian's npm package.
-TEST_TOOLS := promtool:prometheus node:nodejs npm:npm
+# the build tree; tests/server/web_page_test.cpp: chromium, driven by puppeteer-core, which npm
+# installs into the build tree), as command:package. A command already on the PATH is kept,
+# whatever package brought it: NodeSource's nodejs carries its own npm and conflicts with Debian's
+# npm package.
+TEST_TOOLS := promtool:prometheus node:nodejs npm:npm chromium:chromium
 missing_tool_packages = $(shell for t in $(TEST_TOOLS); do \
 	command -v $$(echo $$t | cut -d: -f1) >/dev/null || echo $$t | cut -d: -f2; done)
 
@@ -152,6 +154,20 @@ LOAD_SECONDS ?= 60
 load: build
 	python3 bench/load_test.py --photond $(BUILD)/server/photond --clients 200 \
 		--seconds $(LOAD_SECONDS) --latency-goal-ms 50 --json bench/results/load_test.json
+
+# The web page (README.md, "The web page") in headless chromium with a 4096 x 4096 job of 16,384
+# tiles: every tile drawn, the canvas equal to preview.png, the browser's memory measured against
+# 500 MB (WebPage.DISABLED_LargeJobInChromium in tests/server/web_page_test.cpp; ctest runs the
+# short WebPage.InChromium). WEB_LARGE_SIZE=2048 for a smaller one.
+WEB_LARGE_SIZE ?= 4096
+.PHONY: test-web-large web-screenshots
+test-web-large: build
+	PHOTOND_WEB_LARGE_SIZE=$(WEB_LARGE_SIZE) $(BUILD)/tests/web_page_test \
+		--gtest_also_run_disabled_tests --gtest_filter=WebPage.DISABLED_LargeJobInChromium
+
+# docs/images/web-queue.png and docs/images/web-job.png, taken by WebPage.InChromium.
+web-screenshots: build
+	PHOTOND_WEB_SCREENSHOTS=$(CURDIR)/docs/images $(BUILD)/tests/web_page_test --gtest_filter=WebPage.InChromium
 
 # deploy/slurm/ on a real single-node Slurm cluster started by the test (Debian's slurmctld,
 # slurmd and munge; as root): 2 views x 4 regions, assembled frames byte-identical to photond

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <regex>
 
+#include "core/scene/builtin_scenes.h"
 #include "protocol/field_codec.h"
 
 namespace photond::protocol {
@@ -295,7 +296,8 @@ json vector3_schema(std::string description) {
 json scene_schema() {
     json builtin = {{"type", "string"},
                     {"pattern", "^[A-Za-z0-9_-]+$"},
-                    {"description", "a scene compiled into the binary, e.g. \"cornell-box\""}};
+                    {"description", "a scene compiled into the binary, e.g. \"cornell-box\""},
+                    {"examples", builtin_scene_names()}};  // every one of them (the web page's list)
     // The same rule as is_contained_relative_path: not absolute, no ".." component, no control
     // characters (ECMA-262 syntax).
     json path = {{"type", "string"},

@@ -28,6 +28,7 @@
 #include "server/routes.h"
 #include "server/scene_store.h"
 #include "server/service_error.h"
+#include "server/web_handlers.h"
 
 namespace photond::service {
 namespace {
@@ -313,7 +314,15 @@ void HttpServer::Impl::register_routes() {
     };
     std::set<std::string> unused;
     for (const auto& [id, member] : handlers) unused.insert(id);
+    for (const auto& [id, handler] : web_handlers()) unused.insert(id);
     for (const Route& r : api_routes()) {
+        // The web page's handlers (server/web_handlers.h) are kept in their own file.
+        if (const auto web = web_handlers().find(r.operation_id); web != web_handlers().end() && unused.erase(r.operation_id)) {
+            route(r.method, r.path_regex(),
+                  [this, handler = web->second](const Request& req, Response& res) { handler(services, req, res); },
+                  !r.authenticated);
+            continue;
+        }
         const auto it = handlers.find(r.operation_id);
         if (it == handlers.end() || !unused.erase(r.operation_id))
             throw std::logic_error(r.method + " " + r.path + ": no handler for operation '" +
@@ -464,6 +473,9 @@ void HttpServer::Impl::install() {
         int yes = 1;
         ::setsockopt(socket, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
     });
+    // Small answers go out at once: with Nagle's algorithm a body written after its headers
+    // waited for the client's delayed ACK (40 ms on Linux), and so did each SSE event.
+    server.set_tcp_nodelay(true);
     server.set_payload_max_length(options.max_body_bytes);
     server.set_keep_alive_timeout(2);
     server.set_read_timeout(30);

@@ -687,7 +687,7 @@ std::optional<JobManager::TileGeometry> JobManager::tile_geometry(const std::str
                         entry->submission.job.image.height};
 }
 
-std::optional<std::vector<uint8_t>> JobManager::tile_exr(const std::string& id, TileIndex tile) {
+std::optional<ImageLayers> JobManager::tile_layers(const std::string& id, TileIndex tile) {
     std::shared_ptr<Entry> entry;
     std::shared_ptr<const ImageLayers> pixels;
     bool done = false;
@@ -702,19 +702,24 @@ std::optional<std::vector<uint8_t>> JobManager::tile_exr(const std::string& id, 
             pixels = it->second;
         }
     }
-    const protocol::Job& job = entry->submission.job;
-    const PixelRect rect = *entry->rect_of(tile);
-    ImageLayers layers;
-    if (done) {
-        const auto image = final_image(entry);
-        if (!image) return std::nullopt;
-        layers = copy_rect(*image, rect);
-    } else {
-        layers = *pixels;
+    if (!done) return *pixels;
+    const auto image = final_image(entry);
+    if (!image) return std::nullopt;
+    return copy_rect(*image, *entry->rect_of(tile));
+}
+
+std::optional<std::vector<uint8_t>> JobManager::tile_exr(const std::string& id, TileIndex tile) {
+    auto layers = tile_layers(id, tile);
+    if (!layers) return std::nullopt;
+    std::shared_ptr<Entry> entry;
+    {
+        std::unique_lock lock(mutex_);
+        entry = find_locked(lock, id);
     }
+    const protocol::Job& job = entry->submission.job;
     const ExrPixelType type =
         job.output.pixel_type == "float" ? ExrPixelType::Float : ExrPixelType::Half;
-    auto bytes = encode_tile_exr(layers, rect, job.image.width, job.image.height, type);
+    auto bytes = encode_tile_exr(*layers, *entry->rect_of(tile), job.image.width, job.image.height, type);
     if (!bytes) throw ServiceError(ErrorKind::Internal, bytes.error().message);
     return std::move(bytes).value();
 }
@@ -810,46 +815,65 @@ fs::path JobManager::image_file(const std::string& id) {
     }
 }
 
-std::vector<uint8_t> JobManager::preview_png(const std::string& id) {
+std::shared_ptr<const Image> JobManager::preview_frame(const std::string& id) {
     std::shared_ptr<Entry> entry;
     std::vector<std::pair<TileIndex, std::shared_ptr<const ImageLayers>>> tiles;
+    JobState state;
     {
         std::unique_lock lock(mutex_);
         entry = find_locked(lock, id);
-        const JobState state = entry->status.state;
+        state = entry->status.state;
         if (state == JobState::Queued || state == JobState::Failed || state == JobState::Cancelled)
             throw ServiceError(ErrorKind::Conflict, "job " + id + " is " +
                                                         std::string(protocol::to_string(state)) +
                                                         ": it has no pixels to preview");
         if (state == JobState::Running) tiles.assign(entry->tiles.begin(), entry->tiles.end());
     }
-    if (tiles.empty() && entry->status.state != JobState::Running) {
+    if (state != JobState::Running) {
+        if (!verify_image(entry)) {
+            std::lock_guard lock(mutex_);
+            throw ServiceError(ErrorKind::Conflict, "job " + id + " failed: " + entry->status.error);
+        }
+        const auto image = final_image(entry);
+        if (!image)
+            throw ServiceError(ErrorKind::Internal, "job " + id + ": the image cannot be read");
+        return std::shared_ptr<const Image>(image, &image->beauty);
+    }
+    // While rendering: the finished tiles on black.
+    const protocol::Job& job = entry->submission.job;
+    auto frame = std::make_shared<Image>(job.image.width, job.image.height);
+    for (const auto& [index, pixels] : tiles) {
+        const PixelRect rect = *entry->rect_of(index);
+        frame->paste(pixels->beauty, rect.x0, rect.y0);
+    }
+    return frame;
+}
+
+std::vector<uint8_t> JobManager::preview_png(const std::string& id) {
+    std::shared_ptr<Entry> entry;
+    bool done = false;
+    {
+        std::unique_lock lock(mutex_);
+        entry = find_locked(lock, id);
+        done = entry->status.state == JobState::Done;
+    }
+    if (done) {
         if (!verify_image(entry)) {
             std::lock_guard lock(mutex_);
             throw ServiceError(ErrorKind::Conflict, "job " + id + " failed: " + entry->status.error);
         }
         if (auto bytes = read_file_bytes(store_.preview_path(id))) return std::move(*bytes);
-        const auto image = final_image(entry);
-        if (!image)
-            throw ServiceError(ErrorKind::Internal, "job " + id + ": the image cannot be read");
-        auto png = encode_job_preview(entry->submission.job, image->beauty);
-        if (!png) throw ServiceError(ErrorKind::Internal, png.error().message);
-        // Made on the first request rather than with every job; kept for the next one.
+    }
+    const std::shared_ptr<const Image> frame = preview_frame(id);
+    auto png = encode_job_preview(entry->submission.job, *frame);
+    if (!png) throw ServiceError(ErrorKind::Internal, png.error().message);
+    // A done job's preview is made on the first request rather than with every job; kept for the
+    // next one.
+    if (done)
         if (Status kept = write_file_atomically(store_.preview_path(id),
                                                 {reinterpret_cast<const char*>(png->data()), png->size()});
             !kept)
             log("job " + id + ": the preview is not kept (made again on the next request): " + kept.error().message);
-        return std::move(png).value();
-    }
-    // While rendering: the finished tiles on black.
-    const protocol::Job& job = entry->submission.job;
-    Image frame(job.image.width, job.image.height);
-    for (const auto& [index, pixels] : tiles) {
-        const PixelRect rect = *entry->rect_of(index);
-        frame.paste(pixels->beauty, rect.x0, rect.y0);
-    }
-    auto png = encode_job_preview(job, frame);
-    if (!png) throw ServiceError(ErrorKind::Internal, png.error().message);
     return std::move(png).value();
 }
 

@@ -149,8 +149,10 @@ public:
     /// The rectangle of tile (tx, ty); nullopt outside the job's grid.
     std::optional<TileGeometry> tile_geometry(const std::string& id,
                                               protocol::TileIndex tile) const;
-    /// One finished tile as a small EXR (encode_tile_exr); nullopt while it is not finished (or
-    /// its pixels were freed: cancelled or failed job).
+    /// The pixels of one finished tile (every layer); nullopt while it is not finished (or its
+    /// pixels were freed: cancelled or failed job).
+    std::optional<ImageLayers> tile_layers(const std::string& id, protocol::TileIndex tile);
+    /// One finished tile as a small EXR (encode_tile_exr) of tile_layers.
     std::optional<std::vector<uint8_t>> tile_exr(const std::string& id, protocol::TileIndex tile);
 
     /// The final image's file; Conflict while the job is not done.
@@ -158,6 +160,9 @@ public:
     /// A PNG preview: of the finished image, or of the tiles finished so far while rendering;
     /// Conflict for a queued, failed or cancelled job.
     std::vector<uint8_t> preview_png(const std::string& id);
+    /// The linear image preview_png encodes (the final beauty, or the tiles finished so far on
+    /// black); throws as preview_png.
+    std::shared_ptr<const Image> preview_frame(const std::string& id);
 
     /// Job counts by state and the queue depth, for /metrics.
     void fill_metrics(MetricsSnapshot& snapshot) const;

@@ -70,6 +70,8 @@ json binary_body(std::initializer_list<std::string> types) {
 
 const PathParameter kJobId{"id", "[A-Za-z0-9_-]{1,128}", "the job's id"};
 const PathParameter kSceneId{"id", "[^/]+", "sha256:<64 hex digits>"};
+const PathParameter kTileColumn{"tx", "[0-9]{1,9}", "tile column"};
+const PathParameter kTileRow{"ty", "[0-9]{1,9}", "tile row"};
 
 /// The routes of a cache of artifacts (photon maps, render caches): list, export, import.
 void add_artifact_routes(std::vector<Route>& routes, const std::string& base,
@@ -222,11 +224,26 @@ std::vector<Route> build_routes() {
          .summary =
              "One finished tile as a small EXR (data window = the tile, display window = the "
              "frame); tiles count from the rendered area's top-left corner",
-         .path_parameters = {kJobId,
-                             {"tx", "[0-9]{1,9}", "tile column"},
-                             {"ty", "[0-9]{1,9}", "tile row"}},
+         .path_parameters = {kJobId, kTileColumn, kTileRow},
          .responses = {
              {"200", binary_response("the tile", "image/x-exr")},
+             {"404", problem("unknown job, tile outside the grid, or not finished yet")}}});
+    routes.push_back(
+        {.method = "GET",
+         .path = "/v1/jobs/{id}/tiles/{tx}/{ty}.png",
+         .operation_id = "jobTilePng",
+         .summary =
+             "One finished tile as an 8-bit sRGB PNG made as preview.png is (exposure, filmic tone "
+             "curve, sRGB; server/tile_png.h). Exposure: exposure_ev if given, else the job's "
+             "output.exposure_ev, else the preview's automatic exposure at this moment; "
+             "X-Exposure-EV says which was used, X-Tile-Rect where the tile lies (x0,y0,x1,y1)",
+         .path_parameters = {kJobId, kTileColumn, kTileRow},
+         .query_and_header_parameters = json::array({query_parameter(
+             "exposure_ev", "exposure in stops, e.g. the X-Exposure-EV of an earlier tile",
+             {{"type", "number"}, {"minimum", -64}, {"maximum", 64}})}),
+         .responses = {
+             {"200", binary_response("the tile", "image/png")},
+             {"400", problem("exposure_ev is not a number of stops in [-64, 64]")},
              {"404", problem("unknown job, tile outside the grid, or not finished yet")}}});
     routes.push_back(
         {.method = "GET",
@@ -240,6 +257,16 @@ std::vector<Route> build_routes() {
                        {"404", problem("unknown job")},
                        {"409", problem("not done (without wait), failed or cancelled")},
                        {"503", problem("shutting down while waiting")}}});
+    routes.push_back(
+        {.method = "GET",
+         .path = "/v1/jobs/{id}/layers/{layer}.exr",
+         .operation_id = "jobLayer",
+         .summary = "One AOV layer the job asked for (output.aovs) as an EXR of its own, its values "
+                    "in R, G and B (image.exr holds it too, as <layer>.R, .G, .B)",
+         .path_parameters = {kJobId, {"layer", "[a-z_]{1,32}", "the layer's name, e.g. albedo"}},
+         .responses = {{"200", binary_response("the layer", "image/x-exr")},
+                       {"404", problem("unknown job, or a layer the job did not ask for")},
+                       {"409", problem("not done, failed or cancelled")}}});
     routes.push_back({.method = "GET",
                       .path = "/v1/jobs/{id}/preview.png",
                       .operation_id = "jobPreview",
@@ -326,6 +353,24 @@ std::vector<Route> build_routes() {
          .summary = "This document",
          .responses = {
              {"200", response("OpenAPI 3.1", content("application/json", {{"type", "object"}}))}}});
+    // The web page (server/web_handlers.h): public files without data; the data it shows comes
+    // through the routes above, with the token.
+    const json text = {{"schema", {{"type", "string"}}}};
+    routes.push_back({.method = "GET",
+                      .path = "/",
+                      .operation_id = "webPage",
+                      .summary = "The web page: jobs, submission, a job's image assembling live "
+                                 "(asks for the token when the daemon has one)",
+                      .authenticated = false,
+                      .responses = {{"200", response("the page", {{"text/html", text}})}}});
+    routes.push_back({.method = "GET",
+                      .path = "/web/{file}",
+                      .operation_id = "webAsset",
+                      .summary = "The web page's scripts (ES modules) and style sheet",
+                      .authenticated = false,
+                      .path_parameters = {{"file", "[A-Za-z0-9_.-]{1,64}", "e.g. app.js, app.css"}},
+                      .responses = {{"200", response("the file", {{"text/javascript", text}, {"text/css", text}})},
+                                    {"404", problem("no such file")}}});
     return routes;
 }
 

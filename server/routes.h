@@ -36,7 +36,7 @@ struct Route {
 };
 
 /// Every route of the daemon, in the order a reader meets them: jobs, batches, scenes, photon
-/// maps, render caches, operations.
+/// maps, render caches, operations, the web page.
 const std::vector<Route>& api_routes();
 
 }  // namespace photond::service

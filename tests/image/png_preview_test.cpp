@@ -1,7 +1,6 @@
 #include "core/image/png_preview.h"
 
 #include <gtest/gtest.h>
-#include <png.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -11,35 +10,15 @@
 #include <string>
 #include <vector>
 
+#include "tests/support/decoded_png.h"
+
 namespace photond {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct DecodedPng {
-    int width = 0;
-    int height = 0;
-    std::vector<uint8_t> rgb;
-    uint8_t at(int x, int y, int c) const { return rgb[size_t((y * width + x) * 3 + c)]; }
-};
-
-/// Decodes with libpng's simplified API (independent of the writer's code path).
-DecodedPng decode_png(const std::vector<uint8_t>& bytes) {
-    png_image image{};
-    image.version = PNG_IMAGE_VERSION;
-    DecodedPng decoded;
-    if (!png_image_begin_read_from_memory(&image, bytes.data(), bytes.size())) return decoded;
-    image.format = PNG_FORMAT_RGB;
-    std::vector<uint8_t> rgb(PNG_IMAGE_SIZE(image));
-    if (!png_image_finish_read(&image, nullptr, rgb.data(), 0, nullptr)) {
-        png_image_free(&image);
-        return decoded;
-    }
-    decoded.width = int(image.width);
-    decoded.height = int(image.height);
-    decoded.rgb = std::move(rgb);
-    return decoded;
-}
+using test_support::DecodedPng;
+using test_support::decode_png;
 
 std::vector<uint8_t> read_bytes(const fs::path& path) {
     std::ifstream in(path, std::ios::binary);
