@@ -129,7 +129,7 @@ inline std::optional<Hit> trace_ray(const RenderScene& rs, const Ray& ray, RayCo
 
 /// The ray of a camera sample: from the camera itself, which RayTracer::intersect puts on the front
 /// side of a surface it lies on (so a camera on a floor sees the room, and the floor below it).
-inline Ray primary_ray(const RenderScene&, const CameraRay& ray) {
+inline Ray primary_ray(const CameraRay& ray) {
     return RayTracer::viewpoint_ray(ray.origin, ray.direction);
 }
 

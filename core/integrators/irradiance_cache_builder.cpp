@@ -139,7 +139,7 @@ std::unique_ptr<IrradianceCache> build_irradiance_cache(const RenderScene& rs, c
                 Candidate& c = candidates[i];
                 const CameraRay ray = camera.generate_ray(c.x + kCandidateX, c.y + kCandidateY);
                 std::vector<DiffusePoint> points;
-                collect_diffuse_points(rs, primary_ray(rs, ray), 0.0f, camera_footprint(ray), 0,
+                collect_diffuse_points(rs, primary_ray(ray), 0.0f, camera_footprint(ray), 0,
                                        settings.max_specular_depth, c.counters, points);
                 c.points = points.size();
                 for (size_t k = 0; k < points.size(); ++k) {
