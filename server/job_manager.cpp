@@ -14,7 +14,7 @@
 #include "core/util/sha256.h"
 #include "protocol/json_text.h"
 #include "protocol/statistics.h"
-#include "server/atomic_file.h"
+#include "core/util/file_io.h"
 #include "server/render_pipeline.h"
 #include "server/service_error.h"
 

@@ -2,6 +2,7 @@
 
 #include "core/scene/gltf_compression.h"
 #include "core/math/frame.h"
+#include "core/util/file_io.h"
 #include "core/util/json_depth.h"
 
 #include <tiny_gltf.h>
@@ -154,28 +155,16 @@ bool sandbox_file_exists(const std::string& path, void* user) {
 
 std::string sandbox_expand_path(const std::string& path, void*) { return path; }
 
+/// The file's bytes into *out, or false with the reason in *err (the path is tinygltf's to add).
 bool read_whole_file(const fs::path& path, std::vector<unsigned char>* out, std::string* err) {
-    std::error_code ec;
-    const uintmax_t size = fs::file_size(path, ec);
-    if (ec) {
-        if (err) *err = ec.message();
+    Expected<std::vector<uint8_t>> bytes = read_file_bytes(path, kMaxFileBytes);
+    if (!bytes) {
+        const std::string& message = bytes.error().message;
+        const std::string prefix = path.string() + ": ";
+        if (err) *err = message.compare(0, prefix.size(), prefix) == 0 ? message.substr(prefix.size()) : message;
         return false;
     }
-    if (size > kMaxFileBytes) {
-        if (err) *err = "file larger than " + std::to_string(kMaxFileBytes) + " bytes";
-        return false;
-    }
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-        if (err) *err = "cannot open";
-        return false;
-    }
-    out->resize(static_cast<size_t>(size));
-    if (size > 0 &&
-        !in.read(reinterpret_cast<char*>(out->data()), static_cast<std::streamsize>(size))) {
-        if (err) *err = "read failed";
-        return false;
-    }
+    *out = std::move(bytes).value();
     return true;
 }
 
