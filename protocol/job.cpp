@@ -9,6 +9,7 @@
 #include <span>
 
 #include "core/util/json_depth.h"
+#include "core/util/path_containment.h"
 #include "protocol/json_text.h"
 #include "protocol/presets.h"
 
@@ -211,23 +212,9 @@ bool is_builtin_name(std::string_view name) {
     });
 }
 
-/// Relative, inside the scene root: not absolute (POSIX or Windows), no ".." component, no
-/// control characters. Backslashes count as separators so that "..\\x" is refused too.
-bool is_contained_relative_path(std::string_view path) {
-    if (path.empty() || path.front() == '/' || path.front() == '\\') return false;
-    if (path.size() >= 2 && std::isalpha(static_cast<unsigned char>(path[0])) && path[1] == ':') {
-        return false;  // "C:..." is absolute on Windows
-    }
-    size_t start = 0;
-    while (start <= path.size()) {
-        size_t end = path.find_first_of("/\\", start);
-        if (end == std::string_view::npos) end = path.size();
-        if (path.substr(start, end - start) == "..") return false;
-        start = end + 1;
-    }
-    return std::none_of(path.begin(), path.end(),
-                        [](char c) { return static_cast<unsigned char>(c) < 0x20; });
-}
+/// Relative, inside the scene root: the one rule for a path's text, relative_path_problem
+/// (core/util/path_containment.h).
+bool is_contained_relative_path(std::string_view path) { return !relative_path_problem(path); }
 
 bool is_scene_id(std::string_view id) {
     if (!id.starts_with(limits::kSceneIdPrefix)) return false;
@@ -714,7 +701,7 @@ json scene_schema() {
     // The same rule as is_contained_relative_path: not absolute, no ".." component, no control
     // characters (ECMA-262 syntax).
     json path = {{"type", "string"},
-                 {"pattern", R"(^(?![/\\])(?![A-Za-z]:)(?!(.*[/\\])?\.\.([/\\]|$))[^\x00-\x1f]+$)"},
+                 {"pattern", R"(^(?![/\\])(?![A-Za-z]:)(?!(.*[/\\])?\.\.([/\\]|$))[^\x00-\x1f\x7f]+$)"},
                  {"description",
                   "a .gltf or .glb file relative to the server's --scene-root, "
                   "without '..'"}};

@@ -15,6 +15,7 @@
 #include "protocol/json_text.h"
 #include "protocol/statistics.h"
 #include "core/util/file_io.h"
+#include "core/util/path_containment.h"
 #include "server/render_pipeline.h"
 #include "server/service_error.h"
 
@@ -350,18 +351,15 @@ void JobManager::check_scene(const protocol::Job& job) const {
             break;
         }
         case protocol::SceneRef::Kind::Path: {
-            std::error_code error;
-            const fs::path root = fs::weakly_canonical(options_.scene_root, error);
-            const fs::path file = fs::weakly_canonical(root / scene.value, error);
-            const auto [root_end, file_it] =
-                std::mismatch(root.begin(), root.end(), file.begin(), file.end());
-            if (error || root_end != root.end() || file == root)
+            const std::optional<fs::path> file = resolve_below(options_.scene_root, scene.value);
+            if (!file)
                 throw ServiceError(
                     ErrorKind::InvalidField,
                     "'" + scene.value + "' lies outside the scene root (--scene-root " +
                         options_.scene_root.string() + "); give a path relative to it",
                     "scene.path");
-            if (!fs::is_regular_file(file, error))
+            std::error_code error;
+            if (!fs::is_regular_file(*file, error))
                 throw ServiceError(ErrorKind::InvalidField,
                                    "no scene file '" + scene.value + "' below the scene root (" +
                                        options_.scene_root.string() + ")",

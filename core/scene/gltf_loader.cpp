@@ -4,6 +4,7 @@
 #include "core/math/frame.h"
 #include "core/util/file_io.h"
 #include "core/util/json_depth.h"
+#include "core/util/path_containment.h"
 
 #include <tiny_gltf.h>
 
@@ -70,16 +71,6 @@ struct FileSandbox {
     std::vector<std::string> refused;  // "uri (reason)" for every refusal, in order
 };
 
-bool path_is_inside(const fs::path& root, const fs::path& path) {
-    auto root_it = root.begin();
-    auto path_it = path.begin();
-    for (; root_it != root.end(); ++root_it, ++path_it) {
-        if (root_it->empty()) continue;  // trailing separator
-        if (path_it == path.end() || *root_it != *path_it) return false;
-    }
-    return true;
-}
-
 fs::path canonical_directory(const fs::path& dir) {
     std::error_code ec;
     fs::path canonical = fs::weakly_canonical(fs::absolute(dir, ec), ec);
@@ -134,14 +125,9 @@ std::optional<fs::path> resolve_in_sandbox(FileSandbox& box, const std::string& 
                        "root are allowed");
         return std::nullopt;
     }
-    std::error_code ec;
-    // weakly_canonical resolves "..", "." and symbolic links of every existing component.
-    const fs::path canonical = fs::weakly_canonical(fs::path(path), ec);
-    if (ec) return std::nullopt;
-    if (!path_is_inside(box.root, canonical)) {
-        record_refusal(box, *uri, "escapes the bundle root '" + box.root.string() + "'");
-        return std::nullopt;
-    }
+    // "..", "." and symbolic links resolved, strictly below the root (core/util/path_containment.h).
+    const std::optional<fs::path> canonical = resolve_below(box.root, path);
+    if (!canonical) record_refusal(box, *uri, "escapes the bundle root '" + box.root.string() + "'");
     return canonical;
 }
 
@@ -1779,7 +1765,7 @@ Expected<Scene> load_gltf_file(const std::filesystem::path& file, const GltfLoad
     if (sandbox.root.empty() || !fs::is_directory(sandbox.root, ec))
         return Error{display_name + ": bundle root '" + options.bundle_root.string() +
                      "' is not a directory"};
-    if (!path_is_inside(sandbox.root, canonical_file))
+    if (!resolve_below(sandbox.root, canonical_file))
         return Error{display_name + ": the file lies outside the bundle root '" +
                      sandbox.root.string() + "'"};
     sandbox.base_dir = canonical_file.parent_path().string();
