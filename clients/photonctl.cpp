@@ -321,15 +321,13 @@ ExrWriteOptions exr_options_for(const json& status, int fallback_tile_size) {
             image["tile_size"].is_number_integer())
             options.tile_size = image["tile_size"].get<int>();
         const json output = job.value("output", json::object());
-        if (output.is_object() && output.value("pixel_type", std::string()) == "float")
-            options.pixel_type = ExrPixelType::Float;
+        if (output.is_object()) options.pixel_type = protocol::exr_pixel_type(output.value("pixel_type", std::string()));
         // A region render's file holds the region (its data window), as the daemon writes it.
         const json region = image.is_object() ? image.value("region", json()) : json();
         if (region.is_array() && region.size() == 4 && image.value("width", 0) > 0 && image.value("height", 0) > 0 &&
             std::all_of(region.begin(), region.end(), [](const json& v) { return v.is_number_integer(); })) {
-            const PixelRect frame{0, 0, image["width"].get<int>(), image["height"].get<int>()};
-            const PixelRect rect = PixelRect{region[0].get<int>(), region[1].get<int>(), region[2].get<int>(),
-                                             region[3].get<int>()}.intersect(frame);
+            const PixelRect rect = protocol::region_rect(region.get<std::array<int, 4>>(), image["width"].get<int>(),
+                                                         image["height"].get<int>());
             if (!rect.empty()) options.data_window = rect;
         }
     }

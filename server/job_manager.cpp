@@ -52,14 +52,6 @@ std::string make_job_id(uint64_t sequence, int64_t created_ms) {
     return buffer;
 }
 
-/// The rendered area (the region, clipped to the frame, or the whole frame).
-PixelRect rendered_area(const protocol::Job& job) {
-    const PixelRect frame{0, 0, job.image.width, job.image.height};
-    if (!job.image.region) return frame;
-    const auto& r = *job.image.region;
-    return PixelRect{r[0], r[1], r[2], r[3]}.intersect(frame);
-}
-
 json rect_json(const PixelRect& r) { return json::array({r.x0, r.y0, r.x1, r.y1}); }
 
 /// A job is not run again once the daemon died this many times while running it: it would
@@ -103,7 +95,7 @@ struct JobManager::Entry {
     mutable std::condition_variable changed;
 
     explicit Entry(JobSubmission s) : submission(std::move(s)) {
-        area = rendered_area(submission.job);
+        area = protocol::rendered_area(submission.job);
         tile_size = std::max(submission.job.image.tile_size, 1);
         tiles_x = (area.width() + tile_size - 1) / tile_size;
         tiles_y = (area.height() + tile_size - 1) / tile_size;
@@ -710,8 +702,7 @@ std::optional<std::vector<uint8_t>> JobManager::tile_exr(const std::string& id, 
     } else {
         layers = *pixels;
     }
-    const ExrPixelType type =
-        job.output.pixel_type == "float" ? ExrPixelType::Float : ExrPixelType::Half;
+    const ExrPixelType type = protocol::exr_pixel_type(job.output.pixel_type);
     auto bytes = encode_tile_exr(layers, rect, job.image.width, job.image.height, type);
     if (!bytes) throw ServiceError(ErrorKind::Internal, bytes.error().message);
     return std::move(bytes).value();

@@ -528,10 +528,7 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
         if (!aov) return Error{"output.aovs: unknown AOV '" + name + "'"};  // parse_job lets none through
         tiles.aovs.push_back(*aov);
     }
-    if (job.image.region) {
-        const auto& r = *job.image.region;
-        tiles.region = PixelRect{r[0], r[1], r[2], r[3]};
-    }
+    if (job.image.region) tiles.region = protocol::rendered_area(job);
     pass_start = Clock::now();
     if (options.on_pass) options.on_pass("render");
     TileRenderResult rendered = render_tiles(**integrator, *camera, tiles, options.callbacks);
@@ -552,12 +549,9 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
 
 ExrWriteOptions exr_options(const protocol::Job& job) {
     ExrWriteOptions exr;
-    exr.pixel_type = job.output.pixel_type == "float" ? ExrPixelType::Float : ExrPixelType::Half;
+    exr.pixel_type = protocol::exr_pixel_type(job.output.pixel_type);
     exr.tile_size = job.image.tile_size;
-    if (job.image.region) {
-        const auto& r = *job.image.region;
-        exr.data_window = PixelRect{r[0], r[1], r[2], r[3]}.intersect({0, 0, job.image.width, job.image.height});
-    }
+    if (job.image.region) exr.data_window = protocol::rendered_area(job);
     return exr;
 }
 
