@@ -15,10 +15,6 @@
 namespace photond {
 namespace {
 
-std::string system_message(int error_number) {
-    return std::error_code(error_number, std::generic_category()).message();
-}
-
 Status read_all(const std::filesystem::path& path, std::span<const uint8_t> magic,
                 std::vector<uint8_t>& bytes) {
     const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);

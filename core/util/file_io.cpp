@@ -13,10 +13,6 @@
 namespace photond {
 namespace {
 
-std::string system_message(int error_number) {
-    return std::error_code(error_number, std::generic_category()).message();
-}
-
 /// Closes the descriptor when it goes out of scope.
 struct FileDescriptor {
     int fd;
@@ -79,6 +75,10 @@ Status read_whole(const std::filesystem::path& path, uint64_t max_bytes, std::ve
 }
 
 }  // namespace
+
+std::string system_message(int error_number) {
+    return std::error_code(error_number, std::generic_category()).message();
+}
 
 std::filesystem::path unique_temporary_path(const std::filesystem::path& path) {
     // The pid, a random number and a counter.

@@ -26,6 +26,9 @@ std::filesystem::path unique_temporary_path(const std::filesystem::path& path);
 Status write_file_atomically(const std::filesystem::path& path, std::span<const uint8_t> bytes);
 Status write_file_atomically(const std::filesystem::path& path, std::string_view bytes);
 
+/// The text of an errno value ("No such file or directory").
+std::string system_message(int error_number);
+
 constexpr uint64_t kNoFileSizeLimit = std::numeric_limits<uint64_t>::max();
 
 /// The whole file (a regular file, or anything else but a directory that can be read to its
