@@ -28,7 +28,9 @@
 #include "clients/api_client.h"
 #include "clients/job_view.h"
 #include "clients/tile_assembler.h"
+#include "core/util/file_io.h"
 #include "protocol/job.h"
+#include "protocol/token_file.h"
 
 namespace photond::client {
 namespace {
@@ -167,48 +169,13 @@ const std::map<std::string, std::set<std::string>>& command_options() {
     return kOptions;
 }
 
+/// The file's text; "-" is standard input.
 Expected<std::string> read_file(const std::string& path) {
     if (path == "-") {
         return std::string(std::istreambuf_iterator<char>(std::cin),
                            std::istreambuf_iterator<char>());
     }
-    std::error_code error;
-    if (fs::is_directory(path, error)) return Error{path + ": is a directory"};
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return Error{path + ": cannot open: " + std::strerror(errno)};
-    std::ostringstream contents;
-    contents << in.rdbuf();
-    if (in.bad()) return Error{path + ": cannot read"};
-    return contents.str();
-}
-
-/// Writes next to `path` and renames, so a reader never sees half a file.
-Status write_file_atomically(const fs::path& path, const std::string& bytes) {
-    const fs::path temporary = path.string() + ".part";
-    {
-        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-        if (!out) return Error{path.string() + ": cannot write: " + std::strerror(errno)};
-        out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-        if (!out.flush()) return Error{path.string() + ": cannot write: " + std::strerror(errno)};
-    }
-    std::error_code error;
-    fs::rename(temporary, path, error);
-    if (error) {
-        fs::remove(temporary, error);
-        return Error{path.string() + ": cannot write: " + error.message()};
-    }
-    return Status::ok();
-}
-
-Expected<std::string> read_token(const std::string& token_file) {
-    Expected<std::string> contents = read_file(token_file);
-    if (!contents) return Error{"token file " + contents.error().message};
-    std::string token = *contents;
-    const auto not_space = [](unsigned char c) { return !std::isspace(c); };
-    token.erase(token.begin(), std::find_if(token.begin(), token.end(), not_space));
-    token.erase(std::find_if(token.rbegin(), token.rend(), not_space).base(), token.end());
-    if (token.empty()) return Error{"token file " + token_file + " is empty"};
-    return token;
+    return read_file_text(path);
 }
 
 /// The progress of one job on stderr: a redrawn bar on a terminal, else one line per state.
@@ -354,15 +321,13 @@ ExrWriteOptions exr_options_for(const json& status, int fallback_tile_size) {
             image["tile_size"].is_number_integer())
             options.tile_size = image["tile_size"].get<int>();
         const json output = job.value("output", json::object());
-        if (output.is_object() && output.value("pixel_type", std::string()) == "float")
-            options.pixel_type = ExrPixelType::Float;
+        if (output.is_object()) options.pixel_type = protocol::exr_pixel_type(output.value("pixel_type", std::string()));
         // A region render's file holds the region (its data window), as the daemon writes it.
         const json region = image.is_object() ? image.value("region", json()) : json();
         if (region.is_array() && region.size() == 4 && image.value("width", 0) > 0 && image.value("height", 0) > 0 &&
             std::all_of(region.begin(), region.end(), [](const json& v) { return v.is_number_integer(); })) {
-            const PixelRect frame{0, 0, image["width"].get<int>(), image["height"].get<int>()};
-            const PixelRect rect = PixelRect{region[0].get<int>(), region[1].get<int>(), region[2].get<int>(),
-                                             region[3].get<int>()}.intersect(frame);
+            const PixelRect rect = protocol::region_rect(region.get<std::array<int, 4>>(), image["width"].get<int>(),
+                                                         image["height"].get<int>());
             if (!rect.empty()) options.data_window = rect;
         }
     }
@@ -595,8 +560,8 @@ int run(int argc, char** argv) {
     }
     std::string token;
     if (!token_file.empty()) {
-        Expected<std::string> read = read_token(token_file);
-        if (!read) return print_error(read.error().message);
+        Expected<std::string> read = protocol::read_token_file(token_file);
+        if (!read) return print_error("token file " + read.error().message);
         token = *read;
     }
 

@@ -281,4 +281,17 @@ nlohmann::json job_json_schema() {
     return schema;
 }
 
+PixelRect region_rect(const std::array<int, 4>& region, int width, int height) {
+    return PixelRect{region[0], region[1], region[2], region[3]}.intersect({0, 0, width, height});
+}
+
+PixelRect rendered_area(const Job& job) {
+    if (!job.image.region) return PixelRect{0, 0, job.image.width, job.image.height};
+    return region_rect(*job.image.region, job.image.width, job.image.height);
+}
+
+ExrPixelType exr_pixel_type(std::string_view pixel_type) {
+    return pixel_type == "float" ? ExrPixelType::Float : ExrPixelType::Half;
+}
+
 }  // namespace photond::protocol

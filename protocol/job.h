@@ -18,6 +18,7 @@
 #include <variant>
 #include <vector>
 
+#include "core/image/exr_io.h"
 #include "core/render/aov.h"
 #include "core/util/expected.h"
 
@@ -225,6 +226,13 @@ struct Job {
 
     bool operator==(const Job&) const = default;
 };
+
+/// image.region [x0, y0, x1, y1] as a rectangle clipped to a width x height frame.
+PixelRect region_rect(const std::array<int, 4>& region, int width, int height);
+/// What a job renders: its image.region clipped to the frame, or the whole frame.
+PixelRect rendered_area(const Job& job);
+/// output.pixel_type as the EXR writer's type: "float" is Float, anything else Half.
+ExrPixelType exr_pixel_type(std::string_view pixel_type);
 
 /// A validation failure: the field's path ("irradiance_cache.a", "image.region[2]", "scene";
 /// empty for the document itself) and what is wrong with it.

@@ -6,6 +6,7 @@
 #include <regex>
 
 #include "core/scene/builtin_scenes.h"
+#include "core/util/path_containment.h"
 #include "protocol/field_codec.h"
 
 namespace photond::protocol {
@@ -36,23 +37,9 @@ bool is_builtin_name(std::string_view name) {
     });
 }
 
-/// Relative, inside the scene root: not absolute (POSIX or Windows), no ".." component, no
-/// control characters. Backslashes count as separators so that "..\\x" is refused too.
-bool is_contained_relative_path(std::string_view path) {
-    if (path.empty() || path.front() == '/' || path.front() == '\\') return false;
-    if (path.size() >= 2 && std::isalpha(static_cast<unsigned char>(path[0])) && path[1] == ':') {
-        return false;  // "C:..." is absolute on Windows
-    }
-    size_t start = 0;
-    while (start <= path.size()) {
-        size_t end = path.find_first_of("/\\", start);
-        if (end == std::string_view::npos) end = path.size();
-        if (path.substr(start, end - start) == "..") return false;
-        start = end + 1;
-    }
-    return std::none_of(path.begin(), path.end(),
-                        [](char c) { return static_cast<unsigned char>(c) < 0x20; });
-}
+/// Relative, inside the scene root: the one rule for a path's text, relative_path_problem
+/// (core/util/path_containment.h).
+bool is_contained_relative_path(std::string_view path) { return !relative_path_problem(path); }
 
 bool is_scene_id(std::string_view id) {
     if (!id.starts_with(limits::kSceneIdPrefix)) return false;
@@ -301,7 +288,7 @@ json scene_schema() {
     // The same rule as is_contained_relative_path: not absolute, no ".." component, no control
     // characters (ECMA-262 syntax).
     json path = {{"type", "string"},
-                 {"pattern", R"(^(?![/\\])(?![A-Za-z]:)(?!(.*[/\\])?\.\.([/\\]|$))[^\x00-\x1f]+$)"},
+                 {"pattern", R"(^(?![/\\])(?![A-Za-z]:)(?!(.*[/\\])?\.\.([/\\]|$))[^\x00-\x1f\x7f]+$)"},
                  {"description",
                   "a .gltf or .glb file relative to the server's --scene-root, "
                   "without '..'"}};
@@ -347,7 +334,7 @@ json color_schema(std::string description) {
 json environment_schema() {
     json intensity = number_schema(limits::kEnvironmentIntensity, "scales the radiance (default 1)");
     json image_path = {{"type", "string"},
-                       {"pattern", R"(^(?![/\\])(?![A-Za-z]:)(?!(.*[/\\])?\.\.([/\\]|$))[^\x00-\x1f]+\.([eE][xX][rR]|[hH][dD][rR])$)"},
+                       {"pattern", R"(^(?![/\\])(?![A-Za-z]:)(?!(.*[/\\])?\.\.([/\\]|$))[^\x00-\x1f\x7f]+\.([eE][xX][rR]|[hH][dD][rR])$)"},
                        {"description",
                         "an equirectangular image of linear radiance (.exr or .hdr) relative to the "
                         "scene root or the uploaded scene's bundle; +Y is up, u = 0.5 looks along +X"}};

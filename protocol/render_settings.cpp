@@ -36,12 +36,11 @@ RenderSettings to_render_settings(const Job& job) {
         tiles.aovs.push_back(*aov);
     }
 
-    settings.exr.pixel_type = job.output.pixel_type == "float" ? ExrPixelType::Float : ExrPixelType::Half;
+    settings.exr.pixel_type = exr_pixel_type(job.output.pixel_type);
     settings.exr.tile_size = job.image.tile_size;
     if (job.image.region) {
-        const auto& [x0, y0, x1, y1] = *job.image.region;
-        tiles.region = PixelRect{x0, y0, x1, y1};
-        settings.exr.data_window = tiles.region->intersect({0, 0, job.image.width, job.image.height});
+        tiles.region = rendered_area(job);
+        settings.exr.data_window = tiles.region;
     }
     if (job.output.exposure_ev) settings.preview_exposure_ev = static_cast<float>(*job.output.exposure_ev);
     return settings;

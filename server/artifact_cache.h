@@ -49,7 +49,7 @@
 #include <vector>
 
 #include "core/util/expected.h"
-#include "server/atomic_file.h"
+#include "core/util/file_io.h"
 #include "server/file_lock.h"
 
 namespace photond::service {
@@ -141,7 +141,7 @@ public:
     /// when the key is unknown here.
     std::optional<std::vector<uint8_t>> export_bytes(const std::string& key) {
         if (!Traits::is_valid_key(key)) return std::nullopt;
-        if (auto bytes = read_file_bytes(file_of(key)); bytes && Traits::read_key(*bytes) == key) return bytes;
+        if (auto bytes = read_file_bytes(file_of(key)); bytes && Traits::read_key(*bytes) == key) return std::move(*bytes);
         std::shared_ptr<const Value> found;
         {
             std::lock_guard lock(mutex_);

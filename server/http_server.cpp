@@ -19,6 +19,7 @@
 #include "protocol/job.h"
 #include "protocol/job_status.h"
 #include "protocol/json_text.h"
+#include "server/http_problems.h"
 #include "server/http_thread_pool.h"
 #include "server/job_manager.h"
 #include "server/metrics.h"
@@ -39,81 +40,12 @@ using nlohmann::json;
 using Handler = std::function<void(const Request&, Response&)>;
 
 constexpr const char* kJsonType = "application/json";
-constexpr const char* kProblemType = "application/problem+json";
 constexpr const char* kExrType = "image/x-exr";
 /// The most views one batch may carry.
 constexpr size_t kMaxBatchViews = 1000;
 // HTTP threads kept waiting for the next burst of connections; the others end after the timeout.
 constexpr size_t kKeptHttpThreads = 8;
 constexpr std::chrono::milliseconds kHttpThreadIdleTimeout{10000};
-
-// ---------------------------------------------------------------------------------------------
-// Errors: the one place where failures become HTTP responses.
-
-/// A request path as a URI reference (RFC 3986) for a problem's "instance": cpp-httplib hands
-/// over the percent-decoded path, which may hold spaces, quotes or bytes that are not UTF-8.
-std::string uri_reference(std::string_view path) {
-    // A colon stays only where it cannot read as a scheme (after a leading slash).
-    const std::string_view kept =
-        path.starts_with('/') ? "-._~!$&'()*+,;=:@/" : "-._~!$&'()*+,;=@/";
-    std::string reference;
-    for (const char c : path) {
-        const bool alphanumeric =
-            (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9');
-        if (alphanumeric || kept.find(c) != std::string_view::npos) {
-            reference += c;
-        } else {
-            char escaped[4];
-            std::snprintf(escaped, sizeof escaped, "%%%02X", static_cast<unsigned char>(c));
-            reference += escaped;
-        }
-    }
-    return reference;
-}
-
-void write_problem(Response& res, ErrorKind kind, const std::string& detail,
-                   const std::string& field, const std::string& path) {
-    protocol::Problem problem;
-    problem.type = error_type_uri(kind);
-    problem.title = error_title(kind);
-    problem.status = http_status(kind);
-    problem.detail = detail;
-    problem.field = field;
-    problem.instance = uri_reference(path);
-    res.status = problem.status;
-    res.set_content(protocol::json_text(protocol::to_json(problem), 2) + "\n", kProblemType);
-}
-
-void write_problem(Response& res, const ServiceError& error, const Request& req) {
-    write_problem(res, error.kind(), error.detail(), error.field(), req.path);
-    for (const auto& [name, value] : error.headers()) res.set_header(name, value);
-}
-
-/// Problems for the statuses cpp-httplib sets itself, before any handler ran.
-ErrorKind kind_of_status(int status) {
-    switch (status) {
-        case 400:
-            return ErrorKind::MalformedRequest;
-        case 401:
-            return ErrorKind::Unauthorized;
-        case 404:
-            return ErrorKind::NotFound;
-        case 405:
-            return ErrorKind::MethodNotAllowed;
-        case 409:
-            return ErrorKind::Conflict;
-        case 413:
-            return ErrorKind::PayloadTooLarge;
-        case 422:
-            return ErrorKind::InvalidField;
-        case 429:
-            return ErrorKind::QueueFull;
-        case 503:
-            return ErrorKind::Unavailable;
-        default:
-            return ErrorKind::Internal;
-    }
-}
 
 // ---------------------------------------------------------------------------------------------
 // Small decoding and encoding helpers
@@ -243,7 +175,14 @@ struct HttpServer::Impl {
     }
 
     void register_routes();
+    /// Routes, error handlers and connection settings handed to cpp-httplib.
     void install();
+    httplib::Server::HandlerWithContentReader with_body(Handler handler);
+    void add_route(const std::string& method, const std::string& pattern, Handler handler);
+    void install_routes();
+    void install_error_handlers();
+    httplib::Server::HandlerResponse answer_own_error(const Request& req, Response& res) const;
+    void configure_connections();
 
     // Handlers, in the order of the route table (server/routes.cpp).
     void submit_job(const Request& req, Response& res);
@@ -335,134 +274,136 @@ void HttpServer::Impl::register_routes() {
     if (!unused.empty()) throw std::logic_error("a handler without a route: " + *unused.begin());
 }
 
+void HttpServer::Impl::install() {
+    install_routes();
+    install_error_handlers();
+    configure_connections();
+}
+
+/// Bodies are read through a content reader, whatever their Content-Type: cpp-httplib parses an
+/// application/x-www-form-urlencoded body (what curl's --data-binary sends by default) as a form
+/// and refuses it beyond 8 KiB, which README's uploads of real files hit. The reader still
+/// enforces --max-body-mb.
+httplib::Server::HandlerWithContentReader HttpServer::Impl::with_body(Handler handler) {
+    return [this, handler = std::move(handler)](const Request& req, Response& res,
+                                                const httplib::ContentReader& content) {
+        Request read = req;
+        // Without Content-Length or chunked encoding a request has no body (RFC 9112, 6.3),
+        // and a declared length beyond the limit is refused before any of it is read: the
+        // content reader waited 30 s (its read timeout) for bodies that never came.
+        const std::string declared_length = req.get_header_value("Content-Length");
+        const bool chunked = req.get_header_value("Transfer-Encoding").find("chunked") != std::string::npos;
+        if (declared_length.empty() && !chunked) {
+            handler(read, res);
+            return;
+        }
+        if (!chunked && std::strtoull(declared_length.c_str(), nullptr, 10) > options.max_body_bytes) {
+            res.set_header("Connection", "close");  // its body is not read: no next request on it
+            throw ServiceError(ErrorKind::PayloadTooLarge, body_limit_message());
+        }
+        const bool complete = content([&](const char* data, size_t length) {
+            read.body.append(data, length);
+            return true;
+        });
+        if (!complete) {
+            // A declared length was checked above: a chunked body past the limit, or a cut one.
+            if (chunked && read.body.size() >= options.max_body_bytes)
+                throw ServiceError(ErrorKind::PayloadTooLarge, body_limit_message());
+            throw ServiceError(ErrorKind::MalformedRequest, "the request body could not be read to its end");
+        }
+        handler(read, res);
+    };
+}
+
+void HttpServer::Impl::add_route(const std::string& method, const std::string& pattern, Handler handler) {
+    if (method == "GET")
+        server.Get(pattern, std::move(handler));
+    else if (method == "POST")
+        server.Post(pattern, with_body(std::move(handler)));
+    else if (method == "PUT")
+        server.Put(pattern, with_body(std::move(handler)));
+    else if (method == "PATCH")
+        server.Patch(pattern, with_body(std::move(handler)));
+    else if (method == "DELETE")
+        server.Delete(pattern, std::move(handler));
+}
+
 /// Hands the routes to cpp-httplib, each wrapped with the token check, and answers 405 (with
 /// Allow) for the other methods on a known path.
-void HttpServer::Impl::install() {
+void HttpServer::Impl::install_routes() {
     std::map<std::string, std::set<std::string>> methods_of;  // pattern -> methods
     for (const BoundRoute& r : routes) methods_of[r.pattern].insert(r.method);
-    // Bodies are read through a content reader, whatever their Content-Type: cpp-httplib parses
-    // an application/x-www-form-urlencoded body (what curl's --data-binary sends by default) as a
-    // form and refuses it beyond 8 KiB, which README's uploads of real files hit. The reader
-    // still enforces --max-body-mb.
-    auto with_body = [this](Handler handler) {
-        return [this, handler = std::move(handler)](const Request& req, Response& res,
-                                                    const httplib::ContentReader& content) {
-            Request read = req;
-            // Without Content-Length or chunked encoding a request has no body (RFC 9112, 6.3),
-            // and a declared length beyond the limit is refused before any of it is read: the
-            // content reader waited 30 s (its read timeout) for bodies that never came.
-            const std::string declared_length = req.get_header_value("Content-Length");
-            const bool chunked = req.get_header_value("Transfer-Encoding").find("chunked") != std::string::npos;
-            if (declared_length.empty() && !chunked) {
-                handler(read, res);
-                return;
-            }
-            if (!chunked && std::strtoull(declared_length.c_str(), nullptr, 10) > options.max_body_bytes) {
-                res.set_header("Connection", "close");  // its body is not read: no next request on it
-                throw ServiceError(ErrorKind::PayloadTooLarge, body_limit_message());
-            }
-            const bool complete = content([&](const char* data, size_t length) {
-                read.body.append(data, length);
-                return true;
-            });
-            if (!complete) {
-                // A declared length was checked above: a chunked body past the limit, or a cut one.
-                if (chunked && read.body.size() >= options.max_body_bytes)
-                    throw ServiceError(ErrorKind::PayloadTooLarge, body_limit_message());
-                throw ServiceError(ErrorKind::MalformedRequest, "the request body could not be read to its end");
-            }
-            handler(read, res);
-        };
-    };
-    auto add = [this, &with_body](const std::string& method, const std::string& pattern, Handler handler) {
-        if (method == "GET")
-            server.Get(pattern, std::move(handler));
-        else if (method == "POST")
-            server.Post(pattern, with_body(std::move(handler)));
-        else if (method == "PUT")
-            server.Put(pattern, with_body(std::move(handler)));
-        else if (method == "PATCH")
-            server.Patch(pattern, with_body(std::move(handler)));
-        else if (method == "DELETE")
-            server.Delete(pattern, std::move(handler));
-    };
     for (const BoundRoute& r : routes) {
-        add(r.method, r.pattern,
-            [this, handler = r.handler, open = r.open](const Request& req, Response& res) {
-                if (!open) check_token(req);
-                handler(req, res);
-            });
+        add_route(r.method, r.pattern,
+                  [this, handler = r.handler, open = r.open](const Request& req, Response& res) {
+                      if (!open) check_token(req);
+                      handler(req, res);
+                  });
     }
     for (const auto& [pattern, methods] : methods_of) {
-        std::string allow;
-        for (const std::string& m : methods) allow += (allow.empty() ? "" : ", ") + m;
         for (const char* method : {"GET", "POST", "PUT", "PATCH", "DELETE"}) {
             if (methods.contains(method)) continue;
-            add(method, pattern, [allow, method](const Request&, Response&) {
-                throw ServiceError(ErrorKind::MethodNotAllowed,
-                                   std::string(method) + " is not allowed here; allowed: " + allow)
-                    .with_header("Allow", allow);
+            add_route(method, pattern, [method, methods = methods](const Request&, Response&) {
+                throw method_not_allowed(method, methods);
             });
         }
-    }
-
-    server.set_exception_handler(
-        [this](const Request& req, Response& res, std::exception_ptr error) {
-            try {
-                std::rethrow_exception(error);
-            } catch (const ServiceError& e) {
-                write_problem(res, e, req);
-            } catch (const std::exception& e) {
-                log("internal error on " + req.method + " " + req.path + ": " + e.what());
-                write_problem(res, ErrorKind::Internal, e.what(), "", req.path);
-            } catch (...) {
-                log("internal error on " + req.method + " " + req.path);
-                write_problem(res, ErrorKind::Internal, "unknown error", "", req.path);
-            }
-        });
-    // Errors cpp-httplib answers by itself: no route (404), body too large (413), a malformed
-    // request (400; also a PUT without a body). A response a handler wrote already has a body and
-    // is left alone. A known path with a method it does not serve is a 405 whatever httplib said.
-    for (const auto& [pattern, methods] : methods_of)
         known_paths.push_back({std::regex(pattern), methods});
-    server.set_error_handler(httplib::Server::HandlerWithResponse([this](const Request& req,
-                                                                         Response& res) {
-        if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
-        int status = res.status;
-        std::string detail;
-        for (const auto& [pattern, methods] : known_paths) {
-            if (!std::regex_match(req.path, pattern) || methods.contains(req.method)) continue;
-            std::string allow;
-            for (const std::string& m : methods) allow += (allow.empty() ? "" : ", ") + m;
-            status = 405;
-            detail = req.method + " is not allowed here; allowed: " + allow;
-            res.set_header("Allow", allow);
-            break;
+    }
+}
+
+void HttpServer::Impl::install_error_handlers() {
+    server.set_exception_handler([this](const Request& req, Response& res, std::exception_ptr error) {
+        try {
+            std::rethrow_exception(error);
+        } catch (const ServiceError& e) {
+            write_problem(res, e, req);
+        } catch (const std::exception& e) {
+            log("internal error on " + req.method + " " + req.path + ": " + e.what());
+            write_problem(res, ErrorKind::Internal, e.what(), "", req.path);
+        } catch (...) {
+            log("internal error on " + req.method + " " + req.path);
+            write_problem(res, ErrorKind::Internal, "unknown error", "", req.path);
         }
-        if (detail.empty()) {
-            switch (status) {
-                case 404:
-                    detail =
-                        "no route for " + req.method + " " + req.path + " (see /v1/openapi.json)";
-                    break;
-                case 413:
-                    detail = body_limit_message();
-                    break;
-                case 400:
-                    detail = req.has_header("Content-Length") || req.has_header("Transfer-Encoding")
-                                 ? "malformed HTTP request"
-                                 : "malformed HTTP request (a " + req.method +
-                                       " needs a body with Content-Length or chunked encoding)";
-                    break;
-                default:
-                    detail = "HTTP status " + std::to_string(status);
-                    break;
-            }
-        }
-        write_problem(res, kind_of_status(status), detail, "", req.path);
-        res.status = status;
+    });
+    server.set_error_handler(httplib::Server::HandlerWithResponse(
+        [this](const Request& req, Response& res) { return answer_own_error(req, res); }));
+}
+
+/// Errors cpp-httplib answers by itself: no route (404), body too large (413), a malformed
+/// request (400; also a PUT without a body). A response a handler wrote already has a body and
+/// is left alone. A known path with a method it does not serve is a 405 whatever httplib said.
+httplib::Server::HandlerResponse HttpServer::Impl::answer_own_error(const Request& req, Response& res) const {
+    if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
+    for (const auto& [pattern, methods] : known_paths) {
+        if (!std::regex_match(req.path, pattern) || methods.contains(req.method)) continue;
+        write_problem(res, method_not_allowed(req.method, methods), req);
         return httplib::Server::HandlerResponse::Handled;
-    }));
+    }
+    const int status = res.status;
+    std::string detail;
+    switch (status) {
+        case 404:
+            detail = "no route for " + req.method + " " + req.path + " (see /v1/openapi.json)";
+            break;
+        case 413:
+            detail = body_limit_message();
+            break;
+        case 400:
+            detail = req.has_header("Content-Length") || req.has_header("Transfer-Encoding")
+                         ? "malformed HTTP request"
+                         : "malformed HTTP request (a " + req.method +
+                               " needs a body with Content-Length or chunked encoding)";
+            break;
+        default:
+            detail = "HTTP status " + std::to_string(status);
+            break;
+    }
+    write_problem(res, kind_of_status(status), detail, "", req.path);
+    res.status = status;
+    return httplib::Server::HandlerResponse::Handled;
+}
+
+void HttpServer::Impl::configure_connections() {
     server.set_logger([this](const Request& req, const Response& res) {
         services.metrics.record_response(res.status);
         if (options.access_log) log(req.method + " " + req.path + " " + std::to_string(res.status));

@@ -8,7 +8,7 @@
 #include "core/image/exr_io.h"
 #include "core/image/image_metrics.h"
 #include "core/image/png_preview.h"
-#include "server/atomic_file.h"
+#include "core/util/file_io.h"
 
 namespace photond::service {
 

@@ -33,6 +33,7 @@
 // mutex.
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -194,7 +195,35 @@ private:
     int retry_after_seconds_locked() const;
     void push_event_locked(Entry& entry, protocol::JobEventType type, nlohmann::json data) const;
     void worker_loop();
+    /// Warnings raised while a job runs, each once; they join its statistics' warnings.
+    class RunWarnings {
+    public:
+        /// False when the warning was given already.
+        bool add(const std::string& warning) {
+            std::lock_guard lock(mutex_);
+            if (std::find(warnings_.begin(), warnings_.end(), warning) != warnings_.end()) return false;
+            warnings_.push_back(warning);
+            return true;
+        }
+        std::vector<std::string> taken() {
+            std::lock_guard lock(mutex_);
+            return std::move(warnings_);
+        }
+
+    private:
+        std::mutex mutex_;
+        std::vector<std::string> warnings_;
+    };
     void run(const std::shared_ptr<Entry>& entry);
+    /// The pipeline's options for a run of `entry`: its cancel flag, and callbacks that restore
+    /// kept tiles, keep finished ones and report tiles and passes as events.
+    PipelineOptions run_options(Entry& entry, const TileJournal& journal, RunWarnings& warnings);
+    /// A finished tile's pixels copied into the job, its events sent.
+    void tile_finished(Entry& entry, const PixelRect& rect, const ImageLayers& frame);
+    /// A cancelled run's end: cancelled, or queued again when a shutdown stopped it.
+    void end_cancelled(const std::shared_ptr<Entry>& entry, const RenderStatistics* statistics);
+    /// The final image's EXR and its checksum written; the entry's image marked verified.
+    Status write_image(Entry& entry, const protocol::Job& job, const ImageLayers& layers);
     /// Writes a job's status; a refusal is logged, counted in /metrics and becomes a warning of
     /// the job. Call without holding mutex_.
     void keep_status(const protocol::JobStatus& status);

@@ -10,7 +10,7 @@
 
 #include "core/util/json_depth.h"
 #include "protocol/json_text.h"
-#include "server/atomic_file.h"
+#include "core/util/file_io.h"
 
 namespace photond::service {
 namespace {
@@ -19,12 +19,10 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 Expected<json> read_json(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return Error{path.string() + ": cannot be read"};
-    std::ostringstream text;
-    text << in.rdbuf();
-    if (json_nesting_depth(text.view()) > kMaxJsonNesting) return Error{path.string() + ": " + json_nesting_message()};
-    json document = json::parse(text.str(), nullptr, false);
+    const Expected<std::string> text = read_file_text(path);
+    if (!text) return text.error();
+    if (json_nesting_depth(*text) > kMaxJsonNesting) return Error{path.string() + ": " + json_nesting_message()};
+    json document = json::parse(*text, nullptr, false);
     if (document.is_discarded()) return Error{path.string() + ": not valid JSON"};
     return document;
 }

@@ -16,7 +16,7 @@
 #include "protocol/job.h"
 #include "protocol/json_text.h"
 #include "protocol/statistics.h"
-#include "server/atomic_file.h"
+#include "core/util/file_io.h"
 #include "server/photon_map_cache.h"
 #include "server/render_cache_directory.h"
 #include "server/render_pipeline.h"
@@ -163,14 +163,6 @@ Expected<Arguments> parse_arguments(std::span<const std::string> args) {
     return a;
 }
 
-Expected<std::string> read_text_file(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return Error{path + ": cannot be read"};
-    std::ostringstream text;
-    text << in.rdbuf();
-    return text.str();
-}
-
 /// A one-line progress bar on stderr, redrawn in place (only on a terminal).
 class ProgressBar {
 public:
@@ -238,7 +230,7 @@ int run_render_command(std::span<const std::string> args) {
 
     nlohmann::json document = nlohmann::json::object();
     if (!a.job_file.empty()) {
-        auto text = read_text_file(a.job_file);
+        auto text = read_file_text(a.job_file);
         if (!text) {
             std::fprintf(stderr, "photond render: %s\n", text.error().message.c_str());
             return 2;
@@ -343,7 +335,7 @@ int run_render_command(std::span<const std::string> args) {
     if (Status st = write_exr(a.output, result->layers, exr); !st) return fail(st.error().message);
     written.push_back(a.output);
     if (png) {
-        if (Status st = write_file_atomically(a.preview, {reinterpret_cast<const char*>(png->data()), png->size()}); !st)
+        if (Status st = write_file_atomically(a.preview, *png); !st)
             return fail(st.error().message);
         written.push_back(a.preview);
     }

@@ -16,6 +16,7 @@
 #include "core/image/environment_image.h"
 #include "core/scene/gltf_loader.h"
 #include "core/photon/photon_map_key.h"
+#include "core/util/path_containment.h"
 #include "protocol/render_settings.h"
 
 namespace photond::service {
@@ -32,20 +33,6 @@ Vec3 to_vec3(const std::array<double, 3>& a) {
 }
 
 float radians(double degrees) { return static_cast<float>(degrees * 3.14159265358979323846 / 180.0); }
-
-/// `relative` below `root`, with symbolic links resolved: nullopt when it leaves the root.
-std::optional<std::filesystem::path> contained_path(const std::filesystem::path& root,
-                                                    const std::string& relative) {
-    std::error_code error;
-    const std::filesystem::path canonical_root = std::filesystem::weakly_canonical(root, error);
-    if (error) return std::nullopt;
-    const std::filesystem::path file = std::filesystem::weakly_canonical(canonical_root / relative, error);
-    if (error) return std::nullopt;
-    const auto [root_end, file_it] =
-        std::mismatch(canonical_root.begin(), canonical_root.end(), file.begin(), file.end());
-    if (root_end != canonical_root.end()) return std::nullopt;
-    return file;
-}
 
 /// The file of a job's environment image: below the scene root for built-in and path scenes, in
 /// the uploaded bundle for {"id": ...} scenes. The error is the message for environment.image.
@@ -64,7 +51,7 @@ Expected<std::filesystem::path> environment_image_file(const protocol::Job& job,
         if (options.scene_root.empty()) return Error{"no scene root is configured to read '" + name + "' from"};
         root = options.scene_root;
     }
-    const std::optional<std::filesystem::path> file = contained_path(root, name);
+    const std::optional<std::filesystem::path> file = resolve_below(root, name);
     if (!file) return Error{"'" + name + "' lies outside the scene root"};
     std::error_code error;
     if (!std::filesystem::is_regular_file(*file, error))
@@ -265,7 +252,7 @@ Expected<std::shared_ptr<const Scene>> load_job_scene(const protocol::SceneRef& 
         }
         case protocol::SceneRef::Kind::Path: {
             if (scene_root.empty()) return Error{"scene.path: no scene root is configured"};
-            const std::optional<std::filesystem::path> file = contained_path(scene_root, ref.value);
+            const std::optional<std::filesystem::path> file = resolve_below(scene_root, ref.value);
             if (!file) return Error{"scene.path: '" + ref.value + "' lies outside the scene root"};
             GltfLoadOptions options;
             options.bundle_root = file->parent_path();

@@ -1,5 +1,7 @@
 #include "server/scene_bundle.h"
 
+#include "core/util/path_containment.h"
+
 #include <archive.h>
 #include <archive_entry.h>
 #include <fcntl.h>
@@ -71,23 +73,17 @@ std::variant<std::vector<std::string>, BundleError> checked_components(std::stri
     if (name.size() > kMaxPathBytes)
         return invalid(label + ": the path is longer than " + std::to_string(kMaxPathBytes) +
                        " bytes");
-    if (!name.empty() && name.front() == '/')
-        return invalid(label + ": absolute paths are not allowed in a bundle");
-    if (name.size() >= 2 && std::isalpha(static_cast<unsigned char>(name[0])) && name[1] == ':')
-        return invalid(label + ": drive letters are not allowed in a bundle");
-    for (const char c : name) {
-        if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
-            return invalid(label + ": control characters are not allowed in a path");
-        if (c == '\\') return invalid(label + ": backslashes are not allowed in a path (use '/')");
-    }
+    // The rule for every relative path's text (core/util/path_containment.h), and no backslash.
+    if (const std::optional<std::string> problem = relative_path_problem(name); problem && !name.empty())
+        return invalid(label + ": " + *problem + " is not allowed in a bundle path (it could leave the bundle)");
+    if (name.find('\\') != std::string_view::npos)
+        return invalid(label + ": backslashes are not allowed in a path (use '/')");
     std::vector<std::string> components;
     size_t start = 0;
     while (start <= name.size()) {
         size_t end = name.find('/', start);
         if (end == std::string_view::npos) end = name.size();
         const std::string_view component = name.substr(start, end - start);
-        if (component == "..")
-            return invalid(label + ": '..' is not allowed in a path (it would leave the bundle)");
         if (component.size() > kMaxComponentBytes)
             return invalid(label + ": a path component is longer than " +
                            std::to_string(kMaxComponentBytes) + " bytes");

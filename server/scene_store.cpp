@@ -10,7 +10,7 @@
 #include "core/util/json_depth.h"
 #include "core/util/sha256.h"
 #include "protocol/json_text.h"
-#include "server/atomic_file.h"
+#include "core/util/file_io.h"
 
 namespace photond::service {
 namespace {

@@ -21,7 +21,7 @@
 #include "server/job_manager.h"
 #include "server/metrics.h"
 #include "server/photon_map_cache.h"
-#include "server/render_cache_directory.h"
+#include "protocol/token_file.h"
 #include "server/render_cache_directory.h"
 #include "server/scene_store.h"
 
@@ -199,25 +199,6 @@ bool is_loopback(const std::string& host) {
     return false;  // a host name: it may resolve to anything
 }
 
-Expected<std::string> read_token(const fs::path& file) {
-    std::ifstream in(file);
-    if (!in) return Error{"--token-file: " + file.string() + " cannot be read"};
-    std::ostringstream text;
-    text << in.rdbuf();
-    std::string token = text.str();
-    while (!token.empty() && std::isspace(static_cast<unsigned char>(token.back())))
-        token.pop_back();
-    size_t start = 0;
-    while (start < token.size() && std::isspace(static_cast<unsigned char>(token[start]))) ++start;
-    token.erase(0, start);
-    if (token.empty()) return Error{"--token-file: " + file.string() + " is empty"};
-    for (char c : token)
-        if (std::isspace(static_cast<unsigned char>(c)) ||
-            !std::isprint(static_cast<unsigned char>(c)))
-            return Error{"--token-file: the token must be one word of printable characters"};
-    return token;
-}
-
 /// Timestamped lines on stderr, one call at a time.
 void log_line(const std::string& line) {
     static std::mutex mutex;
@@ -249,9 +230,9 @@ int run_serve_command(std::span<const std::string> args) {
 
     std::string token;
     if (!a.token_file.empty()) {
-        auto read = read_token(a.token_file);
+        auto read = protocol::read_token_file(a.token_file);
         if (!read) {
-            std::fprintf(stderr, "photond serve: %s\n", read.error().message.c_str());
+            std::fprintf(stderr, "photond serve: --token-file %s\n", read.error().message.c_str());
             return 2;
         }
         token = std::move(read).value();

@@ -1,6 +1,6 @@
 // The daemon's typed failures. The job manager, the stores and the handlers throw ServiceError;
-// the HTTP layer turns every one into RFC 9457 problem+json in one place (http_server.cpp,
-// problem_of) with the status code http_status() gives. The core below never throws: its errors
+// the HTTP layer turns every one into RFC 9457 problem+json in one place (server/http_problems.cpp,
+// write_problem) with the status code http_status() gives. The core below never throws: its errors
 // are values that the daemon wraps here.
 #pragma once
 

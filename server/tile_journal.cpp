@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "core/util/sha256.h"
-#include "server/atomic_file.h"
+#include "core/util/file_io.h"
 
 namespace photond::service {
 
@@ -87,7 +87,7 @@ TileJournal::Restored TileJournal::restore(const PixelRect& rect, ImageLayers& f
     };
     if (rect.empty() || !frame.beauty.bounds().contains(rect)) return damaged("the tile lies outside the frame");
     const auto layers = layers_of(frame);
-    const std::optional<std::vector<uint8_t>> bytes = read_file_bytes(file);
+    const Expected<std::vector<uint8_t>> bytes = read_file_bytes(file);
     if (!bytes) return damaged("cannot be read");
     const size_t expected = header_size(job_digest_) + layers.size() * size_t(rect.area()) * 12 + kDigestSize;
     if (bytes->size() != expected)

@@ -118,7 +118,6 @@ public:
 
     const Scene& scene() const { return *scene_; }
     RTCScene handle() const { return rtc_scene_; }
-    float scene_scale() const { return scene_scale_; }
 
     // A barycentric hit point is within gamma(7) * max|p| ~ 3.5 eps * max|p| of its triangle
     // (Pharr, Jakob & Humphreys, PBR 3rd ed., sec. 3.9.5); 4 eps covers it. More costs accuracy far

@@ -1,5 +1,7 @@
 #include "core/image/exr_assemble.h"
 
+#include "core/util/file_io.h"
+
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
@@ -38,9 +40,9 @@ struct Part {
 };
 
 Expected<Part> read_part(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return Error{quoted(path) + ": cannot be read"};
-    const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const Expected<std::vector<uint8_t>> read = read_file_bytes(path);
+    if (!read) return Error{quoted(path) + ": cannot be read (" + read.error().message + ")"};
+    const std::vector<uint8_t>& bytes = *read;
     Part part{path, {}, {}};
     auto layout = read_exr_layout(bytes, quoted(path));
     if (!layout) return layout.error();

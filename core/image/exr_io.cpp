@@ -15,6 +15,8 @@
 #include <ImfTiledOutputFile.h>
 #include <half.h>
 
+#include "core/util/file_io.h"
+
 #include <algorithm>
 #include <array>
 #include <cstring>
@@ -375,27 +377,8 @@ Status write_exr(const std::filesystem::path& path, const ImageLayers& layers,
                  const ExrWriteOptions& options) {
     Expected<std::vector<uint8_t>> bytes = encode_exr(layers, options);
     if (!bytes) return exr_error(quoted(path), bytes.error().message);
-    std::filesystem::path temporary = path;
-    temporary += ".tmp";
-    {
-        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-        if (!out) return exr_error(quoted(path), "cannot create " + quoted(temporary));
-        out.write(reinterpret_cast<const char*>(bytes->data()), std::streamsize(bytes->size()));
-        out.close();
-        if (!out) {
-            std::error_code ignored;
-            std::filesystem::remove(temporary, ignored);
-            return exr_error(quoted(path), "cannot write " + quoted(temporary));
-        }
-    }
-    std::error_code error;
-    std::filesystem::rename(temporary, path, error);
-    if (error) {
-        std::error_code ignored;
-        std::filesystem::remove(temporary, ignored);
-        return exr_error(quoted(path),
-                         "cannot rename " + quoted(temporary) + ": " + error.message());
-    }
+    if (Status written = write_file_atomically(path, *bytes); !written)
+        return Error{"EXR " + written.error().message};
     return Status::ok();
 }
 
@@ -441,12 +424,9 @@ Expected<ImageLayers> read_exr(const std::filesystem::path& path) {
     if (!std::filesystem::is_regular_file(path, error)) {
         return exr_error(quoted(path), "no such file");
     }
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return exr_error(quoted(path), "cannot open");
-    std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)),
-                               std::istreambuf_iterator<char>());
-    if (in.bad()) return exr_error(quoted(path), "cannot read");
-    Expected<RawExr> raw = decode_raw(bytes, quoted(path));
+    const Expected<std::vector<uint8_t>> bytes = read_file_bytes(path);
+    if (!bytes) return Error{"EXR " + bytes.error().message};
+    Expected<RawExr> raw = decode_raw(*bytes, quoted(path));
     if (!raw) return raw.error();
     return place_in_display_window(*raw);
 }

@@ -33,7 +33,7 @@ struct ExrWriteOptions {
     std::optional<PixelRect> data_window;
 };
 
-/// Writes a tiled, ZIP-compressed EXR: first to `path` + ".tmp", then renamed onto `path`, so
+/// Writes a tiled, ZIP-compressed EXR with write_file_atomically (core/util/file_io.h), so
 /// readers never see a half-written file. Every AOV must have the beauty's size.
 Status write_exr(const std::filesystem::path& path, const ImageLayers& layers,
                  const ExrWriteOptions& options = {});

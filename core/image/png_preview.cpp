@@ -2,14 +2,14 @@
 
 #include <png.h>
 
+#include "core/util/file_io.h"
+
 #include <algorithm>
 #include <cmath>
 #include <csetjmp>
 #include <cstddef>
 #include <cstdio>
-#include <fstream>
 #include <string>
-#include <system_error>
 
 namespace photond {
 namespace {
@@ -52,31 +52,6 @@ bool encode_rows(png_structp png, png_infop info, int width, int height, png_byt
     png_write_image(png, rows);
     png_write_end(png, info);
     return true;
-}
-
-Status write_file_atomically(const std::filesystem::path& path, const std::vector<uint8_t>& bytes) {
-    const std::string name = "PNG '" + path.string() + "': ";
-    std::filesystem::path temporary = path;
-    temporary += ".tmp";
-    {
-        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-        if (!out) return Error{name + "cannot create '" + temporary.string() + "'"};
-        out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-        out.close();
-        if (!out) {
-            std::error_code ignored;
-            std::filesystem::remove(temporary, ignored);
-            return Error{name + "cannot write '" + temporary.string() + "'"};
-        }
-    }
-    std::error_code error;
-    std::filesystem::rename(temporary, path, error);
-    if (error) {
-        std::error_code ignored;
-        std::filesystem::remove(temporary, ignored);
-        return Error{name + "cannot rename '" + temporary.string() + "': " + error.message()};
-    }
-    return Status::ok();
 }
 
 /// sRGB OETF, IEC 61966-2-1:1999, of a value in [0, 1], as an 8-bit code rounded to nearest.
@@ -124,7 +99,9 @@ Expected<std::vector<uint8_t>> encode_png(const Image& image, ChannelEncoder enc
 Status write_png_file(const std::filesystem::path& path,
                       const Expected<std::vector<uint8_t>>& bytes) {
     if (!bytes) return Error{"PNG '" + path.string() + "': " + bytes.error().message};
-    return write_file_atomically(path, *bytes);
+    if (Status written = write_file_atomically(path, *bytes); !written)
+        return Error{"PNG " + written.error().message};
+    return Status::ok();
 }
 
 }  // namespace

@@ -48,7 +48,7 @@ uint8_t preview_srgb8(float linear, float exposure_scale);
 Expected<std::vector<uint8_t>> encode_render_preview(
     const Image& image, std::optional<float> exposure_ev = std::nullopt);
 
-/// encode_render_preview written to `path` + ".tmp", then renamed onto `path`.
+/// encode_render_preview written with write_file_atomically (core/util/file_io.h).
 Status write_render_preview(const std::filesystem::path& path, const Image& image,
                             std::optional<float> exposure_ev = std::nullopt);
 
@@ -63,7 +63,7 @@ uint8_t linear_to_srgb8(float linear, float exposure_scale = 1.0f);
 /// renders; Error for an empty image.
 Expected<std::vector<uint8_t>> encode_png_preview(const Image& image, float exposure_stops = 0.0f);
 
-/// encode_png_preview written to `path` + ".tmp", then renamed onto `path`.
+/// encode_png_preview written with write_file_atomically (core/util/file_io.h).
 Status write_png_preview(const std::filesystem::path& path, const Image& image,
                          float exposure_stops = 0.0f);
 

@@ -108,7 +108,7 @@ inline RayFootprint camera_footprint(const CameraRay& ray) { return {ray.pixel_w
 
 /// The ray of a camera sample: from the camera itself, which RayTracer::intersect puts on the front
 /// side of a surface it lies on (so a camera on a floor sees the room, and the floor below it).
-inline Ray primary_ray(const RenderScene&, const CameraRay& ray) {
+inline Ray primary_ray(const CameraRay& ray) {
     return RayTracer::viewpoint_ray(ray.origin, ray.direction);
 }
 

@@ -171,7 +171,7 @@ std::unique_ptr<IrradianceCache> build_irradiance_cache(const RenderScene& rs, c
                     const PixelCandidate& c = candidates[i];
                     const CameraRay ray = camera.generate_ray(c.x + kCandidateX, c.y + kCandidateY);
                     points.clear();
-                    collect_diffuse_points(rs, primary_ray(rs, ray), 0.0f, camera_footprint(ray), 0,
+                    collect_diffuse_points(rs, primary_ray(ray), 0.0f, camera_footprint(ray), 0,
                                            settings.max_specular_depth, chunk.counters, points);
                     chunk.points += points.size();
                     for (size_t k = 0; k < points.size(); ++k) {

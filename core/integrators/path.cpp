@@ -17,7 +17,7 @@ RadianceParts PathIntegrator::radiance_parts(const CameraRay& camera_ray, Sample
         return &RadianceParts::indirect;
     };
     Color throughput(1.0f);
-    Ray ray = primary_ray(rs, camera_ray);
+    Ray ray = primary_ray(camera_ray);
     bool previous_was_delta = true;  // the camera ray counts as specular: emission is taken whole
     float previous_bsdf_pdf = 0.0f;
     Vec3 previous_point = camera_ray.origin;

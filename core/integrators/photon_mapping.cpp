@@ -142,7 +142,7 @@ std::string PhotonMapIntegrator::render_cache_key(const std::string& photon_map_
 }
 
 RadianceParts PhotonMapIntegrator::radiance_parts(const CameraRay& ray, SampleContext& context) const {
-    return radiance_along(primary_ray(*scene_, ray), 0, 0.0f, camera_footprint(ray), context);
+    return radiance_along(primary_ray(ray), 0, 0.0f, camera_footprint(ray), context);
 }
 
 Color PhotonMapIntegrator::indirect_irradiance(const DiffusePoint& point, SampleContext& context) const {

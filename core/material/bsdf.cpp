@@ -32,6 +32,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/material/albedo_lookup.h"
 #include "core/material/albedo_table.h"
 #include "core/material/fresnel.h"
 #include "core/material/microfacet.h"
@@ -67,77 +68,33 @@ LobeKind microfacet_lobe_kind(float roughness) {
 
 bool in_mask(LobeMask mask, LobeKind kind) { return (mask & mask_of(kind)) != 0; }
 
-/// The albedo table (core/material/albedo_table.h), integrated when photond was built.
-class AlbedoTable {
-public:
-    static constexpr int kRoughnessCells = albedo_table::kRoughnessCells;
-    static constexpr int kCosNodes = albedo_table::kCosNodes;
-
-    static const AlbedoTable& instance() {
-        static const AlbedoTable table;  // thread-safe initialisation
-        return table;
+/// The slot u_lobe picks among those of positive probability (-1: none), and the probability
+/// below it (`chosen_lower`), so that the rest of u_lobe can be used again.
+int choose_slot(const std::array<float, 4>& slots, float u_lobe, float& chosen_lower) {
+    int slot = -1;
+    float lower = 0.0f;
+    for (int s = 0; s < 4; ++s) {
+        if (slots[s] <= 0.0f) continue;
+        slot = s;
+        chosen_lower = lower;
+        if (u_lobe < lower + slots[s]) break;
+        lower += slots[s];
     }
+    return slot;
+}
 
-    /// The cell containing `roughness` (in [kDeltaRoughness, 1]) and the weight of its upper row.
-    std::pair<int, float> locate_roughness(float roughness) const {
-        roughness = std::clamp(roughness, kDeltaRoughness, 1.0f);
-        const float x = std::log(roughness / kDeltaRoughness) / std::log(1.0f / kDeltaRoughness) *
-                        kRoughnessCells;
-        int j = std::clamp(static_cast<int>(x), 0, kRoughnessCells - 1);
-        const float r0 = row_roughness_[j], r1 = row_roughness_[j + 1];
-        return {j, std::clamp((roughness - r0) / (r1 - r0), 0.0f, 1.0f)};
-    }
+/// Whether the lobe of a slot is an ideal (delta) one.
+bool slot_is_delta(int slot, const BsdfMaterial& m) {
+    return (slot == kSlotSpecular && m.smooth) || (slot == kSlotGlass && m.glass_delta) ||
+           (slot == kSlotCoat && m.coat_smooth);
+}
 
-    SpecularAlbedo lookup(int cell, float w_roughness, float mu) const {
-        mu = std::clamp(mu, 0.0f, 1.0f);
-        // The node index from a quick log2 (within 0.005, a fifteenth of a node), then checked
-        // exactly: log1pf and std::lerp were a quarter of a photon estimate's time.
-        const float t = approximate_log2_at_least_1(1.0f + mu * albedo_table::kExpBetaMinusOne) *
-                        (0.69314718f / albedo_table::kBeta * (kCosNodes - 1));
-        int k = std::clamp(static_cast<int>(t), 0, kCosNodes - 2);
-        if (k > 0 && mu < node_cos_[k]) --k;
-        if (k < kCosNodes - 2 && mu > node_cos_[k + 1]) ++k;
-        const float w_mu =
-            std::clamp((mu - node_cos_[k]) / (node_cos_[k + 1] - node_cos_[k]), 0.0f, 1.0f);
-        const albedo_table::Cell& c = cells_[cell];
-        auto interpolate = [&](const std::array<float, 2 * kCosNodes>& v) {
-            const float lower = v[k] + w_mu * (v[k + 1] - v[k]);
-            const float upper = v[kCosNodes + k] + w_mu * (v[kCosNodes + k + 1] - v[kCosNodes + k]);
-            return lower + w_roughness * (upper - lower);
-        };
-        return {interpolate(c.total), interpolate(c.schlick)};
-    }
-
-    /// int E(mu) 2 mu dmu of lookup()'s interpolant, exactly.
-    SpecularAlbedo average(int cell, float w_roughness) const {
-        const albedo_table::Cell& c = cells_[cell];
-        return {std::lerp(c.average[0].total, c.average[1].total, w_roughness),
-                std::lerp(c.average[0].schlick, c.average[1].schlick, w_roughness)};
-    }
-
-private:
-    /// log2(x) for x >= 1 to within 0.005: the exponent's bits plus a quadratic in the mantissa.
-    static float approximate_log2_at_least_1(float x) {
-        const uint32_t bits = std::bit_cast<uint32_t>(x);
-        const float exponent = static_cast<float>(static_cast<int>(bits >> 23) - 127);
-        const float m = std::bit_cast<float>((bits & 0x007fffffu) | 0x3f800000u) - 1.0f;  // [0, 1)
-        return exponent + m * (1.3465553f - 0.34655531f * m);
-    }
-
-    AlbedoTable() : node_cos_(albedo_table::node_cos()), cells_(&albedo_table::cell(0)) {
-        for (int j = 0; j <= kRoughnessCells; ++j) row_roughness_[j] = albedo_table::row_roughness(j);
-    }
-
-    std::array<float, kCosNodes> node_cos_{};
-    const albedo_table::Cell* cells_;
-    std::array<float, kRoughnessCells + 1> row_roughness_{};
-};
-
-/// Albedo of the GGX lobe without Fresnel and with the Schlick term: exact for the ideal
-/// mirror (1 and (1 - mu)^5; cell < 0), tabulated upper bounds for rough lobes.
-SpecularAlbedo specular_albedo_terms(int cell, float w_roughness, float mu) {
-    if (cell < 0) return {1.0f, schlick_weight(mu)};
-    return AlbedoTable::instance().lookup(cell, w_roughness, mu);
+/// The kind of a non-delta slot's lobe.
+LobeKind slot_kind(int slot, const BsdfMaterial& m) {
+    return slot == kSlotDiffuse    ? LobeKind::Diffuse
+           : slot == kSlotSpecular ? m.specular_kind
+           : slot == kSlotCoat     ? m.coat_kind
+                                   : m.glass_kind;
 }
 
 }  // namespace
@@ -470,23 +427,15 @@ std::optional<BsdfSample> Bsdf::sample_lobes(const Vec3& wo, float u_lobe, const
     const SlotProbabilities slots = slot_probabilities(o, outside, mask);
 
     // Choose a slot with u_lobe; reuse the remainder of u_lobe for the reflect/refract choice.
-    int slot = -1;
-    float lower = 0.0f, chosen_lower = 0.0f;
-    for (int s = 0; s < 4; ++s) {
-        if (slots[s] <= 0.0f) continue;
-        slot = s;
-        chosen_lower = lower;
-        if (u_lobe < lower + slots[s]) break;
-        lower += slots[s];
-    }
+    float chosen_lower = 0.0f;
+    const int slot = choose_slot(slots, u_lobe, chosen_lower);
     if (slot < 0) return std::nullopt;
     const float u_choice = std::clamp((u_lobe - chosen_lower) / slots[slot], 0.0f, 0x1.fffffep-1f);
     const float eta = relative_ior(outside);
 
     BsdfSample s;
     Vec3 i;
-    const bool delta = (slot == kSlotSpecular && m_->smooth) || (slot == kSlotGlass && m_->glass_delta) ||
-                       (slot == kSlotCoat && m_->coat_smooth);
+    const bool delta = slot_is_delta(slot, *m_);
     // Light reaching the base through a clearcoat both ways (1 where there is none).
     const float coat_o = m_->coat > 0.0f && outside ? coat_through(o.z) : 1.0f;
     if (delta) {
@@ -547,10 +496,7 @@ std::optional<BsdfSample> Bsdf::sample_lobes(const Vec3& wo, float u_lobe, const
         if (!(pdf > 0.0f) || is_black(f) || !is_finite(f)) return std::nullopt;
         s.weight = f * std::abs(i.z) / pdf;
         s.pdf = pdf;
-        s.kind = slot == kSlotDiffuse    ? LobeKind::Diffuse
-                 : slot == kSlotSpecular ? m_->specular_kind
-                 : slot == kSlotCoat     ? m_->coat_kind
-                                         : m_->glass_kind;
+        s.kind = slot_kind(slot, *m_);
         s.is_transmission = i.z < 0.0f;
         s.eta = s.is_transmission ? eta : 1.0f;
     }

@@ -4,7 +4,7 @@ namespace photond {
 
 FirstSurface first_surface(const RenderScene& rs, const CameraRay& ray, RayCounters& counters) {
     FirstSurface surface;
-    const Ray primary = primary_ray(rs, ray);
+    const Ray primary = primary_ray(ray);
     const std::optional<Hit> hit = trace_ray(rs, primary, counters);
     if (!hit) return surface;
     const SurfaceInteraction si = make_interaction(*rs.scene, *hit, primary.direction, 0.0f);

@@ -309,8 +309,6 @@ public:
     /// Validates and returns the scene; the builder is left empty.
     Expected<Scene> build();
 
-    size_t material_count() const { return scene_.materials.size(); }
-
 private:
     Scene scene_;
 };

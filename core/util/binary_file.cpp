@@ -15,37 +15,6 @@
 namespace photond {
 namespace {
 
-std::string system_message(int error_number) {
-    return std::error_code(error_number, std::generic_category()).message();
-}
-
-Status write_all(const std::filesystem::path& path, std::span<const uint8_t> bytes) {
-    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-    if (fd < 0) {
-        const int error_number = errno;
-        return Error{"cannot create the temporary file " + path.filename().string() + ": " +
-                     system_message(error_number)};
-    }
-    size_t written = 0;
-    while (written < bytes.size()) {
-        const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
-        if (n < 0) {
-            if (errno == EINTR) continue;
-            const int error_number = errno;
-            ::close(fd);
-            return Error{"cannot write " + path.filename().string() + ": " +
-                         system_message(error_number)};
-        }
-        written += size_t(n);
-    }
-    if (::close(fd) != 0) {
-        const int error_number = errno;
-        return Error{"cannot write " + path.filename().string() + ": " +
-                     system_message(error_number)};
-    }
-    return Status::ok();
-}
-
 Status read_all(const std::filesystem::path& path, std::span<const uint8_t> magic,
                 std::vector<uint8_t>& bytes) {
     const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
@@ -95,39 +64,6 @@ void ByteReader::truncated(size_t size, const char* field) {
     fail("truncated " + std::string(data_name_) + " data: " + std::string(field) + " at byte " +
          std::to_string(position_) + " needs " + std::to_string(size) + " bytes, " +
          std::to_string(remaining()) + " remain");
-}
-
-std::filesystem::path unique_temporary_path(const std::filesystem::path& path) {
-    // The pid, a random number and a counter.
-    static std::atomic<uint64_t> counter{0};
-    std::random_device random;
-    const uint64_t unique =
-        (uint64_t(random()) << 32 | random()) ^ (counter.fetch_add(1) * 0x9e3779b97f4a7c15ull);
-    char suffix[64];
-    std::snprintf(suffix, sizeof(suffix), ".tmp-%ld-%016llx", long(::getpid()),
-                  static_cast<unsigned long long>(unique));
-    std::filesystem::path temporary = path;
-    temporary += suffix;
-    return temporary;
-}
-
-Status write_file_atomically(const std::filesystem::path& path, std::span<const uint8_t> bytes) {
-    const std::filesystem::path temporary = unique_temporary_path(path);
-    if (Status written = write_all(temporary, bytes); !written) {
-        std::error_code ignored;
-        std::filesystem::remove(temporary, ignored);
-        return Error{path.string() + ": " + written.error().message};
-    }
-    // rename(2) replaces path atomically: a reader opens either the old file or the new one.
-    std::error_code error;
-    std::filesystem::rename(temporary, path, error);
-    if (error) {
-        std::error_code ignored;
-        std::filesystem::remove(temporary, ignored);
-        return Error{path.string() + ": cannot rename " + temporary.filename().string() +
-                     " into place: " + error.message()};
-    }
-    return Status::ok();
 }
 
 Expected<std::vector<uint8_t>> read_file_with_magic(const std::filesystem::path& path,

@@ -1,6 +1,7 @@
 // The pieces shared by photond's versioned binary artifact formats (core/photon/photon_map_io.h,
 // core/integrators/irradiance_cache_io.h): little-endian field writing and bounds-checked field
-// reading with error text, and files written atomically and read only when their magic matches.
+// reading with error text, and files read only when their magic matches (written with
+// core/util/file_io.h).
 #pragma once
 
 #include <array>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "core/util/expected.h"
+#include "core/util/file_io.h"  // write_file_atomically, for the formats
 
 namespace photond {
 
@@ -101,16 +103,6 @@ private:
     size_t position_ = 0;
     std::string error_;
 };
-
-/// path + ".tmp-<pid>-<random>": a name in path's directory that no other writer (thread or
-/// process) uses.
-std::filesystem::path unique_temporary_path(const std::filesystem::path& path);
-
-/// Writes bytes to unique_temporary_path(path), then renames it over path, so concurrent writers
-/// and readers never see a partial file. The directory must exist. Not flushed to the disk (no
-/// fsync): after a crash the file may be incomplete, which a format's checksum must catch.
-/// Messages start with path.
-Status write_file_atomically(const std::filesystem::path& path, std::span<const uint8_t> bytes);
 
 /// A regular file's bytes, read whole only if they start with magic: otherwise only the first
 /// magic.size() bytes (or fewer), so that a large foreign file is not read whole and the format's

@@ -225,6 +225,24 @@ TEST_F(Photonctl, SubmitWaitOutputEqualsFetchedImage) {
     ASSERT_GT(waited_bytes.size(), 100u);
     EXPECT_EQ(waited_bytes, read_file(fetched));
     EXPECT_FALSE(fs::exists(waited.string() + ".part"));
+    // A fetch whose file cannot be put in place (-o names a directory that is not empty) fails
+    // and leaves no temporary file behind (core/util/file_io.h).
+    fs::create_directories(dir_ / "taken" / "inside");
+    const CommandResult refused = photonctl("fetch " + id + " -o " + quote((dir_ / "taken").string()));
+    EXPECT_NE(refused.exit_code, 0) << refused.out;
+    // Nor one whose write fails half way (a file size limit, SIGXFSZ ignored: write(2) fails with
+    // EFBIG); photonctl's own writer left its .part behind here.
+    const CommandResult limited =
+        run_shell("trap '' XFSZ; ulimit -f 1; " + quote(kPhotonctl) + " --server " + daemon_->url() + " fetch " +
+                      id + " -o " + quote((dir_ / "limited.exr").string()),
+                  dir_);
+    EXPECT_NE(limited.exit_code, 0) << limited.out;
+    EXPECT_FALSE(fs::exists(dir_ / "limited.exr"));
+    for (const auto& entry : fs::directory_iterator(dir_)) {
+        const std::string name = entry.path().filename().string();
+        EXPECT_EQ(name.find(".part"), std::string::npos) << name;
+        EXPECT_EQ(name.find(".tmp"), std::string::npos) << name;
+    }
 
     const auto image = photond::read_exr(waited);
     ASSERT_TRUE(image.has_value()) << image.error().message;

@@ -851,7 +851,7 @@ TEST(JobSchema, ScenePathPatternMatchesTheValidator) {
     std::regex pattern(schema_nodes(schema, "scene.path").at(0)["pattern"].get<std::string>(),
                        std::regex::ECMAScript);
     for (std::string path : {"x.glb", "a/b/c.gltf", "a..b/x.glb", "./x", "/x", "../x", "a/../x",
-                             "a/..", "a\\..\\x", "C:x", "x\ty", ""}) {
+                             "a/..", "a\\..\\x", "C:x", "x\ty", "x\x7fy", ""}) {
         bool valid = accepts({{"scene", {{"path", path}}}});
         EXPECT_EQ(std::regex_match(path, pattern), valid) << path;
     }

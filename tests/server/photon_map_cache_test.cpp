@@ -10,7 +10,7 @@
 #include <thread>
 
 #include "core/photon/photon_map_io.h"
-#include "server/atomic_file.h"
+#include "core/util/file_io.h"
 #include "tests/server/daemon_harness.h"
 
 namespace photond::service {

@@ -1,0 +1,149 @@
+// glTF images: kept encoded while the file is parsed, decoded (PNG, JPEG) when a material uses them.
+#include "core/scene/gltf_reader.h"
+
+#include <cstring>
+#include <span>
+
+namespace photond::gltf {
+namespace {
+
+bool is_png(std::span<const uint8_t> b) {
+    static constexpr uint8_t kMagic[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    return b.size() >= 8 && std::memcmp(b.data(), kMagic, 8) == 0;
+}
+
+bool is_jpeg(std::span<const uint8_t> b) {
+    return b.size() >= 3 && b[0] == 0xff && b[1] == 0xd8 && b[2] == 0xff;
+}
+
+uint32_t read_be16(const uint8_t* p) { return (uint32_t(p[0]) << 8) | p[1]; }
+uint32_t read_be32(const uint8_t* p) { return (read_be16(p) << 16) | read_be16(p + 2); }
+
+// Width and height from the PNG IHDR chunk or the first JPEG start-of-frame segment, so that
+// absurd images are refused before the decoder allocates.
+std::optional<std::pair<uint32_t, uint32_t>> encoded_image_size(std::span<const uint8_t> b) {
+    if (is_png(b)) {
+        if (b.size() < 24 || std::memcmp(b.data() + 12, "IHDR", 4) != 0) return std::nullopt;
+        return std::make_pair(read_be32(b.data() + 16), read_be32(b.data() + 20));
+    }
+    if (is_jpeg(b)) {
+        size_t pos = 2;
+        while (pos + 4 <= b.size()) {
+            if (b[pos] != 0xff) return std::nullopt;
+            const uint8_t marker = b[pos + 1];
+            if (marker == 0xff) {  // fill byte
+                ++pos;
+                continue;
+            }
+            if (marker == 0x01 || (marker >= 0xd0 && marker <= 0xd8)) {  // no payload
+                pos += 2;
+                continue;
+            }
+            const uint32_t length = read_be16(b.data() + pos + 2);
+            const bool start_of_frame = marker >= 0xc0 && marker <= 0xcf && marker != 0xc4 &&
+                                        marker != 0xc8 && marker != 0xcc;
+            if (start_of_frame) {
+                if (pos + 9 > b.size()) return std::nullopt;
+                return std::make_pair(read_be16(b.data() + pos + 7), read_be16(b.data() + pos + 5));
+            }
+            if (length < 2) return std::nullopt;
+            pos += 2 + length;
+        }
+    }
+    return std::nullopt;
+}
+
+// sRGB electro-optical transfer function, IEC 61966-2-1.
+float srgb_to_linear(float c) {
+    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
+}  // namespace
+
+bool keep_encoded_image(tinygltf::Image* image, const int image_index, std::string* err,
+                        std::string*, int, int, const unsigned char* bytes, int size, void* user) {
+    const ImageLoadContext& context = *static_cast<const ImageLoadContext*>(user);
+    if (image->bufferView >= 0) {
+        // tinygltf does not check that an image's bufferView lies inside its buffer.
+        const tinygltf::Model& model = *context.model;
+        const auto view_index = static_cast<size_t>(image->bufferView);
+        const tinygltf::BufferView& view = model.bufferViews.at(view_index);
+        const tinygltf::Buffer& buffer = model.buffers.at(static_cast<size_t>(view.buffer));
+        if (view.byteOffset > buffer.data.size() ||
+            view.byteLength > buffer.data.size() - view.byteOffset) {
+            if (err)
+                *err += "image " + std::to_string(image_index) + ": bufferView " +
+                        std::to_string(view_index) + " reaches past the end of buffer " +
+                        std::to_string(view.buffer) + "\n";
+            return false;
+        }
+    }
+    if (bytes == nullptr || size <= 0) {
+        if (err) *err += "image " + std::to_string(image_index) + " is empty\n";
+        return false;
+    }
+    image->image.assign(bytes, bytes + size);
+    image->as_is = true;
+    return true;
+}
+
+Expected<Texture> decode_image(const tinygltf::Image& image, int image_index, bool srgb) {
+    const std::string what = "image " + std::to_string(image_index) + quoted(image.name) +
+                             (image.uri.empty() ? "" : " (uri '" + image.uri + "')");
+    if (!image.as_is || image.image.empty()) return Error{what + " could not be read"};
+    const std::span<const uint8_t> bytes(image.image.data(), image.image.size());
+    if (!is_png(bytes) && !is_jpeg(bytes)) return Error{what + " is neither PNG nor JPEG"};
+    const auto size = encoded_image_size(bytes);
+    if (!size) return Error{what + " has an unreadable header"};
+    const auto [width, height] = *size;
+    if (width == 0 || height == 0 || width > kMaxImageSide || height > kMaxImageSide ||
+        uint64_t(width) * height > kMaxImagePixels)
+        return Error{what + " has unsupported dimensions " + std::to_string(width) + "x" +
+                     std::to_string(height) + " (at most " + std::to_string(kMaxImageSide) +
+                     " per side and " + std::to_string(kMaxImagePixels) + " pixels)"};
+
+    tinygltf::Image decoded;
+    std::string err, warn;
+    // Without user data the decoder expands every image to RGBA, 8 or 16 bits per channel.
+    if (!tinygltf::LoadImageData(&decoded, image_index, &err, &warn, 0, 0, image.image.data(),
+                                 static_cast<int>(image.image.size()), nullptr))
+        return Error{what + " cannot be decoded: " + trim_trailing_whitespace(err)};
+    const size_t texel_count = size_t(decoded.width) * size_t(decoded.height);
+    const size_t bytes_per_channel = decoded.bits == 16 ? 2 : 1;
+    if (decoded.width <= 0 || decoded.height <= 0 || decoded.component != 4 ||
+        (decoded.bits != 8 && decoded.bits != 16) ||
+        decoded.image.size() < texel_count * 4 * bytes_per_channel)
+        return Error{what + " decoded to an unexpected pixel layout"};
+
+    Texture texture;
+    texture.width = decoded.width;
+    texture.height = decoded.height;
+    texture.texels.resize(texel_count);
+    const auto curve = [srgb](float c) { return srgb ? srgb_to_linear(c) : c; };
+    std::vector<float> alpha(texel_count);
+    bool opaque = true;
+    if (decoded.bits == 8) {
+        float table[256];
+        for (int i = 0; i < 256; ++i) table[i] = curve(float(i) / 255.0f);
+        const uint8_t* p = decoded.image.data();
+        for (size_t i = 0; i < texel_count; ++i, p += 4) {
+            texture.texels[i] = Color(table[p[0]], table[p[1]], table[p[2]]);
+            alpha[i] = p[3] / 255.0f;
+            opaque = opaque && p[3] == 255;
+        }
+    } else {
+        const uint8_t* p = decoded.image.data();
+        for (size_t i = 0; i < texel_count; ++i, p += 8) {
+            uint16_t rgba[4];
+            std::memcpy(rgba, p, sizeof(rgba));  // stb returns native-endian 16-bit samples
+            texture.texels[i] = Color(curve(rgba[0] / 65535.0f), curve(rgba[1] / 65535.0f),
+                                      curve(rgba[2] / 65535.0f));
+            alpha[i] = rgba[3] / 65535.0f;
+            opaque = opaque && rgba[3] == 65535;
+        }
+    }
+    if (!opaque) texture.alpha = std::move(alpha);
+    return texture;
+}
+
+}  // namespace photond::gltf

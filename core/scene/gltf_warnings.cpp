@@ -1,0 +1,103 @@
+// Warnings: what a file holds that the loader drops or takes its own way. Keep this list in step
+// with what the loader reads: remove an entry when its feature is implemented.
+#include "core/scene/gltf_reader.h"
+
+#include <array>
+
+namespace photond::gltf {
+namespace {
+
+// Every edge of the triangles (vertices welded by position) is shared by exactly two of them.
+bool is_closed_surface(const std::vector<Vec3>& positions,
+                       const std::vector<glm::uvec3>& triangles) {
+    if (triangles.empty()) return false;
+    std::map<std::array<float, 3>, uint32_t> welded;
+    std::vector<uint32_t> vertex(positions.size());
+    for (size_t i = 0; i < positions.size(); ++i)
+        vertex[i] = welded.emplace(std::array<float, 3>{positions[i].x, positions[i].y,
+                                                        positions[i].z},
+                                   static_cast<uint32_t>(welded.size()))
+                        .first->second;
+    std::map<std::pair<uint32_t, uint32_t>, int> edges;
+    for (const glm::uvec3& t : triangles) {
+        const uint32_t v[3] = {vertex[t.x], vertex[t.y], vertex[t.z]};
+        for (int k = 0; k < 3; ++k)
+            ++edges[std::minmax(v[k], v[(k + 1) % 3])];
+    }
+    return std::all_of(edges.begin(), edges.end(), [](const auto& e) { return e.second == 2; });
+}
+
+// "'A', 'B' and 3 more" for a warning naming the materials (or other things) involved.
+std::string name_list(const std::vector<std::string>& names) {
+    constexpr size_t kShown = 3;
+    std::string list;
+    for (size_t i = 0; i < names.size() && i < kShown; ++i)
+        list += (i == 0 ? "" : i + 1 == names.size() ? " and " : ", ") + ("'" + names[i] + "'");
+    if (names.size() > kShown) list += " and " + std::to_string(names.size() - kShown) + " more";
+    return list;
+}
+
+}  // namespace
+
+void GltfSceneReader::note_dropped_primitive_features(const tinygltf::Primitive& prim,
+                                                      const std::vector<Vec3>& positions,
+                                                      const std::vector<glm::uvec3>& triangles) {
+    for (const auto& [name, accessor] : prim.attributes) {
+        // COLOR_0 multiplies the base colour; further colour sets are read by nothing.
+        if ((name.rfind("COLOR_", 0) == 0 && name != "COLOR_0") || name.rfind("JOINTS_", 0) == 0 ||
+            name.rfind("WEIGHTS_", 0) == 0)
+            ignored_attributes_.insert(name.substr(0, name.find('_')));
+    }
+    if (!prim.targets.empty()) ignored_attributes_.insert("morph targets");
+    if (prim.material < 0 || static_cast<size_t>(prim.material) >= model_.materials.size()) return;
+    // KHR_materials_transmission without KHR_materials_volume is thin-walled by the glTF
+    // specification; the renderer takes every transmissive surface as the boundary of a solid
+    // dielectric (as Blender's exporter means a glass sphere). Where that differs (a closed mesh
+    // is solid glass, not a thin shell), say so.
+    const auto& ext = model_.materials[static_cast<size_t>(prim.material)].extensions;
+    const Expected<double> transmission =
+        extension_number(ext, "KHR_materials_transmission", "transmissionFactor", 0.0);
+    if (transmission && *transmission > 0.0 && !ext.count("KHR_materials_volume") &&
+        is_closed_surface(positions, triangles))
+        solid_transmission_materials_.insert(prim.material);
+}
+
+void GltfSceneReader::add_feature_warnings() {
+    if (skipped_point_line_primitives_ > 0)
+        builder_.add_warning(std::to_string(skipped_point_line_primitives_) +
+                             " point or line primitive(s) are not rendered (they have no area)");
+    for (const std::string& what : ignored_attributes_) {
+        if (what == "COLOR")
+            builder_.add_warning("vertex colour sets after COLOR_0 (COLOR_1, ...) are ignored");
+        else if (what == "morph targets")
+            builder_.add_warning("morph targets are ignored: meshes are rendered in their base shape");
+        else
+            builder_.add_warning("skinning (" + what + "_n) is ignored: skinned meshes are rendered "
+                                 "in their bind pose");
+    }
+    if (!model_.animations.empty())
+        builder_.add_warning(std::to_string(model_.animations.size()) +
+                             " animation(s) are ignored: the nodes' static transforms are rendered");
+    if (model_.scenes.size() > 1)
+        builder_.add_warning("the file has " + std::to_string(model_.scenes.size()) +
+                             " scenes; only the default scene is rendered");
+
+    // occlusionTexture is ignored by design and gets no warning: it approximates for rasterizers
+    // what global illumination computes.
+    const auto material_name = [&](int index) {
+        const std::string& name = model_.materials[static_cast<size_t>(index)].name;
+        return name.empty() ? "material " + std::to_string(index) : name;
+    };
+    if (!solid_transmission_materials_.empty()) {
+        std::vector<std::string> names;
+        for (int index : solid_transmission_materials_) names.push_back(material_name(index));
+        builder_.add_warning(
+            "KHR_materials_transmission without KHR_materials_volume on a closed mesh (material" +
+            std::string(names.size() > 1 ? "s " : " ") + name_list(names) +
+            "): rendered as solid glass that refracts, not as the thin-walled shell the glTF "
+            "specification describes (add KHR_materials_volume with a thickness to say it is "
+            "solid)");
+    }
+}
+
+}  // namespace photond::gltf
