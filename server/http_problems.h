@@ -1,18 +1,14 @@
 // Failures as HTTP responses: every ServiceError (server/service_error.h) and every error
 // cpp-httplib answers by itself become RFC 9457 problem+json here, 405s included. httplib.h is
-// kept out of this header (docs/DEPENDENCIES.md): its types are only declared.
+// kept out of this header (server/httplib_forward.h).
 #pragma once
 
 #include <set>
 #include <string>
 #include <string_view>
 
+#include "server/httplib_forward.h"
 #include "server/service_error.h"
-
-namespace httplib {
-struct Request;
-struct Response;
-}  // namespace httplib
 
 namespace photond::service {
 

@@ -5,17 +5,14 @@
 // server/http_server.cpp registers them by operation id beside its own handlers, with the same
 // token check and error handling.
 //
-// httplib.h stays out of this header (see server/http_server.h); its two types are declared.
+// httplib.h stays out of this header (server/httplib_forward.h).
 #pragma once
 
 #include <functional>
 #include <map>
 #include <string>
 
-namespace httplib {
-struct Request;
-struct Response;
-}  // namespace httplib
+#include "server/httplib_forward.h"
 
 namespace photond::service {
 
