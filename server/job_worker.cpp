@@ -65,8 +65,8 @@ void JobManager::worker_loop() {
         }
         if (!thrown.empty()) fail_after_exception(entry, thrown);
         // A job's scene, acceleration structure and buffers are freed when it ends, but glibc
-        // keeps freed memory of its many arenas mapped: the daemon's RSS grew by about 1.4 MB per
-        // finished job (a thousand 1x1 jobs: +1.4 GB), all of it handed back by malloc_trim.
+        // keeps freed memory of its many arenas mapped: the daemon's RSS grew with every finished
+        // job (README.md, "Measured"), all of it handed back by malloc_trim.
         malloc_trim(0);
         std::lock_guard lock(mutex_);
         running_.reset();

@@ -20,7 +20,7 @@ constexpr int kMaxPointsPerPixel = 8;
 // lines onto edges of the scene (cornell-box: its corner edges lie exactly on the diagonals of a
 // square image), and a ray through an edge hits one face or the other as rounding decides: the
 // record there takes either face's normal, and every record after it follows (the scene scaled by
-// 1.0000001 changed the image by relMSE 0.002). Unequal offsets whose sum is no integer keep every
+// 1.0000001 changed the image visibly). Unequal offsets whose sum is no integer keep every
 // candidate off those lines, by about 100 float steps of the coordinates in cornell-box.
 constexpr float kCandidateX = 0.5f + 1.0f / 1024.0f;
 constexpr float kCandidateY = 0.5f + 1.0f / 2048.0f;

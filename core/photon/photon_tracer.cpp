@@ -33,8 +33,8 @@ struct TracedPhoton {
 
 /// Traced photons of one chunk. oneTBB's scalable allocator keeps freed blocks for reuse, where
 /// glibc hands them back to the kernel: the next photon pass (another job in the daemon) then
-/// writes into memory already mapped instead of taking a page fault every 73 photons (faults
-/// were a third of tracing time on a virtual machine where each costs 13 us).
+/// writes into memory already mapped instead of taking a page fault every few dozen photons
+/// (on virtual machines, where faults are dear, they were a large share of tracing time).
 /// Under AddressSanitizer the standard allocator, whose blocks the sanitizer guards.
 #if defined(__SANITIZE_ADDRESS__)
 using TracedPhotons = std::vector<TracedPhoton>;
@@ -217,8 +217,8 @@ std::shared_ptr<const PhotonMap> precompute_irradiance(const PhotonMap& global, 
 }
 
 std::shared_ptr<const PhotonMap> finish_map(MapBuilder& builder) {
-    // Packing is about 90 ns a photon (the direction's acos and atan2): in parallel, each part
-    // into its own range.
+    // Packing costs an acos and an atan2 a photon (the direction): in parallel, each part into
+    // its own range.
     std::vector<size_t> offsets(builder.parts.size() + 1, 0);
     for (size_t i = 0; i < builder.parts.size(); ++i) offsets[i + 1] = offsets[i] + builder.parts[i].size();
     std::vector<Photon> packed(builder.count);
