@@ -143,6 +143,7 @@ bench: build
 	$(BUILD)/bench/kd_tree_bench
 	$(BUILD)/bench/http_bench
 	$(BUILD)/bench/schedule_simulation cornell-box-diffuse 512 512 3
+	python3 bench/photon_series.py --photond $(BUILD)/server/photond
 	python3 bench/run_benchmark.py --photond $(BUILD)/server/photond $(BENCH_ARGS)
 	python3 bench/gltf_samples.py --photond $(BUILD)/server/photond
 
