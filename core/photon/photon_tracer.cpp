@@ -176,15 +176,31 @@ uint32_t spread_bits(uint32_t v) {
     return v;
 }
 
+/// Where irradiance is precomputed: a global photon's position and surface normal.
+struct IrradianceSite {
+    Vec3 position;
+    Vec3 normal;
+};
+
+/// Every stride-th traced photon of `traced`, in photon order, as an irradiance site. Kept apart
+/// so that the traced photons (56 bytes each) can be freed before the kd-tree is built.
+std::vector<IrradianceSite> irradiance_sites(const MapBuilder& traced, uint32_t stride) {
+    std::vector<IrradianceSite> sites;
+    if (stride == 0) return sites;
+    sites.reserve((traced.count + stride - 1) / stride);
+    traced.for_each_strided(stride, [&](const TracedPhoton& t) { sites.push_back({t.position, t.normal}); });
+    return sites;
+}
+
 /// The indices of `sites` sorted by the Morton code of their positions in the sites' bounds
 /// (ties by index, so the order is the same on every run).
-std::vector<uint32_t> morton_order(const std::vector<const TracedPhoton*>& sites) {
+std::vector<uint32_t> morton_order(const std::vector<IrradianceSite>& sites) {
     Bounds3 bounds;
-    for (const TracedPhoton* t : sites) bounds.extend(t->position);
+    for (const IrradianceSite& site : sites) bounds.extend(site.position);
     const Vec3 extent = glm::max(bounds.extent(), Vec3(1e-30f));
     std::vector<std::pair<uint32_t, uint32_t>> keyed(sites.size());
     tbb::parallel_for(size_t(0), sites.size(), [&](size_t i) {
-        const Vec3 cell = glm::clamp((sites[i]->position - bounds.lower) / extent, 0.0f, 1.0f) * 1023.0f;
+        const Vec3 cell = glm::clamp((sites[i].position - bounds.lower) / extent, 0.0f, 1.0f) * 1023.0f;
         const uint32_t code = (spread_bits(static_cast<uint32_t>(cell.x)) << 2) |
                               (spread_bits(static_cast<uint32_t>(cell.y)) << 1) | spread_bits(static_cast<uint32_t>(cell.z));
         keyed[i] = {code, static_cast<uint32_t>(i)};
@@ -195,13 +211,10 @@ std::vector<uint32_t> morton_order(const std::vector<const TracedPhoton*>& sites
     return order;
 }
 
-/// Irradiance at every stride-th global photon (in photon order), estimated from the global map,
-/// packed as photons whose flux is the irradiance and whose direction is the surface normal.
-std::shared_ptr<const PhotonMap> precompute_irradiance(const PhotonMap& global, const MapBuilder& traced,
+/// Irradiance at each site, estimated from the global map, packed as photons whose flux is the
+/// irradiance and whose direction is the surface normal.
+std::shared_ptr<const PhotonMap> precompute_irradiance(const PhotonMap& global, const std::vector<IrradianceSite>& sites,
                                                        const PhotonTracingSettings& settings, float max_radius) {
-    std::vector<const TracedPhoton*> sites;
-    sites.reserve((traced.count + settings.irradiance_stride - 1) / settings.irradiance_stride);
-    traced.for_each_strided(settings.irradiance_stride, [&](const TracedPhoton& t) { sites.push_back(&t); });
     std::vector<Photon> points(sites.size());
     // Estimated in spatial (Morton) order rather than photon order: neighbouring estimates then
     // walk the same kd-tree nodes and photons while they are in cache. Each estimate is
@@ -209,13 +222,15 @@ std::shared_ptr<const PhotonMap> precompute_irradiance(const PhotonMap& global, 
     const std::vector<uint32_t> order = morton_order(sites);
     tbb::parallel_for(size_t(0), sites.size(), [&](size_t j) {
         const size_t i = order[j];
-        const TracedPhoton& t = *sites[i];
-        const Color e = global.estimate_irradiance(t.position, t.normal, settings.k_irradiance, max_radius);
-        points[i] = make_photon(t.position, t.normal, e, 0, t.normal);
+        const IrradianceSite& site = sites[i];
+        const Color e = global.estimate_irradiance(site.position, site.normal, settings.k_irradiance, max_radius);
+        points[i] = make_photon(site.position, site.normal, e, 0, site.normal);
     });
     return std::make_shared<const PhotonMap>(std::move(points), 0);
 }
 
+/// Packs the traced photons into a map and builds its kd-tree; the traced photons are freed
+/// first, so that they and the tree's build do not take memory at the same time.
 std::shared_ptr<const PhotonMap> finish_map(MapBuilder& builder) {
     // Packing costs an acos and an atan2 a photon (the direction): in parallel, each part into
     // its own range.
@@ -228,6 +243,7 @@ std::shared_ptr<const PhotonMap> finish_map(MapBuilder& builder) {
         for (const TracedPhoton& p : builder.parts[i]) {
             *out++ = make_photon(p.position, p.direction, Color(DVec3(p.flux) * scale), p.flags, p.normal);
         }
+        TracedPhotons().swap(builder.parts[i]);
     });
     return std::make_shared<const PhotonMap>(std::move(packed), builder.emitted);
 }
@@ -357,6 +373,7 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
     stats.caustic_complete = caustic.complete;
 
     const Clock::time_point build_start = Clock::now();
+    const std::vector<IrradianceSite> sites = irradiance_sites(global, global.target > 0 ? settings.irradiance_stride : 0);
     arena.execute([&] {
         tbb::parallel_invoke([&] { if (global.target > 0) maps.global = finish_map(global); },
                              [&] { if (caustic.target > 0) maps.caustic = finish_map(caustic); });
@@ -365,7 +382,7 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
     if (maps.global && settings.irradiance_stride > 0) {
         const Clock::time_point irradiance_start = Clock::now();
         const float max_radius = kIrradianceRadiusShare * rs.scene->bounds.radius();
-        arena.execute([&] { maps.irradiance = precompute_irradiance(*maps.global, global, settings, max_radius); });
+        arena.execute([&] { maps.irradiance = precompute_irradiance(*maps.global, sites, settings, max_radius); });
         stats.irradiance_photons = maps.irradiance->size();
         stats.irradiance_seconds = std::chrono::duration<double>(Clock::now() - irradiance_start).count();
     }
