@@ -4,6 +4,8 @@
 #include <cctype>
 #include <cmath>
 #include <regex>
+#include <type_traits>
+#include <utility>
 
 #include "core/scene/builtin_scenes.h"
 #include "core/util/path_containment.h"
@@ -520,50 +522,45 @@ json render_cache_key_schema() {
 
 using PresetDefaults = std::array<std::string_view, kPresetNames.size()>;
 
+/// A field kept as it is in its member: `read(value, path)` checks the value and returns it as
+/// the member's type; the writer writes the member.
+template <typename Access, typename Read>
+JobField value_field(std::string_view path, Access access, Read read, json schema, PresetDefaults defaults) {
+    return {.path = path,
+            .read = [access, read](const json& value, const std::string& at, Job& job) { access(job) = read(value, at); },
+            .write = [access](const Job& job) -> std::optional<json> { return json(access(job)); },
+            .schema = std::move(schema),
+            .preset_defaults = defaults};
+}
+
 template <typename Access>
 JobField integer_field(std::string_view path, Access access, const IntegerRange& range, std::string description,
                        PresetDefaults defaults) {
-    return {.path = path,
-            .read = [access, range](const json& value, const std::string& at, Job& job) {
-                auto& member = access(job);
-                member = read_integer<std::remove_reference_t<decltype(member)>>(value, at, range);
-            },
-            .write = [access](const Job& job) -> std::optional<json> { return json(access(job)); },
-            .schema = integer_schema(range, std::move(description)),
-            .preset_defaults = defaults};
+    using Integer = std::remove_cvref_t<decltype(access(std::declval<Job&>()))>;
+    return value_field(
+        path, access, [range](const json& value, const std::string& at) { return read_integer<Integer>(value, at, range); },
+        integer_schema(range, std::move(description)), defaults);
 }
 
 template <typename Access>
 JobField number_field(std::string_view path, Access access, const NumberRange& range, std::string description,
                       PresetDefaults defaults) {
-    return {.path = path,
-            .read = [access, range](const json& value, const std::string& at, Job& job) {
-                access(job) = read_number(value, at, range);
-            },
-            .write = [access](const Job& job) -> std::optional<json> { return json(access(job)); },
-            .schema = number_schema(range, std::move(description)),
-            .preset_defaults = defaults};
+    return value_field(
+        path, access, [range](const json& value, const std::string& at) { return read_number(value, at, range); },
+        number_schema(range, std::move(description)), defaults);
 }
 
 template <typename Access>
 JobField bool_field(std::string_view path, Access access, std::string description, PresetDefaults defaults) {
-    return {.path = path,
-            .read = [access](const json& value, const std::string& at, Job& job) { access(job) = read_bool(value, at); },
-            .write = [access](const Job& job) -> std::optional<json> { return json(access(job)); },
-            .schema = bool_schema(std::move(description)),
-            .preset_defaults = defaults};
+    return value_field(path, access, read_bool, bool_schema(std::move(description)), defaults);
 }
 
 template <typename Access>
 JobField choice_field(std::string_view path, Access access, std::span<const std::string_view> choices,
                       std::string description, PresetDefaults defaults) {
-    return {.path = path,
-            .read = [access, choices](const json& value, const std::string& at, Job& job) {
-                access(job) = read_choice(value, at, choices);
-            },
-            .write = [access](const Job& job) -> std::optional<json> { return json(access(job)); },
-            .schema = choice_schema(choices, std::move(description)),
-            .preset_defaults = defaults};
+    return value_field(
+        path, access, [choices](const json& value, const std::string& at) { return read_choice(value, at, choices); },
+        choice_schema(choices, std::move(description)), defaults);
 }
 
 /// An optional member: absent from the document when unset.
