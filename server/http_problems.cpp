@@ -56,28 +56,10 @@ void write_problem(Response& res, const ServiceError& error, const Request& req)
 }
 
 ErrorKind kind_of_status(int status) {
-    switch (status) {
-        case 400:
-            return ErrorKind::MalformedRequest;
-        case 401:
-            return ErrorKind::Unauthorized;
-        case 404:
-            return ErrorKind::NotFound;
-        case 405:
-            return ErrorKind::MethodNotAllowed;
-        case 409:
-            return ErrorKind::Conflict;
-        case 413:
-            return ErrorKind::PayloadTooLarge;
-        case 422:
-            return ErrorKind::InvalidField;
-        case 429:
-            return ErrorKind::QueueFull;
-        case 503:
-            return ErrorKind::Unavailable;
-        default:
-            return ErrorKind::Internal;
-    }
+    // The inverse of http_status (server/service_error.h), from it rather than a second table.
+    for (int k = 0; k <= static_cast<int>(ErrorKind::Unavailable); ++k)
+        if (http_status(static_cast<ErrorKind>(k)) == status) return static_cast<ErrorKind>(k);
+    return ErrorKind::Internal;
 }
 
 ServiceError method_not_allowed(const std::string& method, const std::set<std::string>& methods) {

@@ -21,7 +21,7 @@ enum class ErrorKind {
     InvalidField,      // 422: a job field (or an upload) is invalid; `field` names it
     QueueFull,         // 429: Retry-After says when to try again
     Internal,          // 500
-    Unavailable,       // 503: shutting down, or not ready
+    Unavailable,       // 503: shutting down, or not ready (the last kind: kind_of_status counts up to it)
 };
 
 /// The HTTP status code of a kind.
