@@ -20,6 +20,7 @@
 #include "protocol/job_status.h"
 #include "protocol/json_text.h"
 #include "server/http_problems.h"
+#include "server/parse_number.h"
 #include "server/http_thread_pool.h"
 #include "server/job_manager.h"
 #include "server/metrics.h"
@@ -57,14 +58,6 @@ void send_json(Response& res, const json& document, int status = 200) {
 
 void send_bytes(Response& res, std::vector<uint8_t> bytes, const char* type) {
     res.set_content(reinterpret_cast<const char*>(bytes.data()), bytes.size(), type);
-}
-
-template <class T>
-std::optional<T> parse_number(std::string_view text) {
-    T value{};
-    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (error != std::errc() || end != text.data() + text.size()) return std::nullopt;
-    return value;
 }
 
 bool is_true(const std::string& value) { return value == "true" || value == "1" || value == "yes"; }

@@ -2,12 +2,12 @@
 
 #include <httplib.h>
 
-#include <charconv>
 #include <cstdio>
 #include <optional>
 
 #include "server/http_server.h"
 #include "server/job_layer_exr.h"
+#include "server/parse_number.h"
 #include "server/service_error.h"
 #include "server/tile_png.h"
 #include "server/web_assets.h"
@@ -55,21 +55,15 @@ void web_asset(const HttpServices&, const Request& req, Response& res) {
 }
 
 void job_tile_png(const HttpServices& services, const Request& req, Response& res) {
-    auto index = [](const std::string& text) {
-        int value = -1;
-        const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-        return error == std::errc() && end == text.data() + text.size() ? value : -1;
-    };
-    const protocol::TileIndex tile{index(req.matches[2].str()), index(req.matches[3].str())};
+    const protocol::TileIndex tile{parse_number<int>(req.matches[2].str()).value_or(-1),
+                                   parse_number<int>(req.matches[3].str()).value_or(-1)};
     std::optional<float> exposure_ev;
     if (req.has_param("exposure_ev")) {
         const std::string text = req.get_param_value("exposure_ev");
-        float value = 0.0f;
-        const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-        if (text.empty() || error != std::errc() || end != text.data() + text.size())
+        exposure_ev = parse_number<float>(text);
+        if (!exposure_ev)
             throw ServiceError(ErrorKind::MalformedRequest,
                                "exposure_ev: expected a number of stops, got '" + text + "'");
-        exposure_ev = value;
     }
     TilePng png = make_tile_png(services.jobs, req.matches[1], tile, exposure_ev);
     char exposure[32];
