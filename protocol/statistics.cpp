@@ -45,7 +45,11 @@ nlohmann::json to_json(const RenderStatistics& s) {
             {"caustic_complete", p.caustic_complete},
             {"map_bytes", s.photon_map_bytes},
             {"caustic_flux_share", s.caustic_flux_share},
+            {"caustic_dropped", p.caustic_dropped},
+            {"caustic_points", s.caustic_points},
+            {"caustic_skipped", s.caustic_skipped},
         };
+        if (p.caustic_tested) result["photons"]["caustic_peak_ratio"] = p.caustic_peak_ratio;
         if (!s.photon_cache.empty()) result["photons"]["cache"] = s.photon_cache;
         if (!s.photon_map_key.empty()) result["photons"]["key"] = s.photon_map_key;
     }

@@ -43,7 +43,8 @@ bool PhotonMapFiles::same_content(const Value& a, const Value& b) {
         return x->emitted() == y->emitted() && p.size() == q.size() &&
                std::memcmp(p.data(), q.data(), p.size_bytes()) == 0;
     };
-    return same(a.global, b.global) && same(a.caustic, b.caustic) && same(a.irradiance, b.irradiance);
+    return same(a.global, b.global) && same(a.caustic, b.caustic) && same(a.irradiance, b.irradiance) &&
+           same(a.caustic_irradiance, b.caustic_irradiance);
 }
 
 Expected<std::shared_ptr<const PhotonMaps>> PhotonMapCache::get_or_build(

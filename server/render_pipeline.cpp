@@ -140,6 +140,21 @@ Expected<std::shared_ptr<const PhotonMaps>> build_photon_maps(const protocol::Re
             d.reason += text;
         }
     }
+    if (maps->statistics.caustic_dropped) {
+        // Not a warning either: the caustic would change no pixel by as much as its threshold.
+        for (PassDecision& d : stats.plan) {
+            if (d.pass != "caustic_map") continue;
+            char text[320];
+            std::snprintf(text, sizeof text,
+                          "; dropped after %llu photons (%.1f M emitted): where they land the caustic is at most "
+                          "%.2g %% of the irradiance, under %.2g %%, so it would not show",
+                          static_cast<unsigned long long>(maps->statistics.stored_caustic),
+                          static_cast<double>(maps->statistics.emitted_caustic) * 1e-6,
+                          100.0 * maps->statistics.caustic_peak_ratio, 100.0 * kInvisibleCausticRatio);
+            d.enabled = false;
+            d.reason += text;
+        }
+    }
     if (settings.caustic_photons > 0 && maps->statistics.stored_caustic == 0) {
         for (PassDecision& d : stats.plan) {
             if (d.pass != "caustic_map") continue;
@@ -183,8 +198,8 @@ Expected<std::unique_ptr<Integrator>> make_integrator(const protocol::RenderSett
 
 bool caustic_stopped_as_negligible(const PhotonTracingStatistics& photons, const PhotonTracingSettings& settings) {
     // Stopped short of the emission cap with photons in it: the negligible-share rule did it.
-    return settings.caustic_photons > 0 && !photons.caustic_complete && photons.stored_caustic > 0 &&
-           photons.emitted_caustic <
+    return settings.caustic_photons > 0 && !photons.caustic_complete && !photons.caustic_dropped &&
+           photons.stored_caustic > 0 && photons.emitted_caustic <
                static_cast<uint64_t>(settings.caustic_photons) * settings.max_emitted_per_stored;
 }
 
@@ -218,8 +233,8 @@ std::vector<std::string> incomplete_photon_map_warnings(const PhotonTracingStati
                            grouped(settings.max_emitted_per_stored) + " per requested photon): " + consequence);
     };
     // An empty caustic map is not incomplete: no light focuses (the plan's reason says so).
-    if (settings.caustic_photons > 0 && !photons.caustic_complete && photons.stored_caustic > 0 &&
-        !caustic_stopped_as_negligible(photons, settings))
+    if (settings.caustic_photons > 0 && !photons.caustic_complete && !photons.caustic_dropped &&
+        photons.stored_caustic > 0 && !caustic_stopped_as_negligible(photons, settings))
         incomplete("caustic", photons.stored_caustic, settings.caustic_photons, photons.emitted_caustic,
                    "little light reaches a diffuse surface through the specular ones, so its caustics are noisy. "
                    "Set photons.caustic=0 to skip the caustic map, or give the scene more specular surfaces in "
@@ -518,6 +533,8 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     stats.passes.push_back({"render", stats.render_seconds});
     stats.rays += rendered.counters.rays;
     stats.shadow_rays += rendered.counters.shadow_rays;
+    stats.caustic_points = rendered.counters.caustic_points;
+    stats.caustic_skipped = rendered.counters.caustic_skipped;
     if (stats.irradiance_cache) {
         stats.irradiance_cache->lookups = rendered.counters.irradiance_lookups;
         stats.irradiance_cache->misses = rendered.counters.irradiance_misses;

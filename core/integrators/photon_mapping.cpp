@@ -162,6 +162,24 @@ Color PhotonMapIntegrator::indirect_irradiance(const DiffusePoint& point, Sample
     return g.irradiance;
 }
 
+/// Whether the caustic map's estimate at a visible point may add light that shows, next to the
+/// luminance `other` of what the point sends otherwise (emission, direct and indirect light). A
+/// surface that reads as diffuse reflects its irradiance whatever its direction, so its caustic
+/// is about rho(wo) / pi times the caustic irradiance precomputed at the nearest caustic photon:
+/// where that is under kInvisibleCausticRatio of `other`, the estimate (a hundred photons, each
+/// through the BSDF) is skipped. Each skipped sample leaves out under that share of its own value,
+/// so no pixel changes by more. No caustic photon within the estimate's radius means next to none
+/// would be found. Glossy and translucent surfaces are always estimated: their lobes can gather a
+/// caustic that is faint as irradiance into a highlight.
+bool PhotonMapIntegrator::caustic_may_show(const Vec3& p, const Vec3& normal, const Bsdf& bsdf, const Vec3& wo,
+                                           float other) const {
+    if (!maps_->caustic_irradiance || !bsdf.reads_as_diffuse() || bsdf.transmits_non_delta()) return true;
+    Color irradiance;
+    if (!maps_->caustic_irradiance->nearest_irradiance(p, normal, caustic_options_.max_radius, &irradiance)) return false;
+    const float caustic = luminance(bsdf.diffuse_like_reflectance(wo) * kInvPi * irradiance);
+    return caustic >= static_cast<float>(kInvisibleCausticRatio) * other;
+}
+
 RadianceParts PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_length,
                                                   RayFootprint footprint, SampleContext& context) const {
     const RenderScene& rs = *scene_;
@@ -190,9 +208,6 @@ RadianceParts PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, flo
         // their photons by the mapped normal (RadianceEstimateOptions::shading_normal; README).
         const bool front = glm::dot(si.surface_normal, wo) >= 0.0f;
         const Vec3 normal = front ? si.surface_normal : -si.surface_normal;
-        if (maps_->caustic)
-            radiance.add_caustic(maps_->caustic->estimate_radiance(si.p, normal, bsdf, wo,
-                                                                   estimate_options_at(caustic_options_, si, bsdf, front)));
         if (gatherer_) {
             const Color rho = bsdf.diffuse_reflectance(wo);
             if (max_component(rho) > 0.0f) {
@@ -257,6 +272,15 @@ RadianceParts PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, flo
         } else if (maps_->global) {
             radiance.add_indirect(maps_->global->estimate_radiance(si.p, normal, bsdf, wo,
                                                                    estimate_options_at(global_options_, si, bsdf, front)));
+        }
+        // Last, so that what the point sends otherwise is known (caustic_may_show).
+        if (maps_->caustic) {
+            ++context.counters.caustic_points;
+            if (caustic_may_show(si.p, normal, bsdf, wo, luminance(radiance.total)))
+                radiance.add_caustic(maps_->caustic->estimate_radiance(si.p, normal, bsdf, wo,
+                                                                       estimate_options_at(caustic_options_, si, bsdf, front)));
+            else
+                ++context.counters.caustic_skipped;
         }
     }
     if (bsdf.has_delta() && depth < settings_.max_specular_depth) {

@@ -38,9 +38,10 @@ struct PhotonMapIntegratorSettings {
 /// inputs: every cached render cache then misses.
 inline constexpr uint32_t kRenderCacheAlgorithmVersion = 1;
 
-/// Default search radius caps as a share of the scene's bounding radius.
+/// Default search radius caps as a share of the scene's bounding radius (the caustic map's is
+/// the photon pass's, which tests the map's visibility with it: core/photon/photon_tracer.h).
 inline constexpr float kDefaultGlobalRadiusShare = 0.2f;
-inline constexpr float kDefaultCausticRadiusShare = 0.05f;
+inline constexpr float kDefaultCausticRadiusShare = kCausticRadiusShare;
 
 class PhotonMapIntegrator final : public Integrator {
 public:
@@ -84,6 +85,7 @@ private:
     RadianceParts radiance_along(const Ray& ray, int depth, float path_length, RayFootprint footprint,
                                  SampleContext& context) const;
     Color indirect_irradiance(const DiffusePoint& point, SampleContext& context) const;
+    bool caustic_may_show(const Vec3& p, const Vec3& normal, const Bsdf& bsdf, const Vec3& wo, float other) const;
 
     std::shared_ptr<const RenderScene> scene_;
     std::shared_ptr<const PhotonMaps> maps_;

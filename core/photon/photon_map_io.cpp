@@ -19,7 +19,7 @@ constexpr size_t kChecksumSize = 32;
 
 // Fires when PhotonTracingStatistics gains a field: add it to the layout (and bump
 // kPhotonMapFormatVersion).
-static_assert(sizeof(PhotonTracingStatistics) == 88,
+static_assert(sizeof(PhotonTracingStatistics) == 104,
               "PhotonTracingStatistics changed: store the new field in photon_map_io");
 
 // ---- Writing ----------------------------------------------------------------------------------
@@ -80,7 +80,7 @@ bool read_key(ByteReader& in, std::string& key) {
 }
 
 bool read_statistics(ByteReader& in, PhotonTracingStatistics& s) {
-    uint64_t tracing_bits = 0, build_bits = 0, irradiance_bits = 0;
+    uint64_t tracing_bits = 0, build_bits = 0, irradiance_bits = 0, ratio_bits = 0;
     const bool ok = in.get_u64(s.emitted, "statistics.emitted") &&
                     in.get_u64(s.emitted_global, "statistics.emitted_global") &&
                     in.get_u64(s.emitted_caustic, "statistics.emitted_caustic") &&
@@ -92,10 +92,14 @@ bool read_statistics(ByteReader& in, PhotonTracingStatistics& s) {
                     in.get_u64(build_bits, "statistics.build_seconds") &&
                     in.get_u64(irradiance_bits, "statistics.irradiance_seconds") &&
                     in.get_flag(s.global_complete, "statistics.global_complete") &&
-                    in.get_flag(s.caustic_complete, "statistics.caustic_complete");
+                    in.get_flag(s.caustic_complete, "statistics.caustic_complete") &&
+                    in.get_flag(s.caustic_tested, "statistics.caustic_tested") &&
+                    in.get_u64(ratio_bits, "statistics.caustic_peak_ratio") &&
+                    in.get_flag(s.caustic_dropped, "statistics.caustic_dropped");
     s.tracing_seconds = std::bit_cast<double>(tracing_bits);
     s.build_seconds = std::bit_cast<double>(build_bits);
     s.irradiance_seconds = std::bit_cast<double>(irradiance_bits);
+    s.caustic_peak_ratio = std::bit_cast<double>(ratio_bits);
     return ok;
 }
 
@@ -155,7 +159,8 @@ Expected<PhotonMaps> deserialize_checked(std::span<const uint8_t> bytes,
     }
     PhotonMaps maps;
     if (!read_statistics(in, maps.statistics) || !read_map(in, "global", maps.global) ||
-        !read_map(in, "caustic", maps.caustic) || !read_map(in, "irradiance", maps.irradiance)) {
+        !read_map(in, "caustic", maps.caustic) || !read_map(in, "irradiance", maps.irradiance) ||
+        !read_map(in, "caustic irradiance", maps.caustic_irradiance)) {
         return Error{in.error()};
     }
     if (in.remaining() != 0) {
@@ -177,7 +182,8 @@ Expected<std::vector<uint8_t>> serialize_photon_maps(const PhotonMaps& maps,
         ByteWriter out;
         const size_t photons = (maps.global ? maps.global->size() : 0) +
                                (maps.caustic ? maps.caustic->size() : 0) +
-                               (maps.irradiance ? maps.irradiance->size() : 0);
+                               (maps.irradiance ? maps.irradiance->size() : 0) +
+                               (maps.caustic_irradiance ? maps.caustic_irradiance->size() : 0);
         out.reserve(256 + key.size() + photons * sizeof(Photon));
         out.put_bytes(kMagic.data(), kMagic.size());
         out.put_u32(kPhotonMapFormatVersion);
@@ -198,9 +204,13 @@ Expected<std::vector<uint8_t>> serialize_photon_maps(const PhotonMaps& maps,
         out.put_u64(std::bit_cast<uint64_t>(s.irradiance_seconds));
         out.put_u8(s.global_complete ? 1 : 0);
         out.put_u8(s.caustic_complete ? 1 : 0);
+        out.put_u8(s.caustic_tested ? 1 : 0);
+        out.put_u64(std::bit_cast<uint64_t>(s.caustic_peak_ratio));
+        out.put_u8(s.caustic_dropped ? 1 : 0);
         put_map(out, maps.global);
         put_map(out, maps.caustic);
         put_map(out, maps.irradiance);
+        put_map(out, maps.caustic_irradiance);
         const Sha256Digest checksum = sha256(out.bytes());
         out.put_bytes(checksum.data(), checksum.size());
         return std::move(out.bytes());

@@ -6,7 +6,9 @@
 #include <tbb/scalable_allocator.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <chrono>
+#include <limits>
 
 #include "core/math/rng.h"
 #include "core/shading/scene_queries.h"
@@ -211,10 +213,10 @@ std::vector<uint32_t> morton_order(const std::vector<IrradianceSite>& sites) {
     return order;
 }
 
-/// Irradiance at each site, estimated from the global map, packed as photons whose flux is the
+/// Irradiance at each site, estimated from `global` (the global map, or the caustic one), packed as photons whose flux is the
 /// irradiance and whose direction is the surface normal.
 std::shared_ptr<const PhotonMap> precompute_irradiance(const PhotonMap& global, const std::vector<IrradianceSite>& sites,
-                                                       const PhotonTracingSettings& settings, float max_radius) {
+                                                       uint32_t k, float max_radius) {
     std::vector<Photon> points(sites.size());
     // Estimated in spatial (Morton) order rather than photon order: neighbouring estimates then
     // walk the same kd-tree nodes and photons while they are in cache. Each estimate is
@@ -223,7 +225,7 @@ std::shared_ptr<const PhotonMap> precompute_irradiance(const PhotonMap& global, 
     tbb::parallel_for(size_t(0), sites.size(), [&](size_t j) {
         const size_t i = order[j];
         const IrradianceSite& site = sites[i];
-        const Color e = global.estimate_irradiance(site.position, site.normal, settings.k_irradiance, max_radius);
+        const Color e = global.estimate_irradiance(site.position, site.normal, k, max_radius);
         points[i] = make_photon(site.position, site.normal, e, 0, site.normal);
     });
     return std::make_shared<const PhotonMap>(std::move(points), 0);
@@ -246,6 +248,43 @@ std::shared_ptr<const PhotonMap> finish_map(MapBuilder& builder) {
         TracedPhotons().swap(builder.parts[i]);
     });
     return std::make_shared<const PhotonMap>(std::move(packed), builder.emitted);
+}
+
+/// The caustic map's visibility test (photon_tracer.h): the largest ratio, over the caustic
+/// photons at `sites`, of the caustic irradiance (`caustic`, k photons an estimate) to all the
+/// irradiance the global map finds there; infinity where the global map finds none.
+double caustic_peak_ratio(const PhotonMap& caustic, const PhotonMap& global, const std::vector<IrradianceSite>& sites,
+                          uint32_t k, const PhotonTracingSettings& settings, float scene_radius) {
+    std::vector<double> ratios(sites.size(), 0.0);
+    tbb::parallel_for(size_t(0), sites.size(), [&](size_t i) {
+        const IrradianceSite& site = sites[i];
+        const double e_caustic = luminance(
+            caustic.estimate_irradiance(site.position, site.normal, k, kCausticRadiusShare * scene_radius));
+        const double e_all = luminance(global.estimate_irradiance(site.position, site.normal, settings.k_irradiance,
+                                                                  kIrradianceRadiusShare * scene_radius));
+        if (e_caustic > 0.0) ratios[i] = e_all > 0.0 ? e_caustic / e_all : std::numeric_limits<double>::infinity();
+    });
+    double peak = 0.0;
+    for (const double r : ratios) peak = std::max(peak, r);
+    return peak;
+}
+
+/// The caustic photons traced so far packed into a map of their own (the traced ones stay), their
+/// flux divided by the `emitted` photons so far: the visibility test's map while tracing goes on.
+PhotonMap partial_map(const MapBuilder& builder, uint64_t emitted) {
+    std::vector<Photon> packed;
+    packed.reserve(builder.count);
+    const double scale = emitted > 0 ? 1.0 / static_cast<double>(emitted) : 0.0;
+    for (const TracedPhotons& part : builder.parts)
+        for (const TracedPhoton& p : part)
+            packed.push_back(make_photon(p.position, p.direction, Color(DVec3(p.flux) * scale), p.flags, p.normal));
+    return PhotonMap(std::move(packed), emitted);
+}
+
+/// Every n-th photon of `builder`, n chosen so that at most kCausticTestSites are taken.
+std::vector<IrradianceSite> caustic_test_sites(const MapBuilder& builder) {
+    const uint32_t stride = static_cast<uint32_t>(std::max<size_t>(1, (builder.count + kCausticTestSites - 1) / kCausticTestSites));
+    return irradiance_sites(builder, stride);
 }
 
 }  // namespace
@@ -275,6 +314,17 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
 
     PhotonMaps maps;
     PhotonTracingStatistics& stats = maps.statistics;
+    const float scene_radius = rs.scene->bounds.radius();
+    // The global map is built as soon as it is full when the caustic map goes on (its test needs
+    // it), else after tracing; the irradiance sites are taken before its traced photons go.
+    std::vector<IrradianceSite> sites;
+    double early_build_seconds = 0.0;  // the global map's build inside the tracing loop
+    const auto finish_global = [&] {
+        const Clock::time_point t = Clock::now();
+        sites = irradiance_sites(global, settings.irradiance_stride);
+        maps.global = finish_map(global);
+        return std::chrono::duration<double>(Clock::now() - t).count();
+    };
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
     uint64_t emitted = 0;
     bool cancelled = false;
@@ -354,10 +404,34 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
                 m->emitted = emitted;
             }
         }
+        // The global map full and the caustic map still collecting: build the global one now,
+        // and test whether the caustic light would show once the caustic map holds enough
+        // photons for estimates of its final radii (photon_tracer.h).
+        if (caustic.active && global.target > 0 && !global.active && !maps.global)
+            arena.execute([&] { early_build_seconds = finish_global(); });
+        const uint64_t needed_for_test =
+            (static_cast<uint64_t>(caustic.target) * kCausticTestMinPhotons + kCausticTestPhotons - 1) / kCausticTestPhotons;
+        if (caustic.active && maps.global && !stats.caustic_tested && caustic.count >= needed_for_test) {
+            const uint32_t k = static_cast<uint32_t>(std::clamp<uint64_t>(
+                (uint64_t(kCausticTestPhotons) * caustic.count + caustic.target / 2) / caustic.target,
+                kCausticTestMinPhotons, kCausticTestPhotons));
+            const PhotonMap partial = partial_map(caustic, emitted);
+            arena.execute([&] {
+                stats.caustic_peak_ratio =
+                    caustic_peak_ratio(partial, *maps.global, caustic_test_sites(caustic), k, settings, scene_radius);
+            });
+            stats.caustic_tested = true;
+            if (stats.caustic_peak_ratio < kInvisibleCausticRatio) {
+                stats.caustic_dropped = true;
+                caustic.active = false;
+                caustic.complete = false;
+                caustic.emitted = emitted;
+            }
+        }
     }
     if (cancelled) return Error{"photon pass: cancelled"};
     stats.emitted = emitted;
-    stats.tracing_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    stats.tracing_seconds = std::chrono::duration<double>(Clock::now() - start).count() - early_build_seconds;
     // An empty global map means no light reaches a diffuse surface: the image cannot be right.
     // An empty caustic map only means that no light focuses (PhotonTracingStatistics says so).
     if (global.target > 0 && global.count == 0) {
@@ -373,17 +447,42 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
     stats.caustic_complete = caustic.complete;
 
     const Clock::time_point build_start = Clock::now();
-    const std::vector<IrradianceSite> sites = irradiance_sites(global, global.target > 0 ? settings.irradiance_stride : 0);
+    // A caustic map not tested yet (it filled or stopped before the global map was full, or the
+    // global map came last) is tested whole, with the render's photons per estimate.
+    const bool test_at_end = caustic.target > 0 && caustic.count > 0 && global.target > 0 && !stats.caustic_tested;
+    const std::vector<IrradianceSite> caustic_sites = test_at_end ? caustic_test_sites(caustic) : std::vector<IrradianceSite>{};
+    const std::vector<IrradianceSite> caustic_irradiance_sites =
+        stats.caustic_dropped ? std::vector<IrradianceSite>{} : irradiance_sites(caustic, settings.irradiance_stride);
     arena.execute([&] {
-        tbb::parallel_invoke([&] { if (global.target > 0) maps.global = finish_map(global); },
-                             [&] { if (caustic.target > 0) maps.caustic = finish_map(caustic); });
+        tbb::parallel_invoke([&] { if (global.target > 0 && !maps.global) finish_global(); },
+                             [&] { if (caustic.target > 0 && !stats.caustic_dropped) maps.caustic = finish_map(caustic); });
     });
-    stats.build_seconds = std::chrono::duration<double>(Clock::now() - build_start).count();
+    if (test_at_end) {
+        const uint32_t k = static_cast<uint32_t>(std::min<uint64_t>(kCausticTestPhotons, caustic.count));
+        arena.execute([&] {
+            stats.caustic_peak_ratio = caustic_peak_ratio(*maps.caustic, *maps.global, caustic_sites, k, settings, scene_radius);
+        });
+        stats.caustic_tested = true;
+        if (stats.caustic_peak_ratio < kInvisibleCausticRatio) {
+            stats.caustic_dropped = true;
+            maps.caustic = nullptr;
+        }
+    }
+    stats.build_seconds = std::chrono::duration<double>(Clock::now() - build_start).count() + early_build_seconds;
     if (maps.global && settings.irradiance_stride > 0) {
         const Clock::time_point irradiance_start = Clock::now();
         const float max_radius = kIrradianceRadiusShare * rs.scene->bounds.radius();
-        arena.execute([&] { maps.irradiance = precompute_irradiance(*maps.global, sites, settings, max_radius); });
+        arena.execute([&] { maps.irradiance = precompute_irradiance(*maps.global, sites, settings.k_irradiance, max_radius); });
         stats.irradiance_photons = maps.irradiance->size();
+        // The caustic map's too, with the render's photons per caustic estimate: where it is a
+        // small part of the global one's, estimates at visible points may skip the caustic map.
+        if (maps.caustic && !caustic_irradiance_sites.empty()) {
+            arena.execute([&] {
+                maps.caustic_irradiance = precompute_irradiance(*maps.caustic, caustic_irradiance_sites, kCausticTestPhotons,
+                                                                kCausticRadiusShare * scene_radius);
+            });
+            stats.irradiance_photons += maps.caustic_irradiance->size();
+        }
         stats.irradiance_seconds = std::chrono::duration<double>(Clock::now() - irradiance_start).count();
     }
     return maps;

@@ -18,6 +18,15 @@
 // unbiased, and tracing on to fill it would cost the most time for the least light (a scene
 // lit by a sky, with small emitters near glossy surfaces, reached the emission cap after
 // 50 M photons for caustics a thousandth of a percent as bright as the rest).
+//
+// A caustic map is also dropped when its light would not show: once the global map is full (and
+// again when the caustic map ends), the caustic irradiance at up to kCausticTestSites of its
+// photons is compared with all the irradiance the global map finds there. Where the largest
+// ratio is under kInvisibleCausticRatio, adding the caustic changes no pixel by more than that,
+// while its estimates at every visible point would cost the most of the render pass (a sky-lit
+// scene of rough glass whose small emitters cast a caustic worth 0.2 % of the light where it
+// landed spent half its render there): the map is not built, tracing for it stops, and the
+// statistics say why (caustic_dropped, caustic_peak_ratio).
 #pragma once
 
 #include <atomic>
@@ -34,6 +43,19 @@ namespace photond {
 /// holds kCausticShareMinPhotons photons (enough for the share to be known to about 1/8).
 inline constexpr double kNegligibleCausticShare = 1e-4;
 inline constexpr uint64_t kCausticShareMinPhotons = 64;
+
+/// The caustic map's visibility test: the largest ratio of caustic irradiance to all irradiance
+/// at its photons under which the map is dropped, how many of its photons are tested, and the
+/// photons per caustic estimate at the map's final count (a partly filled map is estimated with
+/// proportionally fewer, so that the estimates' radii are the final map's; never fewer than
+/// kCausticTestMinPhotons, and the test waits until the map holds enough for that).
+inline constexpr double kInvisibleCausticRatio = 0.01;
+inline constexpr uint32_t kCausticTestSites = 1024;
+inline constexpr uint32_t kCausticTestPhotons = 100;
+inline constexpr uint32_t kCausticTestMinPhotons = 8;
+/// The caustic estimate's radius cap as a share of the scene's bounding radius (the render's
+/// default too: core/integrators/photon_mapping.h).
+inline constexpr float kCausticRadiusShare = 0.05f;
 
 struct PhotonTracingSettings {
     uint32_t global_photons = 200000;   // photons to store in the global map (0: no global map)
@@ -65,20 +87,28 @@ struct PhotonTracingStatistics {
     uint64_t irradiance_photons = 0;
     bool global_complete = true;     // false: the emission cap stopped it short
     bool caustic_complete = true;    // false: the emission cap, or a negligible share, stopped it
+    /// The caustic map's visibility test: whether it ran, its largest ratio of caustic to all
+    /// irradiance at the photons tested, and whether the map was dropped for it (then
+    /// PhotonMaps::caustic is null; stored_caustic and emitted_caustic say what was traced).
+    bool caustic_tested = false;
+    double caustic_peak_ratio = 0.0;
+    bool caustic_dropped = false;
 };
 
 /// Both maps of a scene; a map not asked for is null. `irradiance` holds precomputed irradiance
 /// at a subset of the global photons (photon flux = irradiance, direction and normal = surface
-/// normal).
+/// normal), `caustic_irradiance` the caustic map's at a subset of the caustic photons (with
+/// kCausticTestPhotons an estimate), when both maps exist.
 struct PhotonMaps {
     std::shared_ptr<const PhotonMap> global;
     std::shared_ptr<const PhotonMap> caustic;
     std::shared_ptr<const PhotonMap> irradiance;
+    std::shared_ptr<const PhotonMap> caustic_irradiance;
     PhotonTracingStatistics statistics;
 
     size_t bytes() const {
         return (global ? global->bytes() : 0) + (caustic ? caustic->bytes() : 0) +
-               (irradiance ? irradiance->bytes() : 0);
+               (irradiance ? irradiance->bytes() : 0) + (caustic_irradiance ? caustic_irradiance->bytes() : 0);
     }
 };
 

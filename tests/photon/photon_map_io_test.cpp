@@ -331,7 +331,15 @@ TEST(PhotonMapIo, RoundTripIsExact) {
     EXPECT_TRUE(
         same_photons(loaded->irradiance->tree().photons(), maps.irradiance->tree().photons()));
     EXPECT_EQ(loaded->irradiance->emitted(), maps.irradiance->emitted());
+    ASSERT_TRUE(maps.caustic_irradiance && loaded->caustic_irradiance);
+    EXPECT_TRUE(same_photons(loaded->caustic_irradiance->tree().photons(),
+                             maps.caustic_irradiance->tree().photons()));
     const PhotonTracingStatistics &a = loaded->statistics, &b = maps.statistics;
+    EXPECT_TRUE(b.caustic_tested);
+    EXPECT_GT(b.caustic_peak_ratio, kInvisibleCausticRatio);
+    EXPECT_EQ(a.caustic_tested, b.caustic_tested);
+    EXPECT_EQ(a.caustic_peak_ratio, b.caustic_peak_ratio);
+    EXPECT_EQ(a.caustic_dropped, b.caustic_dropped);
     EXPECT_EQ(a.emitted, b.emitted);
     EXPECT_EQ(a.emitted_global, b.emitted_global);
     EXPECT_EQ(a.emitted_caustic, b.emitted_caustic);
@@ -429,15 +437,16 @@ TEST(PhotonMapIo, ForeignDataIsRefused) {
 }
 
 TEST(PhotonMapIo, OtherVersionsAndPhotonSizesAreRefused) {
-    // Version 1 stored 20-byte photons without a normal.
-    for (uint32_t version : {0u, 1u, 3u, 1000u}) {
+    // Version 1 stored 20-byte photons without a normal; version 2 had no caustic visibility
+    // test and no precomputed caustic irradiance.
+    for (uint32_t version : {0u, 1u, 2u, 4u, 1000u}) {
         std::vector<uint8_t> bytes = cornell_bytes();
         for (int i = 0; i < 4; ++i) bytes[8 + i] = uint8_t(version >> (8 * i));
         reseal(bytes);  // a well-formed file of that version
         Expected<PhotonMaps> result = deserialize_photon_maps(bytes, kKey);
         ASSERT_FALSE(result);
         EXPECT_EQ(result.error().message, "unsupported photon-map format version " +
-                                              std::to_string(version) + " (this build reads 2)");
+                                              std::to_string(version) + " (this build reads 3)");
         EXPECT_EQ(read_photon_map_key(bytes), "");
     }
     std::vector<uint8_t> bytes = cornell_bytes();
@@ -461,7 +470,9 @@ TEST(PhotonMapIo, AResealedBrokenTreeIsRefused) {
     // The checksum is not a signature: a rewritten file with a valid checksum but an unsorted
     // tree still reaches the kd-tree checks and is refused.
     std::vector<uint8_t> bytes = cornell_bytes();
-    const size_t photons_start = 24 + kKey.size() + 82 + 17;
+    // Header and key, the statistics (10 u64, 3 flags, 1 u64, 1 flag), the global map's present
+    // flag, emitted and count.
+    const size_t photons_start = 24 + kKey.size() + 82 + 10 + 17;
     const PhotonKdTree& tree = cornell_maps().global->tree();
     const uint32_t root = tree.size() / 2;
     const uint32_t axis = tree.photon(root).split_axis();

@@ -174,16 +174,17 @@ TEST(PhotonTracer, LightsFacingAwayEndWithAMessageInsteadOfLooping) {
 }
 
 /// The closed room lit by a point light of intensity 1 at (0, 1, 0), over a square ideal mirror
-/// of side `side` facing it at y = -1: the mirror's caustic carries the light's flux times the
-/// mirror's solid angle over 4 pi, onto the diffuse walls.
-Scene room_with_a_mirror(float side) {
+/// of side `side` and reflectance `reflectance` (at normal incidence) facing it at y = -1: the
+/// mirror's caustic carries the light's flux times the mirror's solid angle over 4 pi (times the
+/// reflectance), onto the diffuse walls.
+Scene room_with_a_mirror(float side, float reflectance = 1.0f) {
     Scene scene = closed_room(0.8f, Vec3(0.0f, 1.0f, 0.0f), Color(1.0f));
     SceneBuilder builder("mirror room");
     for (const Material& m : scene.materials) builder.add_material(m);
     Material mirror;
     mirror.metallic = 1.0f;
     mirror.roughness = 0.0f;
-    mirror.base_color = Color(1.0f);
+    mirror.base_color = Color(reflectance);
     const uint32_t mirror_material = builder.add_material(mirror);
     MeshData room = make_box(Vec3(-2.0f), Vec3(2.0f));
     flip_orientation(room);
@@ -231,6 +232,52 @@ TEST(PhotonTracer, CausticMapCarryingNegligibleLightStopsEarlyAndStaysUnbiased) 
     EXPECT_TRUE(large->statistics.caustic_complete);
     EXPECT_EQ(large->statistics.stored_caustic, 5000u);
     EXPECT_GT(caustic_flux_share(*large), kNegligibleCausticShare);
+}
+
+TEST(PhotonTracer, CausticMapWhoseLightWouldNotShowIsDropped) {
+    PhotonTracingSettings settings;
+    settings.global_photons = 20000;
+    settings.caustic_photons = 20000;
+    // The large mirror reflecting everything: on the ceiling its caustic (the light's image 5
+    // away, 1 / 25 of the direct irradiance of the light 1 away, more towards the walls) is
+    // several percent of the light there: kept, and its irradiance precomputed.
+    const auto bright = trace_photons(*make_render_scene(room_with_a_mirror(1.0f)), settings);
+    ASSERT_TRUE(bright) << bright.error().message;
+    const PhotonTracingStatistics& b = bright->statistics;
+    EXPECT_TRUE(b.caustic_tested);
+    EXPECT_FALSE(b.caustic_dropped);
+    EXPECT_GT(b.caustic_peak_ratio, kInvisibleCausticRatio);
+    ASSERT_TRUE(bright->caustic);
+    ASSERT_TRUE(bright->caustic_irradiance);
+    EXPECT_EQ(bright->caustic_irradiance->size(), (bright->caustic->size() + 3) / 4);  // every 4th
+
+    // A mirror twice as wide reflecting 1 % (Schlick's Fresnel: more at grazing angles): its
+    // caustic is a few tenths of a percent of the light where it lands, though its share of all
+    // light (above 1e-4) keeps the negligible-share rule from stopping it. Tested once the global
+    // map is full, it is dropped: tracing for it stops there, and the global map is the one a
+    // job without caustics gets.
+    const auto dim = trace_photons(*make_render_scene(room_with_a_mirror(2.0f, 0.01f)), settings);
+    ASSERT_TRUE(dim) << dim.error().message;
+    const PhotonTracingStatistics& d = dim->statistics;
+    std::printf("caustic peak ratio: bright mirror %.4f, dim mirror %.6f (%llu of %u photons when dropped)\n",
+                b.caustic_peak_ratio, d.caustic_peak_ratio, static_cast<unsigned long long>(d.stored_caustic),
+                settings.caustic_photons);
+    EXPECT_TRUE(d.caustic_tested);
+    EXPECT_TRUE(d.caustic_dropped);
+    EXPECT_GT(d.caustic_peak_ratio, 0.0);
+    EXPECT_LT(d.caustic_peak_ratio, kInvisibleCausticRatio);
+    EXPECT_FALSE(dim->caustic);
+    EXPECT_FALSE(dim->caustic_irradiance);
+    EXPECT_LT(d.stored_caustic, settings.caustic_photons);
+    EXPECT_EQ(d.emitted, d.emitted_caustic) << "tracing stopped when the map was dropped";
+
+    settings.caustic_photons = 0;
+    const auto none = trace_photons(*make_render_scene(room_with_a_mirror(2.0f, 0.01f)), settings);
+    ASSERT_TRUE(none) << none.error().message;
+    ASSERT_EQ(none->global->size(), dim->global->size());
+    EXPECT_EQ(std::memcmp(none->global->tree().photons().data(), dim->global->tree().photons().data(),
+                          none->global->size() * sizeof(Photon)),
+              0);
 }
 
 TEST(PhotonTracer, SceneWithoutLightsIsRefused) {
