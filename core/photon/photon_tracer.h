@@ -44,6 +44,10 @@ namespace photond {
 inline constexpr double kNegligibleCausticShare = 1e-4;
 inline constexpr uint64_t kCausticShareMinPhotons = 64;
 
+/// How many irradiance sites a map gets at most before their stride widens (PhotonTracingSettings::
+/// irradiance_stride).
+inline constexpr size_t kMaxIrradianceSites = size_t(1) << 19;
+
 /// The caustic map's visibility test: the largest ratio of caustic irradiance to all irradiance
 /// at its photons under which the map is dropped, how many of its photons are tested, and the
 /// photons per caustic estimate at the map's final count (a partly filled map is estimated with
@@ -67,7 +71,8 @@ struct PhotonTracingSettings {
     /// scene). Maps that are partly filled are kept with what they have.
     uint32_t max_emitted_per_stored = 1000;
     /// Irradiance is precomputed at every n-th global photon (0: none), with k_irradiance
-    /// photons per estimate, for fast lookups at final-gather hits (Christensen 1999).
+    /// photons per estimate, for fast lookups at final-gather hits (Christensen 1999); in maps
+    /// of more than kMaxIrradianceSites times n photons, at fewer (photon_tracer.cpp).
     uint32_t irradiance_stride = 4;
     uint32_t k_irradiance = 50;
     int threads = 0;                    // 0 = every core
