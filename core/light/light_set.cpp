@@ -156,6 +156,7 @@ void LightSet::build_tree() {
     float tree_power = 0.0f;
     for (uint32_t i = 0; i < lights_.size(); ++i) {
         const Entry& e = lights_[i];
+        if (!(average(e.power) > 0.0f)) continue;  // never chosen, as by power (a needle spot, a black light)
         LightBounds b;
         switch (e.kind) {
             case LightKind::Directional:
