@@ -86,6 +86,7 @@ def make_reference(photond):
 
 
 def equal_time(photond, workdir, scene, integrator, spp, seeds, reference, width, height):
+    # Each seed's three renders run back to back, so that the machine's load falls on both alike.
     """The tree at `spp` against power at the samples of equal render time; medians."""
     rows = []
     for seed in seeds:
@@ -126,17 +127,23 @@ def main():
     print(run([bench, "large-city", args.photons, 3 if args.quick else 5]), end="", flush=True)
 
     with tempfile.TemporaryDirectory(prefix="photond-large-scene-") as workdir:
-        print(f"== large-city: the final preset at {WIDTH}x{HEIGHT}, medians of {args.repeats}", flush=True)
-        for selection in ("tree", "power"):
-            runs = [render(photond, workdir, "large-city", "photon-map", 0, seed, selection, WIDTH, HEIGHT,
-                           preset="final")[0] for seed in seeds]
-            names = ["scene", "acceleration", "photon_tracing", "irradiance_cache", "render"]
-            figures = {n: statistics.median(passes(s).get(n, 0.0) for s in runs) for n in names}
-            total = statistics.median(s["total_seconds"] for s in runs)
-            print(f"{selection:5s}: total {total:.2f} s (" +
-                  ", ".join(f"{n} {figures[n]:.2f} s" for n in names) + ")", flush=True)
-
         reference, floor = reference_mean(photond, REFERENCE_DIR, workdir)
+        print(f"== large-city: the final preset at {WIDTH}x{HEIGHT}, 2 threads, medians of {args.repeats}", flush=True)
+        runs = {"tree": [], "power": []}
+        for seed in seeds:  # interleaved, so that the machine's load falls on both alike
+            for selection in runs:
+                stats, image = render(photond, workdir, "large-city", "photon-map", 0, seed, selection, WIDTH, HEIGHT,
+                                      preset="final")
+                stats["relmse"] = relmse(photond, image, reference) if reference else float("nan")
+                runs[selection].append(stats)
+        names = ["scene", "acceleration", "photon_tracing", "irradiance_cache", "render"]
+        for selection, stats in runs.items():
+            figures = {n: statistics.median(passes(s).get(n, 0.0) for s in stats) for n in names}
+            total = statistics.median(s["total_seconds"] for s in stats)
+            error = statistics.median(s["relmse"] for s in stats)
+            print(f"{selection:5s}: total {total:.2f} s (" + ", ".join(f"{n} {figures[n]:.2f} s" for n in names) +
+                  f"), relMSE {error:.4f} against the path reference", flush=True)
+
         if reference is None:
             print(f"no reference under {REFERENCE_DIR.relative_to(REPO)}: run --make-reference", file=sys.stderr)
         else:
@@ -156,13 +163,14 @@ def main():
         if reference is not None:
             print(f"== cornell-box (one light, two triangles): tree against power, path 256x256 at 16 spp, "
                   f"medians of {args.repeats}", flush=True)
-            for selection in ("tree", "power"):
-                rows = []
-                for seed in seeds:
+            rows = {"tree": [], "power": []}
+            for seed in seeds:  # interleaved
+                for selection in rows:
                     stats, image = render(photond, workdir, "cornell-box", "path", 16, seed, selection, 256, 256)
-                    rows.append((passes(stats)["render"], relmse(photond, image, reference)))
-                print(f"{selection:5s}: {statistics.median(r[0] for r in rows):.2f} s, relMSE "
-                      f"{statistics.median(r[1] for r in rows):.4f}", flush=True)
+                    rows[selection].append((passes(stats)["render"], relmse(photond, image, reference)))
+            for selection, r in rows.items():
+                print(f"{selection:5s}: {statistics.median(x[0] for x in r):.2f} s, relMSE "
+                      f"{statistics.median(x[1] for x in r):.4f}", flush=True)
 
 
 if __name__ == "__main__":

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "bench/bare_embree.h"
+#include "core/math/rng.h"
 #include "core/photon/photon_tracer.h"
 #include "core/scene/builtin_scenes.h"
 
@@ -52,6 +53,38 @@ double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
     const size_t n = v.size();
     return n == 0 ? 0.0 : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
+}
+
+/// The cost of next-event estimation's light choice: nanoseconds per sample_incident (choice and
+/// a point on the light) at points spread over the scene's bounds, tree against power, medians.
+void light_choice_cost(const Scene& scene, int repetitions) {
+    const LightSet tree(scene, LightSelection::Tree), power(scene, LightSelection::Power);
+    Rng rng(17, 18);
+    std::vector<Vec3> points(1 << 16);
+    for (Vec3& p : points)
+        p = scene.bounds.lower + Vec3(rng.next_float(), rng.next_float(), rng.next_float()) * scene.bounds.extent();
+    const auto cost = [&](const LightSet& lights) {
+        Rng u(19, 20);
+        float sum = 0.0f;
+        const Clock::time_point start = Clock::now();
+        for (int pass = 0; pass < 8; ++pass) {
+            for (const Vec3& p : points) {
+                const std::optional<LightSample> s = lights.sample_incident(p, u.next_float(), u.next_vec2());
+                if (s) sum += s->pdf;
+            }
+        }
+        const double ns = seconds_since(start) * 1e9 / (8.0 * points.size());
+        if (sum == 12345.0f) std::printf("!");
+        return ns;
+    };
+    std::vector<double> tree_ns, power_ns;
+    for (int r = 0; r < repetitions; ++r) {
+        tree_ns.push_back(cost(tree));
+        power_ns.push_back(cost(power));
+    }
+    std::printf("light choice for next-event estimation (sample_incident), medians of %d: tree %.0f ns, power %.0f ns "
+                "a sample\n",
+                repetitions, median(tree_ns), median(power_ns));
 }
 
 int run(const std::string& name, uint32_t photons, int repetitions) {
@@ -96,6 +129,8 @@ int run(const std::string& name, uint32_t photons, int repetitions) {
                 "acceleration; peak RSS %.1f MiB after the build\n",
                 geometry_bytes(*scene) / 1048576.0, double(geometry_bytes(*scene)) / scene->triangles.size(),
                 rss_scene - rss_start, rss_accel - rss_scene, proc_status_mib("VmHWM"));
+
+    light_choice_cost(*scene, repetitions);
 
     // The photon pass on one core against bare Embree on the photons' rays, interleaved.
     const std::vector<Ray> rays = photon_rays(*rs, 1 << 17);

@@ -200,6 +200,7 @@ void LightSet::build_tree() {
     weights.back() = tree_power;
     tree_ = LightTree(bounds);
     tree_or_distant_ = DiscreteDistribution(weights);
+    tree_only_ = !tree_or_distant_.empty() && tree_or_distant_.probability(static_cast<uint32_t>(lights_.size())) == 1.0f;
 }
 
 std::optional<uint32_t> LightSet::choose_incident(const Vec3& p, float u_select, float* choice_pdf) const {
@@ -208,8 +209,9 @@ std::optional<uint32_t> LightSet::choose_incident(const Vec3& p, float u_select,
         const uint32_t index = selection_.sample(u_select, choice_pdf);
         return *choice_pdf > 0.0f ? std::optional<uint32_t>(index) : std::nullopt;
     }
-    float group_pdf = 0.0f, u_tree = 0.0f;
-    const uint32_t index = tree_or_distant_.sample(u_select, &group_pdf, &u_tree);
+    float group_pdf = 1.0f, u_tree = u_select;
+    const uint32_t index = tree_only_ ? static_cast<uint32_t>(lights_.size())
+                                      : tree_or_distant_.sample(u_select, &group_pdf, &u_tree);
     if (!(group_pdf > 0.0f)) return std::nullopt;
     if (index < lights_.size()) {
         *choice_pdf = group_pdf;
@@ -226,8 +228,8 @@ float LightSet::incident_choice_probability(uint32_t light, const Vec3& p) const
     if (selection_mode_ == LightSelection::Power) return selection_.probability(light);
     const int32_t in_tree = tree_index_of_light_[light];
     if (in_tree < 0) return tree_or_distant_.probability(light);
-    return tree_or_distant_.probability(static_cast<uint32_t>(lights_.size())) *
-           tree_.pmf(p, static_cast<uint32_t>(in_tree));
+    const float tree_share = tree_only_ ? 1.0f : tree_or_distant_.probability(static_cast<uint32_t>(lights_.size()));
+    return tree_share * tree_.pmf(p, static_cast<uint32_t>(in_tree));
 }
 
 std::optional<LightSample> LightSet::sample_incident(const Vec3& p, float u_select,

@@ -166,6 +166,7 @@ private:
     std::vector<uint32_t> tree_lights_;        // the tree's light i is lights_[tree_lights_[i]]
     std::vector<int32_t> tree_index_of_light_;  // -1: a distant light
     DiscreteDistribution tree_or_distant_;      // lights_.size() + 1 entries; the last: the tree
+    bool tree_only_ = false;                    // no distant light has power: the tree's share is 1
     Color total_power_{0.0f};
     Vec3 scene_center_{0.0f};
     float scene_radius_ = 0.0f;

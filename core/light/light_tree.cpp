@@ -95,24 +95,40 @@ LightBounds light_bounds_union(const LightBounds& a, const LightBounds& b) {
     return u;
 }
 
-float light_importance(const LightBounds& b, const Vec3& p) {
-    const Vec3 to_p = p - b.bounds.center();
+ImportanceBounds::ImportanceBounds(const LightBounds& b)
+    : center(b.bounds.center()),
+      radius2(0.25f * glm::dot(b.bounds.extent(), b.bounds.extent())),
+      radius(std::sqrt(radius2)),
+      intensity(b.intensity),
+      w(b.w),
+      cos_theta_o(std::clamp(b.cos_theta_o, -1.0f, 1.0f)),
+      sin_theta_o(safe_sqrt(1.0f - cos_theta_o * cos_theta_o)),
+      cos_theta_e(b.cos_theta_e),
+      two_sided(b.two_sided) {}
+
+float light_importance(const LightBounds& b, const Vec3& p) { return light_importance(ImportanceBounds(b), p); }
+
+float light_importance(const ImportanceBounds& b, const Vec3& p) {
+    const Vec3 to_p = p - b.center;
     const float d2 = glm::dot(to_p, to_p);
-    const Vec3 diagonal = b.bounds.extent();
-    const float radius2 = 0.25f * glm::dot(diagonal, diagonal);  // of the bounding sphere
     // Closer than the bounding sphere's radius, every light inside may be that close.
-    const float distance2 = std::max({d2, radius2, std::numeric_limits<float>::min()});
-    float cos_w = d2 > 0.0f ? glm::dot(b.w, to_p) / std::sqrt(d2) : 1.0f;
+    const float distance2 = std::max({d2, b.radius2, std::numeric_limits<float>::min()});
+    // A cone of every direction (point lights) reaches p at full strength: theta' = 0.
+    if (b.cos_theta_o <= -1.0f) return b.intensity / distance2;
+    const float inv_d = d2 > 0.0f ? 1.0f / std::sqrt(d2) : 0.0f;
+    float cos_w = d2 > 0.0f ? glm::dot(b.w, to_p) * inv_d : 1.0f;
     if (b.two_sided) cos_w = std::abs(cos_w);
     cos_w = std::clamp(cos_w, -1.0f, 1.0f);
+    // p's direction inside the cone: theta' = 0.
+    if (cos_w >= b.cos_theta_o) return b.intensity / distance2;
     const float sin_w = safe_sqrt(1.0f - cos_w * cos_w);
     // theta_b: the half-angle of the bounding sphere seen from p (everything, from inside it).
-    const float cos_b = d2 > radius2 ? safe_sqrt(1.0f - radius2 / d2) : -1.0f;
-    const float sin_b = safe_sqrt(1.0f - cos_b * cos_b);
-    const float sin_o = safe_sqrt(1.0f - b.cos_theta_o * b.cos_theta_o);
+    const bool outside = d2 > b.radius2;
+    const float sin_b = outside ? std::min(b.radius * inv_d, 1.0f) : 0.0f;
+    const float cos_b = outside ? safe_sqrt(1.0f - sin_b * sin_b) : -1.0f;
     // theta' = max(0, theta_w - theta_o - theta_b): the angle from the cone to p's direction.
-    const float cos_x = cos_sub_clamped(sin_w, cos_w, sin_o, b.cos_theta_o);
-    const float sin_x = sin_sub_clamped(sin_w, cos_w, sin_o, b.cos_theta_o);
+    const float cos_x = cos_sub_clamped(sin_w, cos_w, b.sin_theta_o, b.cos_theta_o);
+    const float sin_x = sin_sub_clamped(sin_w, cos_w, b.sin_theta_o, b.cos_theta_o);
     const float cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
     if (cos_p <= b.cos_theta_e) return 0.0f;
     return b.intensity * cos_p / distance2;
@@ -136,7 +152,7 @@ uint32_t LightTree::build(std::span<const LightBounds> all, std::vector<uint32_t
     nodes_.emplace_back();
     depth_ = std::max(depth_, depth);
     if (end - begin == 1) {
-        nodes_[index].bounds = all[lights[begin]];
+        nodes_[index].bounds = ImportanceBounds(all[lights[begin]]);
         nodes_[index].leaf = true;
         nodes_[index].light = lights[begin];
         trails_[lights[begin]] = trail;
@@ -195,7 +211,7 @@ uint32_t LightTree::build(std::span<const LightBounds> all, std::vector<uint32_t
                              return ca < cb || (ca == cb && a < b);
                          });
     }
-    nodes_[index].bounds = node_bounds;
+    nodes_[index].bounds = ImportanceBounds(node_bounds);
     build(all, lights, begin, middle, trail, depth + 1);
     const uint32_t second = build(all, lights, middle, end, trail | (uint64_t(1) << depth), depth + 1);
     nodes_[index].second_child = second;

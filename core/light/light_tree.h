@@ -51,6 +51,24 @@ LightBounds light_bounds_union(const LightBounds& a, const LightBounds& b);
 /// zero when theta' is beyond theta_e (no light in `b` can reach p).
 float light_importance(const LightBounds& b, const Vec3& p);
 
+/// LightBounds in the form light_importance reads at every node: centre, bounding radius, the
+/// cone's sine. Derived once per node when the tree is built.
+struct ImportanceBounds {
+    Vec3 center{0.0f};
+    float radius2 = 0.0f;  // squared radius of the bounding sphere (half the box's diagonal)
+    float radius = 0.0f;
+    float intensity = 0.0f;
+    Vec3 w{0.0f, 0.0f, 1.0f};
+    float cos_theta_o = 1.0f;
+    float sin_theta_o = 0.0f;
+    float cos_theta_e = 0.0f;
+    bool two_sided = false;
+
+    explicit ImportanceBounds(const LightBounds& b);
+    ImportanceBounds() = default;
+};
+float light_importance(const ImportanceBounds& b, const Vec3& p);
+
 class LightTree {
 public:
     LightTree() = default;
@@ -71,7 +89,7 @@ public:
 
 private:
     struct Node {
-        LightBounds bounds;
+        ImportanceBounds bounds;
         uint32_t second_child = 0;  // interior nodes: the first child is the next node
         uint32_t light = 0;         // leaves: the light's index
         bool leaf = false;
