@@ -144,6 +144,7 @@ bench: build
 	$(BUILD)/bench/http_bench
 	$(BUILD)/bench/schedule_simulation cornell-box-diffuse 512 512 3
 	python3 bench/photon_series.py --photond $(BUILD)/server/photond
+	python3 bench/large_scene.py --photond $(BUILD)/server/photond
 	python3 bench/run_benchmark.py --photond $(BUILD)/server/photond $(BENCH_ARGS)
 	python3 bench/gltf_samples.py --photond $(BUILD)/server/photond
 

@@ -49,31 +49,6 @@ void BM_PhotonTracing(benchmark::State& state) {
     state.counters["rays_per_s"] = benchmark::Counter(static_cast<double>(rays), benchmark::Counter::kIsRate);
 }
 
-/// The rays photon tracing cast, rebuilt from a global map's photons: each photon's incoming ray
-/// from the surface it left (found by a ray cast back along its direction) to where it landed.
-std::vector<Ray> photon_rays(const RenderScene& rs, size_t count) {
-    PhotonTracingSettings settings;
-    settings.global_photons = static_cast<uint32_t>(count);
-    settings.caustic_photons = 0;
-    settings.irradiance_stride = 0;
-    const PhotonMaps maps = trace_photons(rs, settings).value();
-    std::vector<Ray> rays;
-    for (const Photon& photon : maps.global->tree().photons()) {
-        const Vec3 d = photon.direction();
-        const Vec3 n = photon.normal();
-        const std::optional<Hit> back = rs.tracer->intersect({rs.tracer->offset_origin(photon.position, n, -d), -d});
-        if (!back) continue;
-        const Vec3 left = rs.tracer->offset_origin(photon.position - back->t * d,
-                                                   rs.scene->triangle_normal(back->triangle), d);
-        rays.push_back(Ray{left, d});
-    }
-    // The map keeps its photons in kd-tree order, which is spatially sorted; tracing casts them
-    // in emission order, with no coherence. Shuffle (a fixed permutation) to match that.
-    Rng rng(5, 6);
-    for (size_t i = rays.size(); i > 1; --i) std::swap(rays[i - 1], rays[rng.next_u32() % i]);
-    return rays;
-}
-
 /// The benchmark loop of bare Embree over `rays`, reporting rays_per_s.
 void cast_bare(benchmark::State& state, const RenderScene& rs, const std::vector<Ray>& rays) {
     RTCScene scene = rs.tracer->handle();

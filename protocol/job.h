@@ -77,6 +77,8 @@ inline constexpr std::array<std::string_view, 3> kPresetNames{"preview", "final"
 inline constexpr std::string_view kDefaultPreset = "final";
 inline constexpr std::array<std::string_view, 3> kIntegratorNames{"photon-map", "path", "direct"};
 inline constexpr std::array<std::string_view, 2> kPixelTypeNames{"half", "float"};
+/// light_sampling.selection: LightSelection (core/light/light_set.h) by name.
+inline constexpr std::array<std::string_view, 2> kLightSelectionNames{"tree", "power"};
 inline constexpr std::array<std::string_view, 4> kLightTypeNames{"point", "spot", "directional",
                                                                  "quad"};
 inline constexpr std::array<std::string_view, 2> kEnvironmentImageExtensions{".exr", ".hdr"};
@@ -152,6 +154,12 @@ struct IrradianceCacheSpec {
     bool operator==(const IrradianceCacheSpec&) const = default;
 };
 
+struct LightSamplingSpec {
+    std::string selection;  // one of kLightSelectionNames
+
+    bool operator==(const LightSamplingSpec&) const = default;
+};
+
 struct OutputSpec {
     std::string pixel_type;         // one of kPixelTypeNames
     std::vector<std::string> aovs;  // from kAovNames, no duplicates, in the order asked
@@ -218,6 +226,7 @@ struct Job {
     PhotonSpec photons;
     GatherSpec gather;
     IrradianceCacheSpec irradiance_cache;
+    LightSamplingSpec light_sampling;
     OutputSpec output;
     EnvironmentSpec environment;
     std::vector<LightSpec> lights;

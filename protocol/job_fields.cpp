@@ -650,6 +650,14 @@ std::vector<JobField> make_job_fields() {
                       },
                       .schema = render_cache_key_schema()});
 
+    // The tree costs little with few lights and wins by far with many (README.md, "Large
+    // scenes"); power stays selectable to measure against.
+    fields.push_back(choice_field(JOB_MEMBER(light_sampling.selection), kLightSelectionNames,
+                                  "how next-event estimation picks the light it samples: tree (a light tree by "
+                                  "intensity, distance and orientation, for scenes of many lights) or power (by "
+                                  "power alone, wherever the point is)",
+                                  {"\"tree\"", "\"tree\"", "\"tree\""}));
+
     fields.push_back(choice_field(JOB_MEMBER(output.pixel_type), kPixelTypeNames, "EXR channel type",
                                   {"\"half\"", "\"half\"", "\"half\""}));
     fields.push_back({.path = "output.aovs",
@@ -690,11 +698,12 @@ std::vector<JobField> make_job_fields() {
 
 #undef JOB_MEMBER
 
-constexpr std::array<JobFieldGroup, 5> kGroups{{
+constexpr std::array<JobFieldGroup, 6> kGroups{{
     {"image", "the image"},
     {"photons", "photon maps (photon-map integrator)"},
     {"gather", "final gathering"},
     {"irradiance_cache", "the irradiance cache of the final gather"},
+    {"light_sampling", "next-event estimation's choice of light"},
     {"output", "the OpenEXR output and its PNG preview"},
 }};
 

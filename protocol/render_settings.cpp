@@ -7,6 +7,8 @@ namespace photond::protocol {
 RenderSettings to_render_settings(const Job& job) {
     RenderSettings settings;
     settings.integrator = job.integrator;
+    settings.light_selection =
+        job.light_sampling.selection == "power" ? LightSelection::Power : LightSelection::Tree;
 
     settings.photon_tracing.global_photons = job.photons.global;
     settings.photon_tracing.caustic_photons = job.photons.caustic;

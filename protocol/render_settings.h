@@ -19,6 +19,8 @@ struct RenderSettings {
     std::string integrator;  // one of kIntegratorNames
     /// The photon counts the job asks for; the render plan drops a map the scene does not need.
     PhotonTracingSettings photon_tracing;
+    /// How next-event estimation picks lights (RenderScene::create builds the lights with it).
+    LightSelection light_selection = LightSelection::Tree;
     PhotonMapIntegratorSettings photon_map;
     TileSettings tiles;
     ExrWriteOptions exr;

@@ -471,7 +471,7 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
 
     pass_start = Clock::now();
     if (options.on_pass) options.on_pass("acceleration");
-    auto render_scene = RenderScene::create(device, lit_scene);
+    auto render_scene = RenderScene::create(device, lit_scene, settings.light_selection);
     if (!render_scene) return render_scene.error();
     stats.lighting.lights = (*render_scene)->lights->size();
     stats.passes.push_back({"acceleration", seconds_since(pass_start)});

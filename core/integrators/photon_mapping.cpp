@@ -136,6 +136,8 @@ std::string PhotonMapIntegrator::render_cache_key(const std::string& photon_map_
     hasher.update_value(uint32_t(gather.k_global));
     hash_float(gather.max_radius);
     hasher.update_value(uint8_t(gather.gather_diffuse_sky));
+    // Glossy gather hits sample lights (final_gather.cpp): how they pick them changes the records.
+    hasher.update_value(uint8_t(scene_->lights->selection()));
     // A cache that starts from another holds that one's records: its key is part of this one.
     if (!start_key.empty()) hasher.update_string(start_key);
     return "rc1-" + Sha256::hex(hasher.finish());

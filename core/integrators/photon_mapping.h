@@ -36,7 +36,7 @@ struct PhotonMapIntegratorSettings {
 
 /// Bump when the irradiance cache's prepass or gathering changes what it stores for the same
 /// inputs: every cached render cache then misses.
-inline constexpr uint32_t kRenderCacheAlgorithmVersion = 1;
+inline constexpr uint32_t kRenderCacheAlgorithmVersion = 2;  // 2: the light tree (LightSelection)
 
 /// Default search radius caps as a share of the scene's bounding radius (the caustic map's is
 /// the photon pass's, which tests the map's visibility with it: core/photon/photon_tracer.h).

@@ -37,9 +37,11 @@ Color LightSet::sun_radiance(const PunctualLight& light) {
     return light.intensity / (kPi * s * s);
 }
 
-LightSet::LightSet(const Scene& scene) : LightSet(scene, scene.environment ? &*scene.environment : nullptr) {}
+LightSet::LightSet(const Scene& scene, LightSelection selection)
+    : LightSet(scene, scene.environment ? &*scene.environment : nullptr, selection) {}
 
-LightSet::LightSet(const Scene& scene, const Environment* environment) : scene_(&scene) {
+LightSet::LightSet(const Scene& scene, const Environment* environment, LightSelection selection)
+    : scene_(&scene), selection_mode_(selection) {
     scene_center_ = scene.bounds.empty() ? Vec3(0.0f) : scene.bounds.center();
     scene_radius_ = std::max(scene.bounds.radius(), 1e-6f);
     for (uint32_t i = 0; i < scene.lights.size(); ++i) {
@@ -144,15 +146,99 @@ LightSet::LightSet(const Scene& scene, const Environment* environment) : scene_(
             }
         }
     }
+    if (selection_mode_ == LightSelection::Tree) build_tree();
+}
+
+void LightSet::build_tree() {
+    std::vector<LightBounds> bounds;
+    std::vector<float> weights(lights_.size() + 1, 0.0f);
+    tree_index_of_light_.assign(lights_.size(), -1);
+    float tree_power = 0.0f;
+    for (uint32_t i = 0; i < lights_.size(); ++i) {
+        const Entry& e = lights_[i];
+        if (!(average(e.power) > 0.0f)) continue;  // never chosen, as by power (a needle spot, a black light)
+        LightBounds b;
+        switch (e.kind) {
+            case LightKind::Directional:
+            case LightKind::Environment:
+                weights[i] = average(e.power);
+                continue;
+            case LightKind::Point:
+            case LightKind::Spot: {
+                const PunctualLight& l = scene_->lights[e.index];
+                b.bounds.extend(l.position);
+                b.intensity = average(l.intensity);
+                if (e.kind == LightKind::Spot) {
+                    // Nothing beyond the outer cone (spot_falloff); a hundredth of a radian of
+                    // margin for rounding.
+                    b.w = l.direction;
+                    b.cos_theta_o = std::min(l.cos_outer, l.cos_inner);
+                    b.cos_theta_e = std::cos(0.01f);
+                } else {
+                    b.cos_theta_o = -1.0f;  // every direction
+                }
+                break;
+            }
+            case LightKind::Triangle: {
+                b.bounds.extend(e.corner);
+                b.bounds.extend(e.corner + e.edge1);
+                b.bounds.extend(e.corner + e.edge2);
+                // Power = sides * pi * L * A: the intensity along the normal is L * A.
+                b.intensity = average(e.power) / ((e.double_sided ? 2.0f : 1.0f) * kPi);
+                b.w = e.front_frame.n;
+                b.cos_theta_o = 1.0f;
+                b.cos_theta_e = 0.0f;  // Lambertian: up to 90 degrees from the normal
+                b.two_sided = e.double_sided;
+                break;
+            }
+        }
+        tree_index_of_light_[i] = static_cast<int32_t>(tree_lights_.size());
+        tree_lights_.push_back(i);
+        bounds.push_back(b);
+        tree_power += average(e.power);
+    }
+    weights.back() = tree_power;
+    tree_ = LightTree(bounds);
+    tree_or_distant_ = DiscreteDistribution(weights);
+    tree_only_ = !tree_or_distant_.empty() && tree_or_distant_.probability(static_cast<uint32_t>(lights_.size())) == 1.0f;
+}
+
+std::optional<uint32_t> LightSet::choose_incident(const Vec3& p, float u_select, float* choice_pdf) const {
+    *choice_pdf = 0.0f;
+    if (selection_mode_ == LightSelection::Power) {
+        const uint32_t index = selection_.sample(u_select, choice_pdf);
+        return *choice_pdf > 0.0f ? std::optional<uint32_t>(index) : std::nullopt;
+    }
+    float group_pdf = 1.0f, u_tree = u_select;
+    const uint32_t index = tree_only_ ? static_cast<uint32_t>(lights_.size())
+                                      : tree_or_distant_.sample(u_select, &group_pdf, &u_tree);
+    if (!(group_pdf > 0.0f)) return std::nullopt;
+    if (index < lights_.size()) {
+        *choice_pdf = group_pdf;
+        return index;
+    }
+    float tree_pmf = 0.0f;
+    const std::optional<uint32_t> picked = tree_.sample(p, u_tree, &tree_pmf);
+    if (!picked) return std::nullopt;
+    *choice_pdf = group_pdf * tree_pmf;
+    return tree_lights_[*picked];
+}
+
+float LightSet::incident_choice_probability(uint32_t light, const Vec3& p) const {
+    if (selection_mode_ == LightSelection::Power) return selection_.probability(light);
+    const int32_t in_tree = tree_index_of_light_[light];
+    if (in_tree < 0) return tree_or_distant_.probability(light);
+    const float tree_share = tree_only_ ? 1.0f : tree_or_distant_.probability(static_cast<uint32_t>(lights_.size()));
+    return tree_share * tree_.pmf(p, static_cast<uint32_t>(in_tree));
 }
 
 std::optional<LightSample> LightSet::sample_incident(const Vec3& p, float u_select,
                                                      const Vec2& u) const {
     if (empty()) return std::nullopt;
     float choice_pdf = 0.0f;
-    const uint32_t index = selection_.sample(u_select, &choice_pdf);
-    if (choice_pdf <= 0.0f) return std::nullopt;
-    const Entry& e = lights_[index];
+    const std::optional<uint32_t> index = choose_incident(p, u_select, &choice_pdf);
+    if (!index || !(choice_pdf > 0.0f)) return std::nullopt;
+    const Entry& e = lights_[*index];
     LightSample s;
     switch (e.kind) {
         case LightKind::Point:
@@ -232,12 +318,12 @@ float LightSet::pdf_incident_triangle(uint32_t triangle, const Vec3& p, const Ve
     if (!(dist2 > 0.0f)) return 0.0f;
     const float abs_cos = std::abs(glm::dot(d, scene_->triangle_normal(triangle))) / std::sqrt(dist2);
     if (!(abs_cos > 0.0f)) return 0.0f;
-    return selection_.probability(static_cast<uint32_t>(light)) * dist2 / (abs_cos * e.area);
+    return incident_choice_probability(static_cast<uint32_t>(light), p) * dist2 / (abs_cos * e.area);
 }
 
 float LightSet::distant_pdf(uint32_t light, const Vec3& d, Color* radiance) const {
     const Entry& e = lights_[light];
-    const float choice_pdf = selection_.probability(light);
+    const float choice_pdf = incident_choice_probability(light, scene_center_);  // the same everywhere
     if (e.kind == LightKind::Environment) {
         *radiance = environment_->radiance(d);
         return choice_pdf * environment_->pdf(d);

@@ -1,12 +1,14 @@
 // Every light of a scene in one set: punctual lights (point, spot, directional, soft sun),
-// emissive triangles and the environment, chosen by power. Immutable after construction; safe
-// to share between threads.
+// emissive triangles and the environment. Photons leave lights chosen by power; next-event
+// estimation chooses by the light tree (core/light/light_tree.h) or by power (LightSelection).
+// Immutable after construction; safe to share between threads.
 #pragma once
 
 #include <optional>
 #include <vector>
 
 #include "core/light/environment_light.h"
+#include "core/light/light_tree.h"
 #include "core/math/frame.h"
 #include "core/math/sampling.h"
 #include "core/scene/interaction.h"
@@ -16,6 +18,12 @@ namespace photond {
 
 enum class LightKind : uint8_t { Point, Spot, Directional, Triangle, Environment };
 
+/// How next-event estimation picks the light it samples from a shading point.
+/// Tree: the distant lights (directional, soft suns, the environment) by power as one group
+/// against the lights with a position, those by the light tree from the shading point (their
+/// intensity, distance and orientation). Power: every light by its power alone, wherever the
+/// point is (one global distribution), as photon emission picks them.
+enum class LightSelection : uint8_t { Tree, Power };
 /// A light sample seen from a shading point (next-event estimation).
 struct LightSample {
     Vec3 wi{0.0f};            // unit, from the shading point towards the light
@@ -48,10 +56,10 @@ struct EmissionFocus {
 
 class LightSet {
 public:
-    explicit LightSet(const Scene& scene);
+    explicit LightSet(const Scene& scene, LightSelection selection = LightSelection::Tree);
     /// The scene's lights with `environment` in place of the scene's own (null: none); it must
     /// outlive the set.
-    LightSet(const Scene& scene, const Environment* environment);
+    LightSet(const Scene& scene, const Environment* environment, LightSelection selection = LightSelection::Tree);
 
     bool empty() const { return lights_.empty() || selection_.empty(); }
     size_t size() const { return lights_.size(); }
@@ -59,9 +67,15 @@ public:
     /// Radiant power of one light (W), and of all lights together.
     Color power(uint32_t light) const { return lights_[light].power; }
     Color total_power() const { return total_power_; }
+    /// The probability of a light for photon emission (by power).
     float selection_probability(uint32_t light) const { return selection_.probability(light); }
+    /// How sample_incident picks lights, and the tree it uses (empty with Power).
+    LightSelection selection() const { return selection_mode_; }
+    const LightTree& tree() const { return tree_; }
+    /// The probability with which sample_incident(p, ...) picks `light`.
+    float incident_choice_probability(uint32_t light, const Vec3& p) const;
 
-    /// Picks a light by power and a point on it as seen from p.
+    /// Picks a light (LightSelection) and a point on it as seen from p.
     std::optional<LightSample> sample_incident(const Vec3& p, float u_select, const Vec2& u) const;
 
     /// Solid-angle pdf with which sample_incident(p, ...) would have produced `light_point` on the
@@ -109,6 +123,11 @@ private:
     /// perpendicular to it, of the scene's bounding radius around its centre (or of `focus`,
     /// when given), moved back outside the scene. Writes the disc's area over the scene's.
     Vec3 parallel_origin(const Vec3& direction, Vec2 u, const EmissionFocus* focus, float* area_ratio) const;
+    /// The light sample_incident samples from p, and its choice probability.
+    std::optional<uint32_t> choose_incident(const Vec3& p, float u_select, float* choice_pdf) const;
+    /// The light tree over the lights with a position (point, spot, triangles), and the
+    /// distribution over the distant lights by power with the tree's lights as its last entry.
+    void build_tree();
 
     struct Entry {
         LightKind kind;
@@ -142,6 +161,12 @@ private:
     std::vector<uint32_t> distant_area_lights_;  // the environment and soft suns, with power
     std::optional<EnvironmentLight> environment_;
     DiscreteDistribution selection_;
+    LightSelection selection_mode_ = LightSelection::Tree;
+    LightTree tree_;
+    std::vector<uint32_t> tree_lights_;        // the tree's light i is lights_[tree_lights_[i]]
+    std::vector<int32_t> tree_index_of_light_;  // -1: a distant light
+    DiscreteDistribution tree_or_distant_;      // lights_.size() + 1 entries; the last: the tree
+    bool tree_only_ = false;                    // no distant light has power: the tree's share is 1
     Color total_power_{0.0f};
     Vec3 scene_center_{0.0f};
     float scene_radius_ = 0.0f;

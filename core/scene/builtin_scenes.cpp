@@ -8,6 +8,7 @@
 
 #include "core/math/equirectangular.h"
 #include "core/math/frame.h"
+#include "core/math/rng.h"
 #include "core/scene/shapes.h"
 
 namespace photond {
@@ -485,11 +486,157 @@ Expected<Scene> make_sunlit_room() {
     return scene;
 }
 
+/// A parallelogram split into nu x nv cells (two triangles each, shared vertices), its front
+/// face towards `facing`; flat normal.
+MeshData make_grid_quad(const Vec3& corner, const Vec3& edge_u, const Vec3& edge_v, int nu, int nv,
+                        const Vec3& facing) {
+    MeshData mesh;
+    const Vec3 normal = glm::normalize(glm::cross(edge_u, edge_v));
+    for (int j = 0; j <= nv; ++j) {
+        for (int i = 0; i <= nu; ++i) {
+            const float u = static_cast<float>(i) / nu, v = static_cast<float>(j) / nv;
+            mesh.positions.push_back(corner + u * edge_u + v * edge_v);
+            mesh.normals.push_back(normal);
+            mesh.uvs.push_back(Vec2(u, v));
+        }
+    }
+    const auto at = [nu](int i, int j) { return static_cast<uint32_t>(j * (nu + 1) + i); };
+    for (int j = 0; j < nv; ++j) {
+        for (int i = 0; i < nu; ++i) {
+            mesh.triangles.push_back(glm::uvec3(at(i, j), at(i + 1, j), at(i + 1, j + 1)));
+            mesh.triangles.push_back(glm::uvec3(at(i, j), at(i + 1, j + 1), at(i, j + 1)));
+        }
+    }
+    if (glm::dot(normal, facing) < 0.0f) flip_orientation(mesh);
+    return mesh;
+}
+
+/// An axis-aligned box standing on y = 0, its four walls tessellated into cells of about
+/// `cell` (a facade's panels) and its roof in one quad; faces outward, no floor.
+MeshData tessellated_tower(const Vec3& lower, const Vec3& upper, float cell) {
+    MeshData tower;
+    const Vec3 size = upper - lower;
+    const int nx = std::max(1, static_cast<int>(std::lround(size.x / cell)));
+    const int ny = std::max(1, static_cast<int>(std::lround(size.y / cell)));
+    const int nz = std::max(1, static_cast<int>(std::lround(size.z / cell)));
+    const Vec3 ex(size.x, 0.0f, 0.0f), ey(0.0f, size.y, 0.0f), ez(0.0f, 0.0f, size.z);
+    append_mesh(tower, make_grid_quad(lower, ex, ey, nx, ny, Vec3(0.0f, 0.0f, -1.0f)));
+    append_mesh(tower, make_grid_quad(lower + ez, ex, ey, nx, ny, Vec3(0.0f, 0.0f, 1.0f)));
+    append_mesh(tower, make_grid_quad(lower, ez, ey, nz, ny, Vec3(-1.0f, 0.0f, 0.0f)));
+    append_mesh(tower, make_grid_quad(lower + ex, ez, ey, nz, ny, Vec3(1.0f, 0.0f, 0.0f)));
+    append_mesh(tower, make_quad(lower + ey, ex, ez, Vec3(0.0f, 1.0f, 0.0f)));
+    return tower;
+}
+
+/// "large-city": see the header for the layout. Every choice comes from a random stream per
+/// block, lamp or light (Rng, fixed seeds), so the scene is the same on every run.
+Expected<Scene> make_large_city() {
+    SceneBuilder builder("large-city");
+    const uint32_t asphalt = builder.add_material(lambertian("asphalt", Color(0.25f)));
+    const std::array<uint32_t, 5> facades = {
+        builder.add_material(lambertian("limestone", Color(0.7f, 0.66f, 0.58f))),
+        builder.add_material(lambertian("brick", Color(0.55f, 0.3f, 0.22f))),
+        builder.add_material(lambertian("concrete", Color(0.5f))),
+        builder.add_material(lambertian("slate", Color(0.3f, 0.33f, 0.42f))),
+        builder.add_material(lambertian("sandstone", Color(0.72f, 0.6f, 0.4f)))};
+    const uint32_t copper = builder.add_material(lambertian("patina", Color(0.3f, 0.55f, 0.45f)));
+
+    constexpr int kBlocks = kLargeCityBlocks;
+    constexpr float kPitch = kLargeCityBlockPitch, kStreet = kLargeCityStreetWidth;
+    constexpr float kHalf = 0.5f * kBlocks * kPitch;
+    Status st;
+    // The ground, beyond the city by a block on every side.
+    const Vec3 ground(-kHalf - kPitch, 0.0f, -kHalf - kPitch);
+    const float ground_side = 2.0f * (kHalf + kPitch);
+    if (st) {
+        st = add_mesh(builder, make_quad(ground, Vec3(ground_side, 0.0f, 0.0f), Vec3(0.0f, 0.0f, ground_side),
+                                         Vec3(0.0f, 1.0f, 0.0f)),
+                      asphalt);
+    }
+
+    // Each block: a tower with tessellated walls and a lower hall carrying a dome.
+    const MeshData unit_dome = make_icosphere(Vec3(0.0f), 1.0f, kLargeCityDomeSubdivisions);
+    std::array<MeshData, 5> by_facade;
+    MeshData domes;
+    for (int bz = 0; bz < kBlocks && st; ++bz) {
+        for (int bx = 0; bx < kBlocks; ++bx) {
+            Rng rng(kLargeCitySeed, static_cast<uint64_t>(bz * kBlocks + bx));
+            const float x0 = -kHalf + bx * kPitch + 0.5f * kStreet, z0 = -kHalf + bz * kPitch + 0.5f * kStreet;
+            const float lot = kPitch - kStreet;  // the block's side
+            // Taller towers towards the centre, as in a city.
+            const float centrality = 1.0f - glm::length(Vec2(x0, z0) + 0.5f * lot) / (1.5f * kHalf);
+            const float height = 8.0f + (10.0f + 30.0f * std::max(centrality, 0.0f)) * rng.next_float();
+            const float width = 0.35f * lot + 0.15f * lot * rng.next_float();
+            const float depth = 0.35f * lot + 0.15f * lot * rng.next_float();
+            const bool tower_west = rng.next_float() < 0.5f;
+            const float tx = tower_west ? x0 : x0 + lot - width;
+            append_mesh(by_facade[rng.next_u32() % by_facade.size()],
+                        tessellated_tower(Vec3(tx, 0.0f, z0), Vec3(tx + width, height, z0 + depth),
+                                          kLargeCityFacadeCell));
+            // The hall on the other half of the lot, and its dome.
+            const float hall_height = 3.0f + 4.0f * rng.next_float();
+            const float hx = tower_west ? x0 + width + 0.5f : x0;
+            const float hall_width = lot - width - 0.5f;
+            const float hz = z0 + 0.3f * lot;
+            const float hall_depth = 0.7f * lot;
+            append_mesh(by_facade[rng.next_u32() % by_facade.size()],
+                        make_box(Vec3(hx, 0.0f, hz), Vec3(hx + hall_width, hall_height, hz + hall_depth)));
+            const float radius = 0.3f * std::min(hall_width, hall_depth);
+            append_mesh(domes, placed_sphere(unit_dome, hall_height - 0.3f * radius, hx + 0.5f * hall_width,
+                                             hz + 0.5f * hall_depth, radius));
+        }
+    }
+    for (size_t f = 0; f < by_facade.size() && st; ++f) st = add_mesh(builder, by_facade[f], facades[f]);
+    if (st) st = add_mesh(builder, domes, copper);
+
+    // Street lamps over every crossing: small squares facing down, warm, their radiance spread
+    // over a decade; every seventh one a bright floodlight (ten times the radiance, larger).
+    Rng lamp_rng(kLargeCitySeed, 1u << 20);
+    for (int cz = 0; cz <= kBlocks && st; ++cz) {
+        for (int cx = 0; cx <= kBlocks && st; ++cx) {
+            const int index = cz * (kBlocks + 1) + cx;
+            const bool flood = index % 7 == 3;
+            const float side = flood ? 1.2f : 0.5f;
+            const float radiance = (flood ? 300.0f : 30.0f) * std::pow(10.0f, lamp_rng.next_float() - 0.5f);
+            const Color tint = index % 3 == 0 ? Color(1.0f, 0.75f, 0.45f) : Color(1.0f, 0.9f, 0.8f);
+            const uint32_t lamp = builder.add_material(emitter("lamp", Color(0.8f), radiance * tint));
+            const float height = flood ? 12.0f : kLargeCityLampHeight;
+            const Vec3 corner(-kHalf + cx * kPitch - 0.5f * side, height, -kHalf + cz * kPitch - 0.5f * side);
+            st = add_mesh(builder,
+                          make_quad(corner, Vec3(side, 0.0f, 0.0f), Vec3(0.0f, 0.0f, side), Vec3(0.0f, -1.0f, 0.0f)),
+                          lamp);
+        }
+    }
+    // Point lights in the streets and on roofs: lit signs and windows, intensity over two decades.
+    Rng point_rng(kLargeCitySeed, 1u << 21);
+    for (int i = 0; i < kLargeCityPointLights; ++i) {
+        PunctualLight light;
+        light.name = "sign " + std::to_string(i);
+        const int street = static_cast<int>(point_rng.next_u32() % (kBlocks + 1));
+        const float along = (point_rng.next_float() - 0.5f) * 2.0f * kHalf;
+        const float y = 1.5f + 4.0f * point_rng.next_float();
+        const float across = -kHalf + street * kPitch;
+        light.position = i % 2 == 0 ? Vec3(across, y, along) : Vec3(along, y, across);
+        const Color colours[4] = {{1.0f, 0.3f, 0.2f}, {0.3f, 0.6f, 1.0f}, {0.4f, 1.0f, 0.5f}, {1.0f, 0.8f, 0.3f}};
+        light.intensity = colours[i % 4] * (2.0f * std::pow(10.0f, 2.0f * point_rng.next_float()));
+        builder.add_light(light);
+    }
+
+    CameraDesc camera;
+    camera.name = "camera";
+    // Above a corner, looking across the city: near streets, far towers and lamps at every distance.
+    camera.position = Vec3(-0.75f * kHalf, 45.0f, 1.05f * kHalf);
+    camera.look_at = Vec3(0.1f * kHalf, 0.0f, -0.1f * kHalf);
+    camera.vfov_deg = 45.0f;
+    builder.add_camera(camera);
+    return finish(builder, st, "large-city");
+}
+
 }  // namespace
 
 std::vector<std::string> builtin_scene_names() {
     return {"cornell-box", "cornell-box-diffuse", "caustic", "caustic-area",
-            "furnace",     "spheres-room",        "sunlit-room"};
+            "furnace",     "spheres-room",        "sunlit-room", "large-city"};
 }
 
 Expected<Scene> make_builtin_scene(std::string_view name) {
@@ -500,6 +647,7 @@ Expected<Scene> make_builtin_scene(std::string_view name) {
     if (name == "furnace") return make_furnace();
     if (name == "spheres-room") return make_spheres_room();
     if (name == "sunlit-room") return make_sunlit_room();
+    if (name == "large-city") return make_large_city();
     std::string known;
     for (const std::string& n : builtin_scene_names()) known += (known.empty() ? "" : ", ") + n;
     return Error{"unknown built-in scene '" + std::string(name) + "'; known scenes: " + known};

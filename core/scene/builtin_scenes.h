@@ -58,6 +58,18 @@
 //                         sun falls through the window onto a checkerboard-textured floor;
 //                         everything else is lit indirectly. Lambertian: white walls and ceiling,
 //                         a blue -x wall, a terracotta box and an ivory sphere.
+//  "large-city"           The large scene of many lights (about 2M triangles, 600+ lights; README,
+//                         "Large scenes"): a night city of kLargeCityBlocks x kLargeCityBlocks
+//                         blocks of kLargeCityBlockPitch (streets kLargeCityStreetWidth wide)
+//                         centred on the origin, y up, on an asphalt ground. Each block holds a
+//                         tower whose walls are tessellated into kLargeCityFacadeCell panels
+//                         (taller towards the centre) and a hall with a dome (an icosphere of
+//                         level kLargeCityDomeSubdivisions, 5120 triangles). Lit by a square lamp
+//                         facing down over every crossing (a 0.5 square at kLargeCityLampHeight,
+//                         radiance 30 within a decade; every seventh a 1.2 floodlight at 12 with
+//                         ten times the radiance) and kLargeCityPointLights coloured point lights
+//                         in the streets of intensities over two decades: lights of varied power,
+//                         where distance decides which matters. No sky. All Lambertian.
 #pragma once
 
 #include <array>
@@ -110,6 +122,16 @@ inline constexpr int kSunlitRoomSkyWidth = 256;
 inline constexpr Vec3 kSunlitRoomSunDirection{-0.8660254f, -0.5f, 0.0f};
 inline constexpr float kSunlitRoomSunRadius = 0.03f;  // radians (the Sun: 0.0047)
 inline constexpr float kSunlitRoomSunIrradiance = 12.0f;
+
+/// "large-city": the grid, its facades and its lights (see above).
+inline constexpr int kLargeCityBlocks = 16;
+inline constexpr float kLargeCityBlockPitch = 12.0f;
+inline constexpr float kLargeCityStreetWidth = 3.0f;
+inline constexpr float kLargeCityFacadeCell = 0.5f;
+inline constexpr int kLargeCityDomeSubdivisions = 4;
+inline constexpr float kLargeCityLampHeight = 6.0f;
+inline constexpr int kLargeCityPointLights = 96;
+inline constexpr uint64_t kLargeCitySeed = 2018;
 
 /// The names make_builtin_scene accepts, in a fixed order.
 std::vector<std::string> builtin_scene_names();

@@ -3,13 +3,14 @@
 namespace photond {
 
 Expected<std::shared_ptr<const RenderScene>> RenderScene::create(std::shared_ptr<EmbreeDevice> device,
-                                                                 std::shared_ptr<const Scene> scene) {
+                                                                 std::shared_ptr<const Scene> scene,
+                                                                 LightSelection selection) {
     auto render_scene = std::make_shared<RenderScene>();
     render_scene->scene = scene;
     auto tracer = RayTracer::build(device, *scene);
     if (!tracer) return tracer.error();
     render_scene->tracer = std::move(tracer).value();
-    render_scene->lights = std::make_unique<LightSet>(*scene);
+    render_scene->lights = std::make_unique<LightSet>(*scene, selection);
     if (scene->environment) {
         EnvironmentSplit split = split_environment_peaks(*scene->environment);
         if (split.peaks) render_scene->sky_peaks = std::make_unique<const Environment>(std::move(*split.peaks));
@@ -17,7 +18,7 @@ Expected<std::shared_ptr<const RenderScene>> RenderScene::create(std::shared_ptr
             render_scene->diffuse_sky_environment = std::make_unique<const Environment>(std::move(*split.diffuse));
             render_scene->diffuse_sky = std::make_unique<EnvironmentLight>(*render_scene->diffuse_sky_environment);
         }
-        render_scene->lights_with_sky_peaks = std::make_unique<LightSet>(*scene, render_scene->sky_peaks.get());
+        render_scene->lights_with_sky_peaks = std::make_unique<LightSet>(*scene, render_scene->sky_peaks.get(), selection);
     }
     render_scene->bsdf_materials.reserve(scene->materials.size());
     for (const Material& material : scene->materials) render_scene->bsdf_materials.emplace_back(material);

@@ -33,8 +33,10 @@ struct RenderScene {
     /// are aimed at (LightSet::sample_emission).
     EmissionFocus caustic_focus;
 
+    /// `selection`: how next-event estimation picks lights (photons always leave by power).
     static Expected<std::shared_ptr<const RenderScene>> create(std::shared_ptr<EmbreeDevice> device,
-                                                               std::shared_ptr<const Scene> scene);
+                                                               std::shared_ptr<const Scene> scene,
+                                                               LightSelection selection = LightSelection::Tree);
 };
 
 }  // namespace photond

@@ -93,6 +93,7 @@ const std::map<std::string, json>& changed_values() {
         {"irradiance_cache.min_spacing_px", 2.5},
         {"irradiance_cache.max_spacing_px", 30.0},
         {"irradiance_cache.start_from", "rc1-" + std::string(64, 'a')},
+        {"light_sampling.selection", "power"},
         {"output.pixel_type", "float"},
         {"output.aovs", {"depth", "albedo"}},
         {"output.exposure_ev", -1.5},
@@ -176,7 +177,8 @@ TEST(JobFields, KeysComeFromTheTable) {
     std::set<std::string> top;
     for (std::string_view key : job_field_keys()) top.insert(std::string(key));
     EXPECT_EQ(top, (std::set<std::string>{"preset", "scene", "camera", "image", "integrator", "photons", "gather",
-                                          "irradiance_cache", "output", "environment", "lights", "priority", "seed"}));
+                                          "irradiance_cache", "light_sampling", "output", "environment", "lights", "priority",
+                                          "seed"}));
     for (const JobFieldGroup& group : job_field_groups()) EXPECT_FALSE(job_field_keys(group.name).empty()) << group.name;
     const std::vector<std::string_view> photons = job_field_keys("photons");
     EXPECT_EQ(std::vector<std::string>(photons.begin(), photons.end()),
