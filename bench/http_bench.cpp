@@ -1,6 +1,9 @@
 // What the daemon costs on top of rendering. Prints:
-//   1. time from submit to the first tile on a photon-map cache hit (a second camera view of a
-//      scene whose maps are cached), through POST /v1/jobs and the multipart tile stream;
+//   0. time from submit to the first full-frame image of a progressive job (job.progressive, the
+//      default) on a photon-map cache hit: the last preview tile's event on the SSE stream, and
+//      preview.png of the whole frame received after it (goal: 150 ms at 512x512 on 2 cores);
+//   1. time from submit to the first final tile on a photon-map cache hit (a second camera view
+//      of a scene whose maps are cached), through POST /v1/jobs and the multipart tile stream;
 //   2. HTTP and streaming overhead as a share of render time: the same job rendered by run_job
 //      directly (plus the EXR write `photond render` does) against the daemon's wall time from
 //      POST to the last byte of the tile stream and of image.exr, with the stream consumed.
@@ -43,12 +46,13 @@ double median(std::vector<double> values) {
     return values[values.size() / 2];
 }
 
-json make_job(const json& camera) {
+json make_job(const json& camera, bool progressive = true) {
     json job = {{"scene", {{"builtin", "cornell-box"}}},
                 {"integrator", "photon-map"},
                 {"image", {{"width", 512}, {"height", 512}, {"spp", 4}, {"tile_size", 32}}},
                 {"photons", {{"global", 100000}, {"caustic", 50000}, {"seed", 1}}},
-                {"gather", {{"rays", 128}}}};
+                {"gather", {{"rays", 128}}},
+                {"progressive", progressive}};
     if (!camera.is_null()) job["camera"] = camera;
     return job;
 }
@@ -141,6 +145,65 @@ StreamTimes submit_and_stream(httplib::Client& client, const json& job) {
     return t;
 }
 
+struct PreviewTimes {
+    double last_preview_event = 0.0;  // the preview tile event that completes the frame, from POST
+    double preview_png = 0.0;         // preview.png (the whole frame) received after it, from POST
+    json status;
+};
+
+/// Submits a progressive job and follows its SSE stream until the preview covers the frame,
+/// then fetches preview.png; waits for the job to end.
+PreviewTimes submit_and_watch_preview(httplib::Client& client, const json& job) {
+    PreviewTimes t;
+    const Clock::time_point start = Clock::now();
+    auto posted = client.Post("/v1/jobs", job.dump(), "application/json");
+    if (!posted || posted->status != 202) {
+        std::fprintf(stderr, "http_bench: submit failed\n");
+        std::exit(1);
+    }
+    const std::string id = json::parse(posted->body).at("id");
+    std::string buffer;
+    bool complete = false;
+    // Events are "event: TYPE\ndata: JSON\n\n"; the stream is left once the preview is whole
+    // (or the job ended without one).
+    client.Get("/v1/jobs/" + id + "/events", [&](const char* data, size_t size) {
+        buffer.append(data, size);
+        for (size_t end; (end = buffer.find("\n\n")) != std::string::npos; buffer.erase(0, end + 2)) {
+            const std::string event = buffer.substr(0, end);
+            const size_t type_at = event.find("event: "), data_at = event.find("data: ");
+            if (type_at == std::string::npos || data_at == std::string::npos) continue;
+            const std::string type = event.substr(type_at + 7, event.find('\n', type_at) - type_at - 7);
+            if (type == "done" || type == "failed" || type == "cancelled") return false;
+            if (type != "tile") continue;
+            const json d = json::parse(event.substr(data_at + 6), nullptr, false);
+            if (!d.value("preview", false)) continue;
+            if (d.value("preview_tiles_done", 0) == d.value("tiles_total", -1)) {
+                t.last_preview_event = seconds_since(start);
+                complete = true;
+                return false;
+            }
+        }
+        return true;
+    });
+    if (!complete) {
+        std::fprintf(stderr, "http_bench: job %s streamed no whole preview\n", id.c_str());
+        std::exit(1);
+    }
+    auto png = client.Get("/v1/jobs/" + id + "/preview.png");
+    if (!png || png->status != 200) {
+        std::fprintf(stderr, "http_bench: preview.png failed\n");
+        std::exit(1);
+    }
+    t.preview_png = seconds_since(start);
+    auto image = client.Get("/v1/jobs/" + id + "/image.exr?wait=true");
+    if (!image || image->status != 200) {
+        std::fprintf(stderr, "http_bench: image.exr failed\n");
+        std::exit(1);
+    }
+    t.status = json::parse(client.Get("/v1/jobs/" + id)->body);
+    return t;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -184,6 +247,26 @@ int main(int argc, char** argv) {
     std::printf("  warm-up (photon maps traced): %.3f s, photons cache %s\n", warm.with_image,
                 warm.status.at("photons").value("cache", "?").c_str());
 
+    // 0. Submit to the first full-frame image of a progressive job on a cache hit: a new view
+    // each time (so that the irradiance cache is built: its prepass is what the preview does
+    // not wait for).
+    std::vector<double> preview_event, preview_png, preview_pass;
+    const int preview_runs = std::max(repetitions, 5);
+    for (int r = 0; r < preview_runs; ++r) {
+        const PreviewTimes t = submit_and_watch_preview(client, make_job(view(-0.5 - 0.25 * r)));
+        if (t.status.at("photons").value("cache", "") != "hit")
+            std::fprintf(stderr, "  warning: no cache hit\n");
+        preview_event.push_back(t.last_preview_event);
+        preview_png.push_back(t.preview_png);
+        preview_pass.push_back(t.status.at("timings").value("preview", 0.0));
+    }
+    std::printf("\n0. submit -> first full-frame image of a progressive job on a photon-map cache hit\n");
+    std::printf("   (new camera view, %d runs, medians; goal 150 ms)\n", preview_runs);
+    std::printf("   last preview tile event (the frame covered)   %.3f s\n", median(preview_event));
+    std::printf("   preview.png of the whole frame received       %.3f s   <- time to the first image\n",
+                median(preview_png));
+    std::printf("   of which the preview pass (server-side)       %.3f s\n", median(preview_pass));
+
     // 1. Submit to first tile on a cache hit: a new camera view each time.
     std::vector<double> first_tile, pre_render;
     for (int r = 0; r < repetitions; ++r) {
@@ -194,18 +277,19 @@ int main(int argc, char** argv) {
         const json& timings = t.status.at("timings");
         double before_tiles = 0.0;
         for (const char* pass :
-             {"scene", "acceleration", "photon_tracing", "photon_kdtree", "irradiance_cache"})
+             {"scene", "acceleration", "photon_tracing", "photon_kdtree", "preview", "irradiance_cache"})
             before_tiles += timings.value(pass, 0.0);
         pre_render.push_back(before_tiles);
     }
-    std::printf("\n1. submit -> first tile on a photon-map cache hit (new camera view)\n");
+    std::printf("\n1. submit -> first final tile on a photon-map cache hit (new camera view)\n");
     std::printf(
         "   median %.3f s; of which passes before the tile pass (scene, acceleration, photon\n"
-        "   lookup, irradiance cache) %.3f s, queue + first tile + HTTP %.3f s\n",
+        "   lookup, preview, irradiance cache) %.3f s, queue + first tile + HTTP %.3f s\n",
         median(first_tile), median(pre_render), median(first_tile) - median(pre_render));
 
-    // 2. Overhead: direct run_job (+ EXR write, as photond render) vs the daemon with the stream.
-    const auto job = protocol::parse_job(make_job(view(1.0)));
+    // 2. Overhead: direct run_job (+ EXR write, as photond render) vs the daemon with the stream,
+    // without the progressive preview, which `photond render` does not render.
+    const auto job = protocol::parse_job(make_job(view(1.0), false));
     std::vector<double> direct, daemon_stream, daemon_image, daemon_pipeline, daemon_writing;
     for (int r = 0; r < repetitions; ++r) {
         service::PipelineOptions direct_options;
@@ -220,7 +304,7 @@ int main(int argc, char** argv) {
         }
         direct.push_back(seconds_since(start));
 
-        const StreamTimes t = submit_and_stream(client, make_job(view(1.0)));
+        const StreamTimes t = submit_and_stream(client, make_job(view(1.0), false));
         daemon_stream.push_back(t.last_byte);
         daemon_image.push_back(t.with_image);
         daemon_pipeline.push_back(t.status.at("statistics").at("total_seconds").get<double>());

@@ -232,6 +232,9 @@ struct Job {
     std::vector<LightSpec> lights;
     int priority = 0;
     uint64_t seed = 0;  // the render's random streams (photons.seed drives photon tracing)
+    /// The daemon streams a quick preview of the whole frame before the final tiles, which
+    /// replace it (README.md, "Progressive previews"); the final image is the same either way.
+    bool progressive = true;
 
     bool operator==(const Job&) const = default;
 };

@@ -693,6 +693,13 @@ std::vector<JobField> make_job_fields() {
                                    {"50", "50", "50"}));
     fields.push_back(integer_field(JOB_MEMBER(seed), limits::kSeed, "seed of the render's random streams",
                                    {"1", "1", "1"}));
+    // On in every preset: a daemon submission is interactive (someone or something watches its
+    // tiles). `photond render` renders no preview whatever this says: nothing streams its tiles.
+    fields.push_back(bool_field(JOB_MEMBER(progressive),
+                                "the daemon first streams a quick preview of the whole frame as tiles "
+                                "(\"preview\": true in their events), then the final tiles replace it; "
+                                "the final image is the same bytes either way. `photond render` ignores it",
+                                {"true", "true", "true"}));
     return fields;
 }
 

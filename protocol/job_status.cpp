@@ -203,9 +203,9 @@ Expected<JobStatus> job_status_from_json(const json& d) {
     }
 }
 
-std::string tile_url(const std::string& job_id, TileIndex tile) {
+std::string tile_url(const std::string& job_id, TileIndex tile, bool preview) {
     return "/v1/jobs/" + job_id + "/tiles/" + std::to_string(tile.tx) + "/" +
-           std::to_string(tile.ty) + ".exr";
+           std::to_string(tile.ty) + ".exr" + (preview ? "?preview=true" : "");
 }
 
 std::string format_sse(const JobEvent& event) {
@@ -295,8 +295,9 @@ json job_event_json_schema() {
             {"description",
              "one Server-Sent Event: `id:` the event id, `event:` the type, `data:` this JSON. "
              "state: {state, reason?}; progress: {tiles_done, tiles_total, fraction, pass}; tile: "
-             "{tx, ty, rect, url, tiles_done, tiles_total}; done and cancelled: the final status; "
-             "failed: the final status (with error)."},
+             "{tx, ty, rect, url, tiles_done, tiles_total}, and for a tile of the progressive preview "
+             "preview: true and preview_tiles_done (its final tile follows as a tile event without "
+             "them); done and cancelled: the final status; failed: the final status (with error)."},
             {"type", "object"},
             {"properties",
              {{"state", enum_schema(kJobStateNames, "state events: the new state")},
@@ -314,6 +315,10 @@ json job_event_json_schema() {
                 {"maxItems", 4},
                 {"description", "[x0, y0, x1, y1], half-open, frame pixels"}}},
               {"url", {{"type", "string"}}},
+              {"preview",
+               {{"type", "boolean"},
+                {"description", "tile events: a tile of the progressive preview (absent: a final tile)"}}},
+              {"preview_tiles_done", {{"type", "integer"}, {"minimum", 0}}},
               {"error", {{"type", "string"}}}}},
             {"x-event-types", enum_schema(kJobEventTypeNames, "the SSE `event:` field")}};
 }

@@ -106,7 +106,9 @@ std::optional<int64_t> parse_timestamp(std::string_view text);
 /// The SSE event types of GET /v1/jobs/{id}/events:
 ///   state      {"state", "reason"?}                    every state change
 ///   progress   {"tiles_done", "tiles_total", "fraction", "pass"}
-///   tile       {"tx", "ty", "rect": [x0, y0, x1, y1], "url", "tiles_done", "tiles_total"}
+///   tile       {"tx", "ty", "rect": [x0, y0, x1, y1], "url", "tiles_done", "tiles_total"}; a
+///              tile of the progressive preview adds "preview": true and "preview_tiles_done"
+///              (its final tile follows later as a tile event without them)
 ///   done       the final status document
 ///   failed     {"error"} and the final status document's members
 ///   cancelled  the final status document
@@ -137,8 +139,9 @@ struct TileIndex {
     auto operator<=>(const TileIndex&) const = default;
 };
 
-/// "/v1/jobs/{id}/tiles/{tx}/{ty}.exr".
-std::string tile_url(const std::string& job_id, TileIndex tile);
+/// "/v1/jobs/{id}/tiles/{tx}/{ty}.exr", with `preview` "...exr?preview=true" (the tile's
+/// progressive preview until its final pixels replace it).
+std::string tile_url(const std::string& job_id, TileIndex tile, bool preview = false);
 
 /// The event as Server-Sent Events text: "id: N\nevent: TYPE\ndata: JSON\n\n".
 std::string format_sse(const JobEvent& event);

@@ -44,6 +44,13 @@ RenderSettings to_render_settings(const Job& job) {
         tiles.region = rendered_area(job);
         settings.exr.data_window = tiles.region;
     }
+    if (job.progressive) {
+        PreviewSettings& preview = settings.preview.emplace();
+        preview.tile_size = tiles.tile_size;
+        preview.seed = tiles.seed;
+        preview.region = tiles.region;
+        preview.aovs = tiles.aovs;
+    }
     if (job.output.exposure_ev) settings.preview_exposure_ev = static_cast<float>(*job.output.exposure_ev);
     return settings;
 }

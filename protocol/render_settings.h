@@ -10,6 +10,7 @@
 #include "core/image/exr_io.h"
 #include "core/integrators/photon_mapping.h"
 #include "core/photon/photon_tracer.h"
+#include "core/render/preview_renderer.h"
 #include "core/render/tile_renderer.h"
 #include "protocol/job.h"
 
@@ -23,6 +24,9 @@ struct RenderSettings {
     LightSelection light_selection = LightSelection::Tree;
     PhotonMapIntegratorSettings photon_map;
     TileSettings tiles;
+    /// The progressive preview before the tiles (job.progressive); the daemon renders it, the
+    /// offline `photond render` never does (nothing streams its tiles).
+    std::optional<PreviewSettings> preview;
     ExrWriteOptions exr;
     std::optional<float> preview_exposure_ev;  // nullopt: automatic
 };

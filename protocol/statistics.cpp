@@ -70,6 +70,10 @@ nlohmann::json to_json(const RenderStatistics& s) {
             result["irradiance_cache"]["records_reused"] = c.records_reused;
         }
     }
+    if (s.preview) {
+        const auto& p = *s.preview;
+        result["preview"] = {{"stride", p.stride}, {"samples", p.samples}, {"tiles", p.tiles}, {"seconds", p.seconds}};
+    }
     return result;
 }
 

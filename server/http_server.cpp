@@ -60,8 +60,6 @@ void send_bytes(Response& res, std::vector<uint8_t> bytes, const char* type) {
     res.set_content(reinterpret_cast<const char*>(bytes.data()), bytes.size(), type);
 }
 
-bool is_true(const std::string& value) { return value == "true" || value == "1" || value == "yes"; }
-
 /// Constant-time comparison, so that the token cannot be guessed byte by byte from timings.
 bool same_secret(std::string_view given, std::string_view expected) {
     if (expected.empty()) return false;
@@ -560,7 +558,9 @@ void HttpServer::Impl::job_tile(const Request& req, Response& res) {
         throw ServiceError(ErrorKind::NotFound, "tile (" + req.matches[2].str() + ", " +
                                                     req.matches[3].str() +
                                                     ") is outside the tile grid of job " + id);
-    auto bytes = services.jobs.tile_exr(id, tile);
+    const bool or_preview = req.has_param("preview") && is_true(req.get_param_value("preview"));
+    bool preview = false;
+    auto bytes = services.jobs.tile_exr(id, tile, or_preview, &preview);
     if (!bytes) {
         const protocol::JobStatus status = services.jobs.status(id);
         throw ServiceError(
@@ -574,6 +574,8 @@ void HttpServer::Impl::job_tile(const Request& req, Response& res) {
     res.set_header("X-Tile-X", std::to_string(tile.tx));
     res.set_header("X-Tile-Y", std::to_string(tile.ty));
     res.set_header("X-Tile-Rect", rect_header(geometry->rect));
+    res.set_header("X-Tile-Kind", preview ? "preview" : "final");
+    if (or_preview) res.set_header("Cache-Control", "no-cache");  // the same URL gives the final tile later
     send_bytes(res, std::move(*bytes), kExrType);
 }
 

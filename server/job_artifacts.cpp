@@ -20,19 +20,26 @@ std::optional<JobManager::TileGeometry> JobManager::tile_geometry(const std::str
                         entry->submission.job.image.height};
 }
 
-std::optional<ImageLayers> JobManager::tile_layers(const std::string& id, TileIndex tile) {
+std::optional<ImageLayers> JobManager::tile_layers(const std::string& id, TileIndex tile, bool or_preview,
+                                                   bool* preview) {
     std::shared_ptr<Entry> entry;
     std::shared_ptr<const ImageLayers> pixels;
     bool done = false;
+    if (preview) *preview = false;
     {
         std::unique_lock lock(mutex_);
         entry = find_locked(lock, id);
         if (!entry->rect_of(tile)) return std::nullopt;
         done = entry->status.state == JobState::Done;
         if (!done) {
-            const auto it = entry->tiles.find(tile);
-            if (it == entry->tiles.end()) return std::nullopt;
-            pixels = it->second;
+            if (const auto it = entry->tiles.find(tile); it != entry->tiles.end()) {
+                pixels = it->second;
+            } else if (const auto p = entry->preview_tiles.find(tile); or_preview && p != entry->preview_tiles.end()) {
+                pixels = p->second;
+                if (preview) *preview = true;
+            } else {
+                return std::nullopt;
+            }
         }
     }
     if (!done) return *pixels;
@@ -41,8 +48,9 @@ std::optional<ImageLayers> JobManager::tile_layers(const std::string& id, TileIn
     return copy_rect(*image, *entry->rect_of(tile));
 }
 
-std::optional<std::vector<uint8_t>> JobManager::tile_exr(const std::string& id, TileIndex tile) {
-    auto layers = tile_layers(id, tile);
+std::optional<std::vector<uint8_t>> JobManager::tile_exr(const std::string& id, TileIndex tile, bool or_preview,
+                                                         bool* preview) {
+    auto layers = tile_layers(id, tile, or_preview, preview);
     if (!layers) return std::nullopt;
     std::shared_ptr<Entry> entry;
     {
@@ -150,6 +158,7 @@ fs::path JobManager::image_file(const std::string& id) {
 std::shared_ptr<const Image> JobManager::preview_frame(const std::string& id) {
     std::shared_ptr<Entry> entry;
     std::vector<std::pair<TileIndex, std::shared_ptr<const ImageLayers>>> tiles;
+    std::vector<std::pair<TileIndex, std::shared_ptr<const ImageLayers>>> preview_tiles;
     JobState state;
     {
         std::unique_lock lock(mutex_);
@@ -159,7 +168,10 @@ std::shared_ptr<const Image> JobManager::preview_frame(const std::string& id) {
             throw ServiceError(ErrorKind::Conflict, "job " + id + " is " +
                                                         std::string(protocol::to_string(state)) +
                                                         ": it has no pixels to preview");
-        if (state == JobState::Running) tiles.assign(entry->tiles.begin(), entry->tiles.end());
+        if (state == JobState::Running) {
+            tiles.assign(entry->tiles.begin(), entry->tiles.end());
+            preview_tiles.assign(entry->preview_tiles.begin(), entry->preview_tiles.end());
+        }
     }
     if (state != JobState::Running) {
         if (!verify_image(entry)) {
@@ -171,9 +183,13 @@ std::shared_ptr<const Image> JobManager::preview_frame(const std::string& id) {
             throw ServiceError(ErrorKind::Internal, "job " + id + ": the image cannot be read");
         return std::shared_ptr<const Image>(image, &image->beauty);
     }
-    // While rendering: the finished tiles on black.
+    // While rendering: the finished tiles over the progressive preview's, on black.
     const protocol::Job& job = entry->submission.job;
     auto frame = std::make_shared<Image>(job.image.width, job.image.height);
+    for (const auto& [index, pixels] : preview_tiles) {
+        const PixelRect rect = *entry->rect_of(index);
+        frame->paste(pixels->beauty, rect.x0, rect.y0);
+    }
     for (const auto& [index, pixels] : tiles) {
         const PixelRect rect = *entry->rect_of(index);
         frame->paste(pixels->beauty, rect.x0, rect.y0);

@@ -52,6 +52,10 @@ struct JobManager::Entry {
     std::vector<protocol::JobEvent> events;  // ids first_event_id, first_event_id + 1, ...
     uint64_t first_event_id = 1;  // above 1 for a history rebuilt shorter than it was
     std::map<protocol::TileIndex, std::shared_ptr<const ImageLayers>> tiles;  // finished, while rendering
+    // The progressive preview's tiles while the job renders, each served until its final tile
+    // replaces it; never kept on disk (the tile journal holds final tiles only).
+    std::map<protocol::TileIndex, std::shared_ptr<const ImageLayers>> preview_tiles;
+    uint64_t preview_tiles_done = 0;
     std::vector<protocol::TileIndex> finished_order;
     std::shared_ptr<const ImageLayers> image;  // a done job's final image, while in memory
     bool image_verified = false;  // its file matched the checksum written with it (this process)
@@ -84,13 +88,21 @@ struct JobManager::Entry {
                          std::min(y0 + tile_size, area.y1)};
     }
 
-    nlohmann::json tile_event(protocol::TileIndex t) const {
-        return {{"tx", t.tx},
-                {"ty", t.ty},
-                {"rect", rect_json(*rect_of(t))},
-                {"url", protocol::tile_url(id(), t)},
-                {"tiles_done", status.progress.tiles_done},
-                {"tiles_total", status.progress.tiles_total}};
+    /// A final tile's event, or with `preview` a preview tile's: "preview": true, its URL asking
+    /// for the preview (?preview=true) and the preview tiles so far (tiles_done still counts the
+    /// final ones).
+    nlohmann::json tile_event(protocol::TileIndex t, bool preview = false) const {
+        nlohmann::json data = {{"tx", t.tx},
+                               {"ty", t.ty},
+                               {"rect", rect_json(*rect_of(t))},
+                               {"url", protocol::tile_url(id(), t, preview)},
+                               {"tiles_done", status.progress.tiles_done},
+                               {"tiles_total", status.progress.tiles_total}};
+        if (preview) {
+            data["preview"] = true;
+            data["preview_tiles_done"] = preview_tiles_done;
+        }
+        return data;
     }
 
     nlohmann::json progress_event() const {

@@ -59,6 +59,7 @@ void JobManager::announce_end_locked(Entry& e, protocol::JobStatus ended) {
     e.status = std::move(ended);
     const JobState state = e.status.state;
     e.tiles.clear();
+    e.preview_tiles.clear();
     if (state != JobState::Done) {
         // Nothing can be fetched from a cancelled or failed job: free its pixels.
         e.finished_order.clear();

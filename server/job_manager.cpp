@@ -93,6 +93,7 @@ PipelineOptions JobManager::pipeline_options() const {
     options.scene_root = options_.scene_root;
     options.photon_maps = photon_maps_;
     options.render_caches = options_.render_caches;
+    options.previews = true;  // a daemon's jobs stream their tiles: job.progressive decides
     options.scene_lookup = [this](const std::string& id) { return scenes_->lookup(id); };
     options.bundle_lookup = [this](const std::string& id) { return scenes_->bundle_root(id); };
     return options;

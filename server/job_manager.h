@@ -6,7 +6,7 @@
 // possible and a job's output does not depend on what else runs.
 //
 // Tiles: each finished tile's pixels are copied out of the frame in the renderer's tile callback
-// and kept with the job, so that tiles can be fetched and streamed while the job renders. When
+// and kept with the job (so are the tiles of a progressive job's preview, until the job ends), so that tiles can be fetched and streamed while the job renders. When
 // the job is done its tiles are dropped and served from the final image (kept in memory for the
 // last few jobs, else read back from <cache-dir>/jobs/<id>/image.exr); a cancelled or failed
 // job's pixels are freed.
@@ -151,18 +151,22 @@ public:
     std::optional<TileGeometry> tile_geometry(const std::string& id,
                                               protocol::TileIndex tile) const;
     /// The pixels of one finished tile (every layer); nullopt while it is not finished (or its
-    /// pixels were freed: cancelled or failed job).
-    std::optional<ImageLayers> tile_layers(const std::string& id, protocol::TileIndex tile);
-    /// One finished tile as a small EXR (encode_tile_exr) of tile_layers.
-    std::optional<std::vector<uint8_t>> tile_exr(const std::string& id, protocol::TileIndex tile);
+    /// pixels were freed: cancelled or failed job). With `or_preview`, a tile not finished yet
+    /// gives its progressive preview when there is one; `*preview` (when given) says whether
+    /// the pixels are the preview's.
+    std::optional<ImageLayers> tile_layers(const std::string& id, protocol::TileIndex tile,
+                                           bool or_preview = false, bool* preview = nullptr);
+    /// One tile as a small EXR (encode_tile_exr) of tile_layers.
+    std::optional<std::vector<uint8_t>> tile_exr(const std::string& id, protocol::TileIndex tile,
+                                                 bool or_preview = false, bool* preview = nullptr);
 
     /// The final image's file; Conflict while the job is not done.
     std::filesystem::path image_file(const std::string& id);
     /// A PNG preview: of the finished image, or of the tiles finished so far while rendering;
     /// Conflict for a queued, failed or cancelled job.
     std::vector<uint8_t> preview_png(const std::string& id);
-    /// The linear image preview_png encodes (the final beauty, or the tiles finished so far on
-    /// black); throws as preview_png.
+    /// The linear image preview_png encodes (the final beauty, or while rendering the tiles
+    /// finished so far over the progressive preview's, on black); throws as preview_png.
     std::shared_ptr<const Image> preview_frame(const std::string& id);
 
     /// Job counts by state and the queue depth, for /metrics.
@@ -220,6 +224,8 @@ private:
     PipelineOptions run_options(Entry& entry, const TileJournal& journal, RunWarnings& warnings);
     /// A finished tile's pixels copied into the job, its events sent.
     void tile_finished(Entry& entry, const PixelRect& rect, const ImageLayers& frame);
+    /// A progressive preview tile's pixels copied into the job (not kept on disk), its event sent.
+    void preview_tile_finished(Entry& entry, const PixelRect& rect, const ImageLayers& frame);
     /// A cancelled run's end: cancelled, or queued again when a shutdown stopped it.
     void end_cancelled(const std::shared_ptr<Entry>& entry, const RenderStatistics* statistics);
     /// The final image's EXR and its checksum written; the entry's image marked verified.

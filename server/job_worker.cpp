@@ -160,6 +160,10 @@ PipelineOptions JobManager::run_options(Entry& e, const TileJournal& journal, Ru
     };
     options.callbacks.on_tile = [this, entry = &e, journal = &journal, warnings = &warnings](
                                     const TileEvent& event, const ImageLayers& frame) {
+        if (event.preview) {  // replaced by its final tile later: never kept for a resume
+            preview_tile_finished(*entry, event.rect, frame);
+            return;
+        }
         if (!event.restored) {
             if (const Status kept = journal->save(event.rect, frame); !kept) {
                 metrics_->record_store_failure();
@@ -198,6 +202,16 @@ void JobManager::tile_finished(Entry& e, const PixelRect& rect, const ImageLayer
     e.changed.notify_all();
 }
 
+void JobManager::preview_tile_finished(Entry& e, const PixelRect& rect, const ImageLayers& frame) {
+    auto pixels = std::make_shared<const ImageLayers>(copy_rect(frame, rect));
+    const TileIndex index = e.index_of(rect);
+    std::lock_guard lock(mutex_);
+    e.preview_tiles[index] = std::move(pixels);
+    ++e.preview_tiles_done;
+    push_event_locked(e, JobEventType::Tile, e.tile_event(index, true));
+    e.changed.notify_all();
+}
+
 void JobManager::end_cancelled(const std::shared_ptr<Entry>& entry, const RenderStatistics* statistics) {
     Entry& e = *entry;
     bool by_user = false;
@@ -219,6 +233,8 @@ void JobManager::end_cancelled(const std::shared_ptr<Entry>& entry, const Render
         e.status.timings.clear();
         e.status.progress.tiles_done = 0;
         e.tiles.clear();
+        e.preview_tiles.clear();
+        e.preview_tiles_done = 0;
         e.finished_order.clear();
         push_event_locked(e, JobEventType::State,
                           {{"state", "queued"},

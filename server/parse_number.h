@@ -1,4 +1,5 @@
-// A number from a request's path segment or query value: the whole text, or nothing.
+// A number from a request's path segment or query value: the whole text, or nothing; and a
+// query flag's value.
 #pragma once
 
 #include <charconv>
@@ -14,5 +15,8 @@ std::optional<T> parse_number(std::string_view text) {
     if (error != std::errc() || end != text.data() + text.size()) return std::nullopt;
     return value;
 }
+
+/// Whether a query flag (?wait=, ?preview=) is set: "true", "1" or "yes".
+inline bool is_true(std::string_view value) { return value == "true" || value == "1" || value == "yes"; }
 
 }  // namespace photond::service

@@ -10,6 +10,7 @@
 #include "core/integrators/direct.h"
 #include "core/integrators/path.h"
 #include "core/integrators/photon_mapping.h"
+#include "core/render/preview_renderer.h"
 #include "core/render/render_plan.h"
 #include "core/shading/render_scene.h"
 #include "core/scene/builtin_scenes.h"
@@ -486,6 +487,25 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     stats.plan.insert(stats.plan.begin(), environment_decision);
 
     Integrator& renderer = **integrator;
+    // The preview needs the photon maps (a cache hit has them at once) and nothing the
+    // irradiance-cache prepass builds: it streams while the prepass and the tiles are still to come.
+    if (options.previews && settings.preview && !options.caches_only) {
+        pass_start = Clock::now();
+        if (options.on_pass) options.on_pass("preview");
+        const std::unique_ptr<Integrator> cheap = renderer.make_preview();
+        PreviewSettings preview = *settings.preview;
+        preview.threads = options.threads;
+        const PreviewResult previewed = render_preview(cheap ? *cheap : renderer, *camera, preview, options.callbacks);
+        stats.rays += previewed.counters.rays;
+        stats.shadow_rays += previewed.counters.shadow_rays;
+        RenderStatistics::PreviewFigures figures;
+        figures.stride = previewed.stride;
+        figures.samples = previewed.samples;
+        figures.tiles = previewed.tiles;
+        figures.seconds = seconds_since(pass_start);
+        stats.preview = figures;
+        stats.passes.push_back({"preview", figures.seconds});
+    }
     const std::string_view preparation = renderer.preparation_pass();
     if (!job.irradiance_cache.start_from.empty() && preparation != "irradiance_cache")
         stats.warnings.push_back("irradiance_cache.start_from is ignored: this job has no irradiance cache (it needs the "

@@ -43,7 +43,8 @@ using SceneLookup = std::function<Expected<std::shared_ptr<const Scene>>(const s
 /// The directory holding an uploaded scene's bundle files (environment images), if it has one.
 using SceneBundleLookup = std::function<std::optional<std::filesystem::path>(const std::string& id)>;
 
-/// Called when a pass starts ("scene", "acceleration", "photon_tracing", "render"), for status.
+/// Called when a pass starts ("scene", "acceleration", "photon_tracing", "preview",
+/// "irradiance_cache", "render"), for status.
 using PassCallback = std::function<void(const std::string& pass)>;
 
 struct PipelineOptions {
@@ -53,6 +54,10 @@ struct PipelineOptions {
     PhotonMapStore* photon_maps = nullptr;  // null: photon maps are built for this job only
     RenderCacheStore* render_caches = nullptr;  // null: irradiance caches are built for this job only
     bool caches_only = false;  // stop after the photon maps and the irradiance cache (no image)
+    /// Render the progressive preview of a job that asks for one (job.progressive) before its
+    /// irradiance cache and tiles, reported through callbacks.on_tile with TileEvent::preview:
+    /// the daemon's jobs (their tiles stream); `photond render` leaves it off.
+    bool previews = false;
     SceneLookup scene_lookup;               // null: {"id": ...} scenes are refused
     SceneBundleLookup bundle_lookup;        // null: uploaded scenes have no files for the job
     PassCallback on_pass;

@@ -72,6 +72,10 @@ const PathParameter kJobId{"id", "[A-Za-z0-9_-]{1,128}", "the job's id"};
 const PathParameter kSceneId{"id", "[^/]+", "sha256:<64 hex digits>"};
 const PathParameter kTileColumn{"tx", "[0-9]{1,9}", "tile column"};
 const PathParameter kTileRow{"ty", "[0-9]{1,9}", "tile row"};
+// The tile endpoints' ?preview=true: the progressive preview of a tile not finished yet.
+const json kPreviewParameter = query_parameter(
+    "preview", "while the final tile is not finished, its progressive preview (the URL of a preview tile event)",
+    {{"type", "boolean"}});
 
 /// The routes of a cache of artifacts (photon maps, render caches): list, export, import.
 void add_artifact_routes(std::vector<Route>& routes, const std::string& base,
@@ -213,7 +217,8 @@ std::vector<Route> build_routes() {
          .summary =
              "multipart/mixed stream of tile EXRs as they finish (finished ones first); each part "
              "has Content-Type image/x-exr, Content-Length, X-Tile-X, X-Tile-Y and X-Tile-Rect "
-             "(x0,y0,x1,y1); the closing boundary ends it when the job ends",
+             "(x0,y0,x1,y1); the closing boundary ends it when the job ends. Final tiles only: a "
+             "progressive job's preview tiles come as tile events with preview: true",
          .path_parameters = {kJobId},
          .responses = {{"200", binary_response("the tile stream", "multipart/mixed")},
                        {"404", problem("unknown job")}}});
@@ -223,11 +228,14 @@ std::vector<Route> build_routes() {
          .operation_id = "jobTile",
          .summary =
              "One finished tile as a small EXR (data window = the tile, display window = the "
-             "frame); tiles count from the rendered area's top-left corner",
+             "frame); tiles count from the rendered area's top-left corner. With preview=true a "
+             "tile not finished yet gives its progressive preview; X-Tile-Kind says which "
+             "(preview or final)",
          .path_parameters = {kJobId, kTileColumn, kTileRow},
+         .query_and_header_parameters = json::array({kPreviewParameter}),
          .responses = {
              {"200", binary_response("the tile", "image/x-exr")},
-             {"404", problem("unknown job, tile outside the grid, or not finished yet")}}});
+             {"404", problem("unknown job, tile outside the grid, or not finished yet (nor its preview)")}}});
     routes.push_back(
         {.method = "GET",
          .path = "/v1/jobs/{id}/tiles/{tx}/{ty}.png",
@@ -236,15 +244,18 @@ std::vector<Route> build_routes() {
              "One finished tile as an 8-bit sRGB PNG made as preview.png is (exposure, filmic tone "
              "curve, sRGB; server/tile_png.h). Exposure: exposure_ev if given, else the job's "
              "output.exposure_ev, else the preview's automatic exposure at this moment; "
-             "X-Exposure-EV says which was used, X-Tile-Rect where the tile lies (x0,y0,x1,y1)",
+             "X-Exposure-EV says which was used, X-Tile-Rect where the tile lies (x0,y0,x1,y1). "
+             "With preview=true a tile not finished yet gives its progressive preview; "
+             "X-Tile-Kind says which (preview or final)",
          .path_parameters = {kJobId, kTileColumn, kTileRow},
-         .query_and_header_parameters = json::array({query_parameter(
-             "exposure_ev", "exposure in stops, e.g. the X-Exposure-EV of an earlier tile",
-             {{"type", "number"}, {"minimum", -64}, {"maximum", 64}})}),
+         .query_and_header_parameters = json::array(
+             {query_parameter("exposure_ev", "exposure in stops, e.g. the X-Exposure-EV of an earlier tile",
+                              {{"type", "number"}, {"minimum", -64}, {"maximum", 64}}),
+              kPreviewParameter}),
          .responses = {
              {"200", binary_response("the tile", "image/png")},
              {"400", problem("exposure_ev is not a number of stops in [-64, 64]")},
-             {"404", problem("unknown job, tile outside the grid, or not finished yet")}}});
+             {"404", problem("unknown job, tile outside the grid, or not finished yet (nor its preview)")}}});
     routes.push_back(
         {.method = "GET",
          .path = "/v1/jobs/{id}/image.exr",

@@ -9,7 +9,7 @@
 namespace photond::service {
 
 TilePng make_tile_png(JobManager& jobs, const std::string& id, protocol::TileIndex tile,
-                      std::optional<float> exposure_ev) {
+                      std::optional<float> exposure_ev, bool or_preview) {
     if (exposure_ev && !(std::isfinite(*exposure_ev) && std::abs(*exposure_ev) <= kMaxAutomaticExposureEv))
         throw ServiceError(ErrorKind::MalformedRequest,
                            "exposure_ev: expected a number of stops in [-64, 64]");
@@ -17,7 +17,8 @@ TilePng make_tile_png(JobManager& jobs, const std::string& id, protocol::TileInd
         "tile (" + std::to_string(tile.tx) + ", " + std::to_string(tile.ty) + ") of job " + id;
     const auto geometry = jobs.tile_geometry(id, tile);  // NotFound for an unknown job
     if (!geometry) throw ServiceError(ErrorKind::NotFound, name + " is outside its tile grid");
-    const std::optional<ImageLayers> layers = jobs.tile_layers(id, tile);
+    bool preview = false;
+    const std::optional<ImageLayers> layers = jobs.tile_layers(id, tile, or_preview, &preview);
     if (!layers) {
         const protocol::JobStatus status = jobs.status(id);
         throw ServiceError(ErrorKind::NotFound,
@@ -35,7 +36,7 @@ TilePng make_tile_png(JobManager& jobs, const std::string& id, protocol::TileInd
     }
     auto png = encode_render_preview(layers->beauty, exposure_ev);
     if (!png) throw ServiceError(ErrorKind::Internal, name + ": " + png.error().message);
-    return {std::move(png).value(), *exposure_ev, geometry->rect};
+    return {std::move(png).value(), *exposure_ev, geometry->rect, preview};
 }
 
 }  // namespace photond::service

@@ -26,12 +26,14 @@ struct TilePng {
     std::vector<uint8_t> bytes;
     float exposure_ev = 0.0f;  // the exposure it was made with
     PixelRect rect;            // the tile's pixels in the frame
+    bool preview = false;      // the progressive preview's pixels, not the final tile's
 };
 
-/// The tile's PNG. Throws ServiceError: NotFound for an unknown job, a tile outside the grid, or
-/// one not finished yet (or gone: the job failed or was cancelled); MalformedRequest for an
-/// exposure beyond +-kMaxAutomaticExposureEv or not finite.
+/// The tile's PNG; with `or_preview`, a tile not finished yet gives its progressive preview when
+/// there is one (TilePng::preview). Throws ServiceError: NotFound for an unknown job, a tile
+/// outside the grid, or one not finished yet (or gone: the job failed or was cancelled);
+/// MalformedRequest for an exposure beyond +-kMaxAutomaticExposureEv or not finite.
 TilePng make_tile_png(JobManager& jobs, const std::string& id, protocol::TileIndex tile,
-                      std::optional<float> exposure_ev);
+                      std::optional<float> exposure_ev, bool or_preview = false);
 
 }  // namespace photond::service

@@ -65,13 +65,15 @@ void job_tile_png(const HttpServices& services, const Request& req, Response& re
             throw ServiceError(ErrorKind::MalformedRequest,
                                "exposure_ev: expected a number of stops, got '" + text + "'");
     }
-    TilePng png = make_tile_png(services.jobs, req.matches[1], tile, exposure_ev);
+    const bool or_preview = req.has_param("preview") && is_true(req.get_param_value("preview"));
+    TilePng png = make_tile_png(services.jobs, req.matches[1], tile, exposure_ev, or_preview);
     char exposure[32];
     std::snprintf(exposure, sizeof exposure, "%.9g", png.exposure_ev);  // reads back as the same float
     const PixelRect& r = png.rect;
     res.set_header("X-Exposure-EV", exposure);
     res.set_header("X-Tile-Rect", std::to_string(r.x0) + "," + std::to_string(r.y0) + "," +
                                       std::to_string(r.x1) + "," + std::to_string(r.y1));
+    res.set_header("X-Tile-Kind", png.preview ? "preview" : "final");
     res.set_header("Cache-Control", "no-cache");
     res.set_content(reinterpret_cast<const char*>(png.bytes.data()), png.bytes.size(), "image/png");
 }

@@ -48,6 +48,10 @@ bool encode_rows(png_structp png, png_infop info, int width, int height, png_byt
     png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8, PNG_COLOR_TYPE_RGB,
                  PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+    // zlib's fastest level: a 512 x 512 preview encodes in 26 ms instead of 102 (level 6), and
+    // previews are made while a job renders, on its first image's path (README.md,
+    // "Progressive previews"); the files are somewhat larger.
+    png_set_compression_level(png, 1);
     png_write_info(png, info);
     png_write_image(png, rows);
     png_write_end(png, info);

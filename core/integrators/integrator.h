@@ -3,6 +3,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -89,6 +90,11 @@ public:
     /// Builds what the render of this view reads (the photon-map integrator's irradiance cache),
     /// or takes it from the store. Called once, before render_tiles, from one thread.
     virtual Expected<PrepareReport> prepare(const PrepareContext&) { return PrepareReport{}; }
+
+    /// A cheaper integrator of the same scene and light for the progressive preview
+    /// (core/render/preview_renderer.h), which needs nothing prepare() builds; null when this
+    /// one is cheap enough per sample and needs no preparation (it renders the preview itself).
+    virtual std::unique_ptr<Integrator> make_preview() const { return nullptr; }
 };
 
 /// The camera-ray footprint: the width of one pixel per unit of distance along the ray.

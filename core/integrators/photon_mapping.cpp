@@ -1,5 +1,7 @@
 #include "core/integrators/photon_mapping.h"
 
+#include <algorithm>
+
 #include "core/integrators/direct.h"
 #include "core/integrators/render_cache_store.h"
 #include "core/util/sha256.h"
@@ -96,6 +98,18 @@ Expected<PrepareReport> PhotonMapIntegrator::prepare(const PrepareContext& conte
         report.counters = build_statistics.counters;
     }
     return report;
+}
+
+std::unique_ptr<Integrator> PhotonMapIntegrator::make_preview() const {
+    PhotonMapIntegratorSettings preview = settings_;
+    preview.final_gather = false;
+    preview.use_irradiance_cache = false;
+    // The k-nearest searches are most of a photon-map sample's cost without gathering
+    // (cornell-box: 8.2 us a sample with k = 50 and 100, 4.4 us with 16; README.md, "Progressive
+    // previews").
+    preview.k_global = std::min(preview.k_global, kPreviewPhotons);
+    preview.k_caustic = std::min(preview.k_caustic, kPreviewPhotons);
+    return std::make_unique<PhotonMapIntegrator>(scene_, maps_, preview);
 }
 
 std::string PhotonMapIntegrator::render_cache_key(const std::string& photon_map_key, const CameraDesc& camera,

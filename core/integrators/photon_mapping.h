@@ -38,6 +38,9 @@ struct PhotonMapIntegratorSettings {
 /// inputs: every cached render cache then misses.
 inline constexpr uint32_t kRenderCacheAlgorithmVersion = 2;  // 2: the light tree (LightSelection)
 
+/// Nearest photons per estimate in the progressive preview's integrator (make_preview), at most.
+inline constexpr uint32_t kPreviewPhotons = 16;
+
 /// Default search radius caps as a share of the scene's bounding radius (the caustic map's is
 /// the photon pass's, which tests the map's visibility with it: core/photon/photon_tracer.h).
 inline constexpr float kDefaultGlobalRadiusShare = 0.2f;
@@ -58,6 +61,9 @@ public:
     /// render. `start_from` names an earlier view's cache in the store to start from (an error
     /// when there is no store, no such cache, or it was built for another scene or settings).
     Expected<PrepareReport> prepare(const PrepareContext& context) override;
+    /// The preview's integrator: the same maps read directly at the first hit (final_gather
+    /// off, so no irradiance cache and no prepass), direct light and caustics as here.
+    std::unique_ptr<Integrator> make_preview() const override;
     /// Fills the irradiance cache for this camera (a no-op without final gathering or cache),
     /// starting from `start` when given (build_irradiance_cache; check start_matches first).
     void build_cache(const Camera& camera, CacheBuildStatistics* statistics, const IrradianceCache* start = nullptr);

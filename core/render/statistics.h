@@ -73,6 +73,15 @@ struct RenderStatistics {
     };
     std::optional<IrradianceCacheFigures> irradiance_cache;
 
+    /// The progressive preview (core/render/preview_renderer.h), when one was rendered.
+    struct PreviewFigures {
+        int stride = 0;         // one camera sample per stride x stride pixels
+        uint64_t samples = 0;
+        uint64_t tiles = 0;     // preview tiles reported
+        double seconds = 0.0;   // the pass, tiles reported included
+    };
+    std::optional<PreviewFigures> preview;
+
     /// What the user should know about this render: the scene's warnings (Scene::warnings:
     /// ignored glTF features), then the render's own (an incomplete photon map). One sentence
     /// each; any pass may append.

@@ -36,6 +36,9 @@ struct TileEvent {
     size_t tiles_done = 0;
     size_t tiles_total = 0;
     bool restored = false;  // filled by RenderCallbacks::restore_tile, not rendered
+    /// A tile of the progressive preview (core/render/preview_renderer.h), which the final tile
+    /// of the same rectangle replaces later; tiles_done and tiles_total count preview tiles then.
+    bool preview = false;
 };
 
 struct RenderCallbacks {

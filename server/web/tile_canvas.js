@@ -13,6 +13,12 @@
 // piece. When the job is done its automatic exposure is asked for again; if it differs, the
 // finished image is drawn from preview.png, so that the frame ends as the preview.
 //
+// Progressive jobs (README.md, "Progressive previews") first announce a preview of the whole
+// frame as tile events with `preview: true`; each is fetched with ?preview=true and drawn until
+// its final tile replaces it. A preview tile whose final tile was announced before it was
+// fetched is dropped, and one that arrives after its final tile was drawn is not drawn (the
+// answer's X-Tile-Kind says which pixels came), so the frame only ever improves.
+//
 // At most MAX_IN_FLIGHT tile requests run at once; a PNG's decoded bitmap is closed as soon as
 // it is drawn.
 
@@ -59,8 +65,14 @@ export class TileCanvas {
     this.pinning = false;
     this.idleWaiters = [];
     this.closed = false;
+    this.finalSeen = new Set();   // "tx,ty" of final tiles announced
+    this.finalDrawn = new Set();  // "tx,ty" of tiles whose final pixels are drawn
     // Figures the browser test reads (tests/server/web_page_browser.mjs).
-    this.tilesDrawn = 0;
+    this.tilesDrawn = 0;          // final tiles
+    this.previewTilesDrawn = 0;
+    this.covered = new Set();     // "tx,ty" of tiles drawn, preview or final
+    this.tilesTotal = 0;
+    this.frameCoveredAt = null;   // performance.now() when every tile was drawn, preview or final
     this.latencies = [];   // ms from the tile's event to its pixels on the canvas
     this.phases = [];      // per tile: [queued, request, read and decode, draw] in ms
     this.finalSource = "tiles";
@@ -71,10 +83,13 @@ export class TileCanvas {
     return `/v1/jobs/${encodeURIComponent(this.jobId)}`;
   }
 
-  /// A `tile` event: {tx, ty, rect: [x0, y0, x1, y1]}.
+  /// A `tile` event: {tx, ty, rect: [x0, y0, x1, y1], preview?, preview_tiles_done?, tiles_total}.
   add(event) {
     if (this.closed) return;
-    this.pending.push({ tx: event.tx, ty: event.ty, rect: event.rect, at: performance.now() });
+    const preview = event.preview === true;
+    if (!preview) this.finalSeen.add(`${event.tx},${event.ty}`);
+    this.tilesTotal = event.tiles_total;
+    this.pending.push({ tx: event.tx, ty: event.ty, rect: event.rect, at: performance.now(), preview });
     this.pump();
   }
 
@@ -98,6 +113,13 @@ export class TileCanvas {
       const unpinned = !this.fixedExposure && this.exposure === null;
       if (unpinned && this.pinning) return;
       const tile = this.next();
+      // A preview tile whose final tile is already announced: not worth a request.
+      if (tile.preview && this.finalSeen.has(`${tile.tx},${tile.ty}`)) {
+        if (this.inFlight === 0 && this.waiting() === 0) {
+          for (const resolve of this.idleWaiters.splice(0)) resolve();
+        }
+        continue;
+      }
       this.inFlight += 1;
       if (unpinned) this.pinning = true;
       this.draw(tile)
@@ -115,15 +137,27 @@ export class TileCanvas {
 
   async draw(tile) {
     const started = performance.now();
-    let path = `${this.base()}/tiles/${tile.tx}/${tile.ty}.png`;
-    if (!this.fixedExposure && this.exposure !== null) path += `?exposure_ev=${encodeURIComponent(this.exposure)}`;
+    const query = [];
+    if (!this.fixedExposure && this.exposure !== null) query.push(`exposure_ev=${encodeURIComponent(this.exposure)}`);
+    if (tile.preview) query.push("preview=true");
+    const path = `${this.base()}/tiles/${tile.tx}/${tile.ty}.png` + (query.length ? `?${query.join("&")}` : "");
     const response = await apiFetch(path);
     if (!this.fixedExposure && this.exposure === null) this.exposure = response.headers.get("X-Exposure-EV");
     const answered = performance.now();
     const image = await decodePng(response);
     const decoded = performance.now();
-    if (!this.closed) this.place(image, tile.rect);
+    const key = `${tile.tx},${tile.ty}`;
+    const gotFinal = response.headers.get("X-Tile-Kind") !== "preview";
+    // Preview pixels never cover final ones drawn before them.
+    if (!this.closed && (gotFinal || !this.finalDrawn.has(key))) this.place(image, tile.rect);
     image.close();
+    if (gotFinal) this.finalDrawn.add(key);
+    this.covered.add(key);
+    if (this.frameCoveredAt === null && this.covered.size === this.tilesTotal) this.frameCoveredAt = performance.now();
+    if (tile.preview) {
+      this.previewTilesDrawn += 1;
+      return;
+    }
     this.tilesDrawn += 1;
     const drawn = performance.now();
     this.latencies.push(drawn - tile.at);

@@ -114,7 +114,7 @@ class PythonClientTest(unittest.TestCase):
         ids = [int(event.id) for event in events]
         self.assertEqual(ids, sorted(ids))
         self.assertEqual(len(set(ids)), len(ids))
-        tiles = [event for event in events if event.type == "tile"]
+        tiles = [event for event in events if event.type == "tile" and not event.data.get("preview")]
         self.assertEqual(len(tiles), 12)
         x0, y0, x1, y1 = tiles[0].data["rect"]
         self.assertEqual((x1 - x0, y1 - y0), (16, 16))

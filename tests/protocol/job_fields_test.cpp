@@ -101,6 +101,7 @@ const std::map<std::string, json>& changed_values() {
         {"lights", {{{"type", "point"}, {"position", {1, 2, 3}}, {"intensity", 40.0}, {"color", {1, 0.5, 0.25}}}}},
         {"priority", 7},
         {"seed", 99},
+        {"progressive", false},
     };
     return values;
 }
@@ -178,7 +179,7 @@ TEST(JobFields, KeysComeFromTheTable) {
     for (std::string_view key : job_field_keys()) top.insert(std::string(key));
     EXPECT_EQ(top, (std::set<std::string>{"preset", "scene", "camera", "image", "integrator", "photons", "gather",
                                           "irradiance_cache", "light_sampling", "output", "environment", "lights", "priority",
-                                          "seed"}));
+                                          "seed", "progressive"}));
     for (const JobFieldGroup& group : job_field_groups()) EXPECT_FALSE(job_field_keys(group.name).empty()) << group.name;
     const std::vector<std::string_view> photons = job_field_keys("photons");
     EXPECT_EQ(std::vector<std::string>(photons.begin(), photons.end()),

@@ -66,7 +66,7 @@ TEST_F(DaemonApi, SubmitEventsTilesAndImageEqualToPhotondRender) {
     double last_fraction = 0.0;
     bool saw_running = false;
     for (const SseEvent& e : events) {
-        if (e.type == "tile") tiles.push_back(e);
+        if (e.type == "tile" && !e.data.value("preview", false)) tiles.push_back(e);  // final tiles
         if (e.type == "state" && e.data.at("state") == "running") saw_running = true;
         if (e.type == "progress") {
             EXPECT_GE(e.data.at("fraction").get<double>(), last_fraction);
