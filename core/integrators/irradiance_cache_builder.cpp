@@ -121,8 +121,9 @@ std::unique_ptr<IrradianceCache> build_irradiance_cache(const RenderScene& rs, c
         RayCounters counters;
         uint64_t points = 0;
     };
-    // Chunks of up to 64 candidates, at least 256 chunks a wave where there are enough candidates
-    // (the first waves are sparse and slow per candidate), fixed by the wave alone.
+    // Chunks of up to 64 candidates, at least 1,024 chunks a wave where there are enough
+    // candidates (the first waves are sparse and slow per candidate: with 256 their barriers
+    // waited longer for the last chunks), fixed by the wave alone.
     constexpr size_t kMaxCandidatesPerChunk = 64, kMinChunksPerWave = 1024;
     // Waves at steps 32, 16, ..., 1, then a repair wave over every pixel: neighbour clamping in
     // later waves can shrink a record that covered a pixel centre when it was visited.
