@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <optional>
 #include <queue>
 #include <vector>
 
@@ -34,6 +35,39 @@ inline double modelled_seconds(const WorkLog& log, int workers) {
     for (const WorkLog::Phase& phase : log.phases)
         total += list_schedule_makespan(phase.item_seconds, workers) + phase.serial_seconds;
     return total;
+}
+
+/// Item by item, the median of several recordings of the same deterministic pass (the same
+/// phases with the same item counts): a shared machine preempts single items at random, and one
+/// preempted item at the end of a phase would pass for load imbalance. Empty when the
+/// recordings differ in structure.
+inline std::optional<WorkLog> median_log(const std::vector<WorkLog>& logs) {
+    if (logs.empty()) return std::nullopt;
+    const auto median = [](std::vector<double> v) {
+        std::sort(v.begin(), v.end());
+        const size_t n = v.size();
+        return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    };
+    WorkLog out = logs.front();
+    for (const WorkLog& log : logs) {
+        if (log.phases.size() != out.phases.size()) return std::nullopt;
+        for (size_t p = 0; p < out.phases.size(); ++p) {
+            if (log.phases[p].name != out.phases[p].name ||
+                log.phases[p].item_seconds.size() != out.phases[p].item_seconds.size())
+                return std::nullopt;
+        }
+    }
+    std::vector<double> values(logs.size());
+    for (size_t p = 0; p < out.phases.size(); ++p) {
+        WorkLog::Phase& phase = out.phases[p];
+        for (size_t i = 0; i < phase.item_seconds.size(); ++i) {
+            for (size_t l = 0; l < logs.size(); ++l) values[l] = logs[l].phases[p].item_seconds[i];
+            phase.item_seconds[i] = median(values);
+        }
+        for (size_t l = 0; l < logs.size(); ++l) values[l] = logs[l].phases[p].serial_seconds;
+        phase.serial_seconds = median(values);
+    }
+    return out;
 }
 
 /// The share of one worker's time that is serial (Amdahl's s).

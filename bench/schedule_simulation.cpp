@@ -1,8 +1,9 @@
 // How the irradiance-cache prepass and the render pass would scale to 4, 8 and 16 cores, from
 // measured times: both passes run once on one thread recording every work item's duration and
 // every serial section (core/util/work_log.h), then bench/schedule_model.h schedules those items
-// on P workers with every barrier and serial section kept. Beside the model, the measured 1 and
-// 2 thread times (medians of alternating runs) check it where this machine can.
+// on P workers with every barrier and serial section kept (each item's median over `repeats`
+// recordings, so that a preempted item does not pass for imbalance). Beside the model, the
+// measured 1 and 2 thread times (medians of alternating runs) check it where this machine can.
 //
 //   schedule_simulation [scene] [width] [height] [repeats]   (default cornell-box-diffuse 512 512 3)
 // The job settings are the `final` preset's.
@@ -90,21 +91,30 @@ int run(int argc, char** argv) {
     auto maps = std::make_shared<const PhotonMaps>(trace_photons(*render_scene, settings.photon_tracing).value());
     const Camera camera = Camera::create(scene->cameras.at(0), width, height).value();
 
-    WorkLog prepass_log, render_log;
-    (void)run_passes(render_scene, maps, settings, camera, 1, &prepass_log, &render_log);
+    // Each repeat records one logged 1-thread run and times a 1- and a 2-thread run, alternating;
+    // the model takes every item's median over the recordings.
+    std::vector<WorkLog> prepass_logs(static_cast<size_t>(repeats)), render_logs(static_cast<size_t>(repeats));
     std::vector<double> prepass[3], render[3];  // by thread count 1, 2
     for (int r = 0; r < repeats; ++r) {
+        (void)run_passes(render_scene, maps, settings, camera, 1, &prepass_logs[size_t(r)], &render_logs[size_t(r)]);
         for (int threads : {1, 2}) {
             const PassTimes t = run_passes(render_scene, maps, settings, camera, threads, nullptr, nullptr);
             prepass[threads].push_back(t.prepass);
             render[threads].push_back(t.render);
         }
     }
+    const std::optional<WorkLog> prepass_median = median_log(prepass_logs), render_median = median_log(render_logs);
+    if (!prepass_median || !render_median) {
+        std::fprintf(stderr, "schedule_simulation: the recorded runs differ in their work items\n");
+        return 1;
+    }
+    const WorkLog& prepass_log = *prepass_median;
+    const WorkLog& render_log = *render_median;
     std::printf("schedule model: %s %dx%d, preset final (%u global / %u caustic photons, %u gather rays, %d spp), "
-                "medians of %d alternating runs\n",
+                "medians of %d alternating runs, the model from each item's median of %d recordings\n",
                 scene_name.c_str(), width, height, settings.photon_tracing.global_photons,
                 settings.photon_tracing.caustic_photons, settings.photon_map.gather.rays,
-                settings.tiles.samples_per_pixel, repeats);
+                settings.tiles.samples_per_pixel, repeats, repeats);
     print_pass("prepass", prepass_log, median(prepass[1]), median(prepass[2]));
     print_pass("render", render_log, median(render[1]), median(render[2]));
     for (const WorkLog::Phase& phase : prepass_log.phases) {

@@ -245,17 +245,35 @@ int32_t IrradianceCache::child_for(int32_t node_index, const Vec3& p) {
     return child;
 }
 
+bool IrradianceCache::accepts(const IrradianceRecord& record) {
+    return record.radius > 0.0f && std::isfinite(record.radius) && is_finite(record.irradiance);
+}
+
+void IrradianceCache::neighbour_candidates(const IrradianceRecord& record, std::vector<uint32_t>* out) const {
+    out->clear();
+    // Every record whose domain overlaps the new one's is filed in a node within reach.
+    for_each_unique_candidate(record.position, 1.0f, settings_.accuracy * record.radius, [&](uint32_t j) {
+        if (may_neighbour(settings_.accuracy, record, records_[j])) out->push_back(j);
+    });
+}
+
 void IrradianceCache::insert(IrradianceRecord record, float min_radius) {
+    if (!accepts(record)) return;
+    std::vector<uint32_t> candidates;
+    neighbour_candidates(record, &candidates);
+    insert(record, min_radius, candidates);
+}
+
+void IrradianceCache::insert(IrradianceRecord record, float min_radius, std::span<const uint32_t> candidates) {
     const float a = settings_.accuracy;
-    if (!(record.radius > 0.0f) || !std::isfinite(record.radius) || !is_finite(record.irradiance)) return;
+    if (!accepts(record)) return;
     // Neighbour clamping: R_i <= R_j + |P_i - P_j| for every record whose domain overlaps.
     const uint32_t new_index = static_cast<uint32_t>(records_.size());
-    std::vector<uint32_t> neighbours;
-    for_each_unique_candidate(record.position, 1.0f, a * record.radius, [&](uint32_t j) {
-        const IrradianceRecord& r = records_[j];
-        const float d = glm::length(record.position - r.position);
-        if (d < a * (record.radius + r.radius) && glm::dot(record.normal, r.normal) > 0.0f) neighbours.push_back(j);
-    });
+    thread_local std::vector<uint32_t> neighbours;
+    neighbours.clear();
+    for (uint32_t j : candidates) {
+        if (may_neighbour(a, record, records_[j])) neighbours.push_back(j);
+    }
     for (uint32_t j : neighbours) {
         const float d = glm::length(record.position - records_[j].position);
         record.radius = std::max(min_radius, std::min(record.radius, records_[j].radius + d));

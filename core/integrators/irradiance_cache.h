@@ -14,17 +14,20 @@
 // radius (a R_i <= h < 2 a R_i), in every node of that level its domain overlaps (at most 8), so a
 // lookup tests only the records of the nodes on P's root-to-leaf path.
 //
-// Thread safety: the cache has two phases that never overlap. Reading (interpolate and the other
-// const methods: records, nodes, state, memory_bytes) may run on any number of threads at once
-// with no lock. Writing (insert) is done by one thread while nobody reads. IrradianceCacheBuilder
-// alternates them in waves, merging each wave's new records in a fixed order, which is why the
-// cache, and the image, are the same for any thread count and tile order. A cache restored by
-// from_state is only read.
+// Thread safety: the cache has two phases that never overlap. Reading (interpolate,
+// neighbour_candidates and the other const methods: records, nodes, state, memory_bytes) may run
+// on any number of threads at once with no lock. Writing (insert) is done by one thread while
+// nobody reads. The prepass (core/integrators/irradiance_cache_builder.h) alternates them in
+// waves, merging each wave's new records in a fixed order (core/integrators/irradiance_wave_merge.h
+// finds their neighbours in parallel beforehand, so only the cheap part of insert is serial),
+// which is why the cache, and the image, are the same for any thread count and tile order. A
+// cache restored by from_state is only read.
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "core/math/vec.h"
@@ -81,8 +84,27 @@ public:
     bool interpolate(const Vec3& p, const Vec3& n, Color* irradiance, float accuracy_scale = 1.0f) const;
 
     /// Adds a record. Its radius is first clamped by its neighbours' (R_i <= R_j + |P_i - P_j|,
-    /// and the neighbours' by it), never below `min_radius` (Krivanek et al. 2006).
+    /// and the neighbours' by it), never below `min_radius` (Krivanek et al. 2006). Its
+    /// neighbours are the records j with may_neighbour(a, record, j) at the time of the insert.
     void insert(IrradianceRecord record, float min_radius);
+    /// The same, with the neighbours sought only among `candidates` (ascending record indices):
+    /// the result equals insert(record, min_radius) whenever they include every record that is
+    /// a neighbour now, e.g. neighbour_candidates taken earlier (radii only ever shrink, so a
+    /// neighbour now was one then) plus the records added since that may be.
+    void insert(IrradianceRecord record, float min_radius, std::span<const uint32_t> candidates);
+    /// The records that are `record`'s neighbours if it were inserted now, ascending (read only:
+    /// any number of threads while nobody inserts).
+    void neighbour_candidates(const IrradianceRecord& record, std::vector<uint32_t>* out) const;
+
+    /// Whether insert keeps the record (a finite positive radius, a finite irradiance).
+    static bool accepts(const IrradianceRecord& record);
+    /// Whether `other` is a neighbour of `record` when `record` is inserted: their domains
+    /// overlap (|P - P_j| < a (R + R_j), `record`'s radius as it comes, `other`'s as it is now)
+    /// and they face the same side.
+    static bool may_neighbour(float accuracy, const IrradianceRecord& record, const IrradianceRecord& other) {
+        const float d = glm::length(record.position - other.position);
+        return d < accuracy * (record.radius + other.radius) && glm::dot(record.normal, other.normal) > 0.0f;
+    }
 
     size_t size() const { return records_.size(); }
     const std::vector<IrradianceRecord>& records() const { return records_; }

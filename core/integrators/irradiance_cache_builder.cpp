@@ -5,9 +5,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <iterator>
 #include <string>
 
 #include "core/integrators/direct.h"
+#include "core/integrators/irradiance_wave_merge.h"
 
 namespace photond {
 namespace {
@@ -114,18 +116,15 @@ std::unique_ptr<IrradianceCache> build_irradiance_cache(const RenderScene& rs, c
     struct PixelCandidate {
         int x, y;
     };
-    struct NewRecord {
-        IrradianceRecord record;
-        float min_radius;
-    };
     struct Chunk {
-        std::vector<NewRecord> records;
+        std::vector<WaveRecord> records;
         RayCounters counters;
         uint64_t points = 0;
     };
-    // Chunks of up to 64 candidates, at least 256 chunks a wave where there are enough candidates
-    // (the first waves are sparse and slow per candidate), fixed by the wave alone.
-    constexpr size_t kMaxCandidatesPerChunk = 64, kMinChunksPerWave = 256;
+    // Chunks of up to 64 candidates, at least 1,024 chunks a wave where there are enough
+    // candidates (the first waves are sparse and slow per candidate: with 256 their barriers
+    // waited longer for the last chunks), fixed by the wave alone.
+    constexpr size_t kMaxCandidatesPerChunk = 64, kMinChunksPerWave = 1024;
     // Waves at steps 32, 16, ..., 1, then a repair wave over every pixel: neighbour clamping in
     // later waves can shrink a record that covered a pixel centre when it was visited.
     struct Wave {
@@ -139,6 +138,7 @@ std::unique_ptr<IrradianceCache> build_irradiance_cache(const RenderScene& rs, c
     const auto seconds_since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
     std::vector<PixelCandidate> candidates;
     std::vector<Chunk> chunks;
+    std::vector<WaveRecord> wave_records;
     for (const auto [step, repair] : waves) {
         if (settings.cancel && settings.cancel->load()) break;
         Clock::time_point serial_start = Clock::now();
@@ -179,24 +179,37 @@ std::unique_ptr<IrradianceCache> build_irradiance_cache(const RenderScene& rs, c
                         if (cache->interpolate(points[k].position, points[k].normal, &unused)) continue;
                         const uint64_t pixel = static_cast<uint64_t>(c.y) * camera.width() + c.x;
                         Rng rng = Rng::for_stream(settings.seed, kRecordStreamTag, pixel, k);
-                        NewRecord& added = chunk.records.emplace_back();
+                        WaveRecord& added = chunk.records.emplace_back();
                         added.record = make_irradiance_record(gatherer, points[k], settings, rng, chunk.counters);
                         float max_radius = 0.0f;
                         record_radius_limits(settings, points[k].footprint, &added.min_radius, &max_radius);
+                        // The cache is frozen for the wave: its part of the merge's neighbour
+                        // search is done here, in parallel (core/integrators/irradiance_wave_merge.h).
+                        if (IrradianceCache::accepts(added.record)) {
+                            cache->neighbour_candidates(added.record, &added.cache_candidates);
+                            added.candidates_taken = true;
+                        }
                     }
                 }
                 if (phase) phase->item_seconds[chunk_index] = seconds_since(chunk_start);
             });
         });
         serial_start = Clock::now();
-        // Merge in candidate order: one writer, no readers.
-        for (const Chunk& chunk : chunks) {
-            for (const NewRecord& added : chunk.records) cache->insert(added.record, added.min_radius);
+        // Merge in candidate order, as if one thread inserted each record in turn.
+        wave_records.clear();
+        for (Chunk& chunk : chunks) {
+            std::move(chunk.records.begin(), chunk.records.end(), std::back_inserter(wave_records));
             stats.counters += chunk.counters;
             stats.candidates += chunk.points;
         }
+        WorkLog::Phase* merge_phase = nullptr;
+        if (settings.work_log) {
+            phase->serial_seconds += seconds_since(serial_start);
+            settings.work_log->phases.push_back({phase->name + " merge", {}, 0.0});
+            merge_phase = &settings.work_log->phases.back();
+        }
+        merge_wave(*cache, wave_records, arena, merge_phase);
         ++stats.waves;
-        if (phase) phase->serial_seconds += seconds_since(serial_start);
     }
     stats.records = cache->size();
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();

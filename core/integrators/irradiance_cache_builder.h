@@ -2,8 +2,10 @@
 // coarse-to-fine pixel grid (steps 32, 16, ..., 1 pixels). In each wave every candidate pixel's
 // camera ray finds its visible diffuse points (through ideal specular surfaces) and, where the
 // cache (frozen during the wave) cannot interpolate, gathers a new record; all threads only read
-// the cache. Then one thread inserts the wave's records in pixel order. The records, and so the
-// image, do not depend on the thread count or on tile order; the render pass then mostly reads.
+// the cache. Then the wave's records are merged as if one thread inserted them in pixel order
+// (core/integrators/irradiance_wave_merge.h: the neighbour searches in parallel, the inserts on one
+// thread). The records, and so the image, do not depend on the thread count or on tile order; the
+// render pass then mostly reads.
 #pragma once
 
 #include <atomic>
@@ -29,8 +31,9 @@ struct CacheBuildSettings {
     int threads = 0;
     std::optional<PixelRect> region;
     const std::atomic<bool>* cancel = nullptr;
-    /// Set: each wave's candidate durations and serial sections are recorded here (one phase a
-    /// wave), for the scheduling model of bench/schedule_simulation.cpp.
+    /// Set: each wave's work items and serial sections are recorded here, for the scheduling
+    /// model of bench/schedule_simulation.cpp: two phases a wave, "wave N" (the candidate chunks)
+    /// and "wave N merge" (the merge's neighbour searches, then its serial inserts).
     WorkLog* work_log = nullptr;
 
     /// What the cache itself keeps of these (its interpolation rule).

@@ -27,5 +27,21 @@ TEST(ScheduleModel, PhasesAreSeparatedByBarriersAndSerialSections) {
     EXPECT_DOUBLE_EQ(serial_share(log), 0.75 / 7.75);
 }
 
+TEST(ScheduleModel, MedianLogTakesEachItemsMedianAndRefusesDifferentPasses) {
+    WorkLog a, b, c;
+    a.phases.push_back({"wave", {1, 1, 9}, 0.5});  // its last item preempted
+    b.phases.push_back({"wave", {1, 2, 1}, 0.25});
+    c.phases.push_back({"wave", {3, 1, 1}, 0.75});
+    const std::optional<WorkLog> m = median_log({a, b, c});
+    ASSERT_TRUE(m);
+    ASSERT_EQ(m->phases.size(), 1u);
+    EXPECT_EQ(m->phases[0].item_seconds, (std::vector<double>{1, 1, 1}));
+    EXPECT_DOUBLE_EQ(m->phases[0].serial_seconds, 0.5);
+    EXPECT_DOUBLE_EQ(modelled_seconds(*m, 3), 1.5);
+    c.phases[0].item_seconds.push_back(1);
+    EXPECT_FALSE(median_log({a, b, c}));
+    EXPECT_FALSE(median_log({}));
+}
+
 }  // namespace
 }  // namespace photond
