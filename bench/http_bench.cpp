@@ -109,16 +109,21 @@ struct StreamTimes {
     json status;
 };
 
-/// Submits a job and consumes its tile stream and final image, timing from the POST.
-StreamTimes submit_and_stream(httplib::Client& client, const json& job) {
-    StreamTimes t;
-    const Clock::time_point start = Clock::now();
+/// Submits a job; returns its id (exits on failure).
+std::string submit(httplib::Client& client, const json& job) {
     auto posted = client.Post("/v1/jobs", job.dump(), "application/json");
     if (!posted || posted->status != 202) {
         std::fprintf(stderr, "http_bench: submit failed\n");
         std::exit(1);
     }
-    const std::string id = json::parse(posted->body).at("id");
+    return json::parse(posted->body).at("id");
+}
+
+/// Submits a job and consumes its tile stream and final image, timing from the POST.
+StreamTimes submit_and_stream(httplib::Client& client, const json& job) {
+    StreamTimes t;
+    const Clock::time_point start = Clock::now();
+    const std::string id = submit(client, job);
     std::unique_ptr<PartCounter> counter;
     client.Get(
         "/v1/jobs/" + id + "/tiles",
@@ -156,12 +161,7 @@ struct PreviewTimes {
 PreviewTimes submit_and_watch_preview(httplib::Client& client, const json& job) {
     PreviewTimes t;
     const Clock::time_point start = Clock::now();
-    auto posted = client.Post("/v1/jobs", job.dump(), "application/json");
-    if (!posted || posted->status != 202) {
-        std::fprintf(stderr, "http_bench: submit failed\n");
-        std::exit(1);
-    }
-    const std::string id = json::parse(posted->body).at("id");
+    const std::string id = submit(client, job);
     std::string buffer;
     bool complete = false;
     // Events are "event: TYPE\ndata: JSON\n\n"; the stream is left once the preview is whole

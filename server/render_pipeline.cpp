@@ -127,42 +127,39 @@ Expected<std::shared_ptr<const PhotonMaps>> build_photon_maps(const protocol::Re
     stats.caustic_flux_share = caustic_flux_share(*maps);
     for (std::string& warning : incomplete_photon_map_warnings(maps->statistics, settings))
         stats.warnings.push_back(std::move(warning));
-    if (caustic_stopped_as_negligible(maps->statistics, settings)) {
-        // Not a warning: the map is right, only its light is too faint to be worth more photons.
+    // Adds to the caustic map's reason in the plan; `skipped`: the map is not read after all.
+    const auto tell_caustic_plan = [&](const std::string& text, bool skipped) {
         for (PassDecision& d : stats.plan) {
             if (d.pass != "caustic_map") continue;
-            char text[320];
-            std::snprintf(text, sizeof text,
-                          "; stopped early at %llu of %u photons (%.1f M emitted): they carry %.2g %% of the light "
-                          "the global map brings to surfaces, under %.2g %%, so more would not show",
-                          static_cast<unsigned long long>(maps->statistics.stored_caustic), settings.caustic_photons,
-                          static_cast<double>(maps->statistics.emitted_caustic) * 1e-6,
-                          100.0 * stats.caustic_flux_share, 100.0 * kNegligibleCausticShare);
+            if (skipped) d.enabled = false;
             d.reason += text;
         }
+    };
+    char text[320];
+    if (caustic_stopped_as_negligible(maps->statistics, settings)) {
+        // Not a warning: the map is right, only its light is too faint to be worth more photons.
+        std::snprintf(text, sizeof text,
+                      "; stopped early at %llu of %u photons (%.1f M emitted): they carry %.2g %% of the light "
+                      "the global map brings to surfaces, under %.2g %%, so more would not show",
+                      static_cast<unsigned long long>(maps->statistics.stored_caustic), settings.caustic_photons,
+                      static_cast<double>(maps->statistics.emitted_caustic) * 1e-6,
+                      100.0 * stats.caustic_flux_share, 100.0 * kNegligibleCausticShare);
+        tell_caustic_plan(text, false);
     }
     if (maps->statistics.caustic_dropped) {
         // Not a warning either: the caustic would change no pixel by as much as its threshold.
-        for (PassDecision& d : stats.plan) {
-            if (d.pass != "caustic_map") continue;
-            char text[320];
-            std::snprintf(text, sizeof text,
-                          "; dropped after %llu photons (%.1f M emitted): where they land the caustic is at most "
-                          "%.2g %% of the irradiance, under %.2g %%, so it would not show",
-                          static_cast<unsigned long long>(maps->statistics.stored_caustic),
-                          static_cast<double>(maps->statistics.emitted_caustic) * 1e-6,
-                          100.0 * maps->statistics.caustic_peak_ratio, 100.0 * kInvisibleCausticRatio);
-            d.enabled = false;
-            d.reason += text;
-        }
+        std::snprintf(text, sizeof text,
+                      "; dropped after %llu photons (%.1f M emitted): where they land the caustic is at most "
+                      "%.2g %% of the irradiance, under %.2g %%, so it would not show",
+                      static_cast<unsigned long long>(maps->statistics.stored_caustic),
+                      static_cast<double>(maps->statistics.emitted_caustic) * 1e-6,
+                      100.0 * maps->statistics.caustic_peak_ratio, 100.0 * kInvisibleCausticRatio);
+        tell_caustic_plan(text, true);
     }
-    if (settings.caustic_photons > 0 && maps->statistics.stored_caustic == 0) {
-        for (PassDecision& d : stats.plan) {
-            if (d.pass != "caustic_map") continue;
-            d.reason += "; no photon reached a diffuse surface through them after " +
-                        std::to_string(maps->statistics.emitted_caustic) + " emitted: the scene has no caustics";
-        }
-    }
+    if (settings.caustic_photons > 0 && maps->statistics.stored_caustic == 0)
+        tell_caustic_plan("; no photon reached a diffuse surface through them after " +
+                              std::to_string(maps->statistics.emitted_caustic) + " emitted: the scene has no caustics",
+                          false);
     // The photon pass in parts: tracing, the kd-trees and the irradiance precomputed at photons
     // when traced here, and the rest of its wall time (the cache's file written, or read on a
     // hit) as photon_map_store, so that the passes add up to the whole.

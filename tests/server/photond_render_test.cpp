@@ -427,6 +427,23 @@ TEST_F(PhotondRender, DeeplyNestedJobsAndGltfFilesAreRefusedByName) {
     EXPECT_FALSE(fs::exists(dir_ / "g.exr"));
 }
 
+TEST_F(PhotondRender, ACausticMapThatWouldNotShowIsDroppedAndThePlanSaysSo) {
+    // A wide mirror reflecting 0.1 % of the light: its caustic is under a thousandth of the light
+    // where it lands (tests/data/gltf/generate.py).
+    const auto r = run("render " + (kGltfData / "faint_caustics.gltf").string() +
+                       " --width 16 --height 16 --spp 1 --set photons.caustic=2000"
+                       " --set photons.global=2000 --set gather.rays=16 --stats-json " +
+                       (dir_ / "s.json").string() + " -o " + (dir_ / "c.exr").string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("plan: caustic_map  skipped"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("where they land the caustic is at most"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("photon map incomplete"), std::string::npos) << r.output;
+    const auto stats = nlohmann::json::parse(read_file(dir_ / "s.json"));
+    EXPECT_TRUE(stats.at("photons").at("caustic_dropped").get<bool>());
+    EXPECT_LT(stats.at("photons").at("caustic_peak_ratio").get<double>(), 0.01);
+    EXPECT_EQ(stats.at("photons").at("caustic_points").get<uint64_t>(), 0u);
+}
+
 TEST_F(PhotondRender, IncompletePhotonMapIsAWarningThatSaysWhatToChange) {
     // One small mirror catches about 1 in 1,400 photons: 2,000 caustic photons need 2.8 M
     // emissions, beyond the cap of 1,000 per requested photon.
