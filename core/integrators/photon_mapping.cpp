@@ -189,7 +189,8 @@ Color PhotonMapIntegrator::indirect_irradiance(const DiffusePoint& point, Sample
 /// caustic that is faint as irradiance into a highlight.
 bool PhotonMapIntegrator::caustic_may_show(const Vec3& p, const Vec3& normal, const Bsdf& bsdf, const Vec3& wo,
                                            float other) const {
-    if (!maps_->caustic_irradiance || !bsdf.reads_as_diffuse() || bsdf.transmits_non_delta()) return true;
+    // reads_as_diffuse() is false for rough transmission too.
+    if (!maps_->caustic_irradiance || !bsdf.reads_as_diffuse()) return true;
     Color irradiance;
     if (!maps_->caustic_irradiance->nearest_irradiance(p, normal, caustic_options_.max_radius, &irradiance)) return false;
     const float caustic = luminance(bsdf.diffuse_like_reflectance(wo) * kInvPi * irradiance);

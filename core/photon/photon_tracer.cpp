@@ -280,6 +280,14 @@ double caustic_peak_ratio(const PhotonMap& caustic, const PhotonMap& global, con
     return peak;
 }
 
+/// Records that the caustic map's visibility test ran (its peak ratio already in `stats`);
+/// true, and the map marked dropped, when its light would not show anywhere.
+bool caustic_test_drops(PhotonTracingStatistics& stats) {
+    stats.caustic_tested = true;
+    stats.caustic_dropped = stats.caustic_peak_ratio < kInvisibleCausticRatio;
+    return stats.caustic_dropped;
+}
+
 /// The caustic photons traced so far packed into a map of their own (the traced ones stay), their
 /// flux divided by the `emitted` photons so far: the visibility test's map while tracing goes on.
 PhotonMap partial_map(const MapBuilder& builder, uint64_t emitted) {
@@ -431,9 +439,7 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
                 stats.caustic_peak_ratio =
                     caustic_peak_ratio(partial, *maps.global, caustic_test_sites(caustic), k, settings, scene_radius);
             });
-            stats.caustic_tested = true;
-            if (stats.caustic_peak_ratio < kInvisibleCausticRatio) {
-                stats.caustic_dropped = true;
+            if (caustic_test_drops(stats)) {
                 caustic.active = false;
                 caustic.complete = false;
                 caustic.emitted = emitted;
@@ -474,11 +480,7 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
         arena.execute([&] {
             stats.caustic_peak_ratio = caustic_peak_ratio(*maps.caustic, *maps.global, caustic_sites, k, settings, scene_radius);
         });
-        stats.caustic_tested = true;
-        if (stats.caustic_peak_ratio < kInvisibleCausticRatio) {
-            stats.caustic_dropped = true;
-            maps.caustic = nullptr;
-        }
+        if (caustic_test_drops(stats)) maps.caustic = nullptr;
     }
     stats.build_seconds = std::chrono::duration<double>(Clock::now() - build_start).count() + early_build_seconds;
     if (maps.global && settings.irradiance_stride > 0) {

@@ -23,10 +23,10 @@
 // again when the caustic map ends), the caustic irradiance at up to kCausticTestSites of its
 // photons is compared with all the irradiance the global map finds there. Where the largest
 // ratio is under kInvisibleCausticRatio, adding the caustic changes no pixel by more than that,
-// while its estimates at every visible point would cost the most of the render pass (a sky-lit
-// scene of rough glass whose small emitters cast a caustic worth 0.2 % of the light where it
-// landed spent half its render there): the map is not built, tracing for it stops, and the
-// statistics say why (caustic_dropped, caustic_peak_ratio).
+// while tracing it and estimating it at visible points would cost time: the map is not built,
+// tracing for it stops, and the statistics say why (caustic_dropped, caustic_peak_ratio). A map
+// that shows somewhere is kept; where it is faint, the render skips it point by point
+// (PhotonMapIntegrator::caustic_may_show, with the caustic irradiance precomputed here).
 #pragma once
 
 #include <atomic>
