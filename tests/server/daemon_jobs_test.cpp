@@ -61,7 +61,8 @@ TEST_F(DaemonJobs, CancelMidRenderStopsWithinAboutATile) {
     json first_tile;
     double cancel_seconds = -1.0;
     const std::vector<SseEvent> events = follow_events(client, id, [&](const SseEvent& e) {
-        if (e.type != "tile" || !first_tile.is_null()) return true;
+        // The first final tile: a progressive job's preview tiles come first, in the preview pass.
+        if (e.type != "tile" || e.data.value("preview", false) || !first_tile.is_null()) return true;
         first_tile = e.data;
         // While rendering: a finished tile is served, the image is not ready, the preview is.
         const HttpResponse tile = client.get(e.data.at("url"));
