@@ -4,8 +4,9 @@
 Renders builtin:cornell-box-diffuse (256x256, `final` otherwise, no caustic map) with 200k, 1M,
 3M and 10M global photons through `photond render`, one process each, and prints for each count:
 the photon pass in its parts (tracing, kd-tree, precomputed irradiance), its cost per stored
-photon, the photon map's bytes, the process's peak RSS against the map, and the sum of all
-passes against the total (the statistics' `passes` must add up to `total_seconds`).
+photon, the photon map's bytes, the process's peak RSS against the map (whole, and less the peak
+of the same render with a thousand photons: the maps' own share), and the sum of all passes
+against the total (the statistics' `passes` must add up to `total_seconds`).
 
     python3 bench/photon_series.py --photond build/server/photond [--counts 200000,1000000]
 
@@ -46,10 +47,15 @@ def main():
     args = parser.parse_args()
     counts = [int(c) for c in args.counts.split(",")]
 
-    print("global photons | tracing s | kd-tree s | irradiance s | photon pass s | us per photon | "
-          "map MB | peak RSS MB | RSS / map | passes s | total s | passes / total")
-    print("---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:")
     with tempfile.TemporaryDirectory() as directory:
+        # The same render with a thousand photons: the process without photon maps (program,
+        # scene, acceleration structure, image, cache), to tell the maps' share of the peak.
+        _, baseline_rss = render(args.photond, 1000, args.threads, directory)
+        print(f"Process without photon maps (1,000 photons): peak RSS {baseline_rss / 1e6:.0f} MB.")
+        print()
+        print("global photons | tracing s | kd-tree s | irradiance s | photon pass s | us per photon | "
+              "map MB | peak RSS MB | RSS / map | (RSS - without) / map | passes s | total s | passes / total")
+        print("---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:")
         for count in counts:
             stats, peak_rss = render(args.photond, count, args.threads, directory)
             seconds = {p["name"]: p["seconds"] for p in stats["passes"]}
@@ -60,7 +66,8 @@ def main():
             total = stats["total_seconds"]
             print(f"{count:,} | {seconds.get('photon_tracing', 0):.2f} | {seconds.get('photon_kdtree', 0):.2f} | "
                   f"{seconds.get('photon_irradiance', 0):.2f} | {photon_pass:.2f} | {1e6 * photon_pass / stored:.2f} | "
-                  f"{map_bytes / 1e6:.0f} | {peak_rss / 1e6:.0f} | {peak_rss / map_bytes:.2f} | {passes:.2f} | "
+                  f"{map_bytes / 1e6:.0f} | {peak_rss / 1e6:.0f} | {peak_rss / map_bytes:.2f} | "
+                  f"{(peak_rss - baseline_rss) / map_bytes:.2f} | {passes:.2f} | "
                   f"{total:.2f} | {passes / total:.3f}")
             sys.stdout.flush()
 

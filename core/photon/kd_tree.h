@@ -55,10 +55,11 @@ struct KnnResult {
 /// is contiguous in memory and no pointers or extra node records are stored: 24 bytes per photon,
 /// like Jensen's left-balanced heap, and faster to query (bench/kd_tree_bench.cpp measures both).
 /// Split axis: the largest extent of the subtree's bounding box (lowest axis on ties); split at
-/// the median of (coordinate, input index), so equal coordinates are ordered deterministically.
+/// the median coordinate.
 ///
-/// Build: parallel over subtrees with oneTBB in the current task arena; the tree does not
-/// depend on the number of threads. Photons with a non-finite position are dropped, so
+/// Build: in place in the photons' own array (no memory beyond them), parallel over subtrees
+/// with oneTBB in the current task arena; the tree depends only on the input order, not on the
+/// number of threads. Photons with a non-finite position are dropped, so
 /// size() may be less than the input's size. Indices are positions in the tree's order, not in
 /// the input vector.
 class PhotonKdTree {
@@ -118,6 +119,8 @@ public:
     }
 
 private:
+    static void build_subtree(Photon* photons, uint32_t lo, uint32_t hi);
+
     template <class Distance2>
     void k_nearest_impl(const Vec3& p, uint32_t k, float max_radius, KnnResult& out,
                         Distance2 distance2_to) const;

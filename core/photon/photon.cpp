@@ -85,29 +85,37 @@ Vec3 Photon::normal() const {
 
 constinit const PhotonDirectionTables kPhotonDirectionTables = make_direction_tables();
 
-Photon make_photon(Vec3 position, Vec3 direction, Color flux, uint8_t user_flags, Vec3 normal) {
-    Photon p;
-    p.position = position;
-    p.flags_ = uint8_t((user_flags << 2) | 3u);
-
-    // Flux: shared exponent from the largest channel, mantissas rounded to nearest (the encoded
-    // value is the representable one nearest to each channel for that exponent). Float bit
-    // arithmetic, exact like frexp, ldexp and lround, which were a tenth of packing a photon.
+void Photon::set_flux(const Color& flux) {
+    // Shared exponent from the largest channel, mantissas rounded to nearest (the encoded value
+    // is the representable one nearest to each channel for that exponent). Float bit arithmetic,
+    // exact like frexp, ldexp and lround, which were a tenth of packing a photon.
+    flux_mantissas_ = 0;
+    flux_exponent_ = 0;
     const float rgb[3] = {sanitize_channel(flux.x), sanitize_channel(flux.y), sanitize_channel(flux.z)};
     const float largest = std::max(rgb[0], std::max(rgb[1], rgb[2]));
     // largest = f * 2^exponent with f in [0.5, 1) (frexp's convention); subnormals fall below the range.
     int exponent = static_cast<int>(std::bit_cast<uint32_t>(largest) >> 23) - 126;
-    if (largest > 0.0f && exponent >= Photon::kMinFluxExponent) {
+    if (largest > 0.0f && exponent >= kMinFluxExponent) {
         if (round_half_away(times_power_of_two(largest, 10 - exponent)) >= 1024) ++exponent;  // rounds up
-        exponent = std::min(exponent, Photon::kMaxFluxExponent);
+        exponent = std::min(exponent, kMaxFluxExponent);
         uint32_t mantissas = 0;
         for (int c = 0; c < 3; ++c) {
             const uint32_t m = std::min(1023u, round_half_away(times_power_of_two(rgb[c], 10 - exponent)));
             mantissas |= m << (10 * c);
         }
-        p.flux_mantissas_ = mantissas;
-        p.flux_exponent_ = uint8_t(exponent - Photon::kMinFluxExponent + 1);
+        flux_mantissas_ = mantissas;
+        flux_exponent_ = uint8_t(exponent - kMinFluxExponent + 1);
     }
+}
+
+void Photon::scale_flux(double factor) { set_flux(Color(DVec3(flux()) * factor)); }
+
+Photon make_photon(Vec3 position, Vec3 direction, Color flux, uint8_t user_flags, Vec3 normal) {
+    Photon p;
+    p.position = position;
+    p.flags_ = uint8_t((user_flags << 2) | 3u);
+
+    p.set_flux(flux);
 
     // Direction: theta = acos(z), phi = atan2(y, x) (Jensen 2001, section 6.3).
     const float length = glm::length(direction);

@@ -72,6 +72,11 @@ struct Photon {
     /// 3 otherwise. Written by PhotonKdTree only.
     uint32_t split_axis() const { return flags_ & 3u; }
 
+    /// Multiplies the flux by `factor` (>= 0) and encodes it anew: the photon tracer stores
+    /// photons before it knows how many were emitted for their map, and divides once it does.
+    /// Each rounding is within max_channel / 1024 (see above), the two within max_channel / 512.
+    void scale_flux(double factor);
+
     // Raw encoded fields, for tests and serialisation.
     uint32_t flux_mantissas() const { return flux_mantissas_; }
     uint8_t flux_exponent() const { return flux_exponent_; }
@@ -89,6 +94,7 @@ private:
     friend class PhotonKdTree;
 
     void set_split_axis(uint32_t axis) { flags_ = uint8_t((flags_ & ~3u) | (axis & 3u)); }
+    void set_flux(const Color& flux);
 
     uint32_t flux_mantissas_ = 0;  // red bits 0-9, green 10-19, blue 20-29, bits 30-31 zero
     uint8_t flux_exponent_ = 0;    // shared exponent - kMinFluxExponent + 1; 0 = black

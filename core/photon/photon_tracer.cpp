@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <utility>
 
 #include "core/math/rng.h"
 #include "core/shading/scene_queries.h"
@@ -20,17 +21,19 @@ using Clock = std::chrono::steady_clock;
 constexpr uint64_t kPhotonStreamTag = 0x70686f746f6e73ull;  // separates photon streams from pixels
 constexpr uint32_t kChunkSize = 1024;                       // photons per parallel task
 constexpr uint64_t kEmptyMapTrial = 1u << 20;               // emissions before an empty map is given up
+// A batch stores at most about this share of a map's photons: the chunks' buffers of traced
+// photons (28 bytes each) then stay a small part of the map's memory (photon_series.py's peak).
+constexpr double kBatchesPerMap = 8.0;
 constexpr float kIrradianceRadiusShare = 0.2f;             // irradiance estimate radius cap / scene radius
 
-/// A stored photon before its map is complete: full-precision flux, scaled once at the end by
-/// 1 / (photons emitted for its map), then packed.
+/// A stored photon before its map is complete: packed as the map stores it, but with its flux
+/// not yet divided by the photons emitted for its map (Photon::scale_flux does that once they
+/// are counted), and its emission index within the batch, to cut the map at the photon that
+/// fills it. 28 bytes: a full-precision record was 56, and with the packed copy made from it
+/// the traced photons took 3.3 times the map's bytes at their peak.
 struct TracedPhoton {
-    Vec3 position;
-    Vec3 direction;
-    Vec3 normal;  // shading normal on the side the photon arrived from
-    Color flux;
-    uint32_t path;  // emission index within the batch, to cut the map at the photon that fills it
-    uint8_t flags;
+    Photon photon;
+    uint32_t path;
 };
 
 /// Traced photons of one chunk. oneTBB's scalable allocator keeps freed blocks for reuse, where
@@ -56,40 +59,45 @@ struct MapBuilder {
     bool active = false;      // still collecting
     bool complete = true;
     uint64_t emitted = 0;     // photons emitted for this map (set when it fills or stops)
-    size_t count = 0;         // photons collected so far, over all parts
+    size_t count = 0;         // photons collected so far
     double flux_sum = 0.0;    // their flux's luminance, not yet divided by the emissions
-    /// The collected photons in emission order: the chunks' own buffers, moved in rather than
-    /// copied (copying every photon into one fresh array cost about a fifth of tracing).
-    std::vector<TracedPhotons> parts;
+    /// The collected photons in emission order, flux not yet divided (TracedPhoton), in one
+    /// array reserved for the whole map: it becomes the map, and its kd-tree is built in it.
+    std::vector<Photon> photons;
 
-    /// Takes a batch's photons in order; stops at the one that fills the map.
-    void append(std::span<ChunkOutput> chunks, TracedPhotons ChunkOutput::*member,
-                uint64_t batch_start) {
+    /// Takes a batch's photons in order; stops at the one that fills the map. The chunks'
+    /// photons are copied in parallel, each chunk to its own range.
+    void append(std::span<ChunkOutput> chunks, TracedPhotons ChunkOutput::*member, uint64_t batch_start) {
         if (!active) return;
-        for (ChunkOutput& chunk : chunks) {
-            TracedPhotons& photons = chunk.*member;
-            if (photons.empty()) continue;
-            if (count + photons.size() >= target) {
-                photons.resize(target - count);
-                emitted = batch_start + photons.back().path + 1;
+        std::vector<size_t> offsets(chunks.size() + 1, count);
+        size_t used = 0;  // chunks that contribute
+        for (size_t c = 0; c < chunks.size() && active; ++c) {
+            TracedPhotons& traced = chunks[c].*member;
+            if (count + traced.size() >= target) {
+                traced.resize(target - count);
+                if (!traced.empty()) emitted = batch_start + traced.back().path + 1;
                 active = false;
             }
-            count += photons.size();
-            for (const TracedPhoton& p : photons) flux_sum += static_cast<double>(luminance(p.flux));
-            parts.push_back(std::move(photons));
-            photons = {};
-            if (!active) return;
+            count += traced.size();
+            offsets[c + 1] = count;
+            used = c + 1;
         }
+        photons.resize(count);
+        std::vector<double> sums(used, 0.0);
+        tbb::parallel_for(size_t(0), used, [&](size_t c) {
+            Photon* out = photons.data() + offsets[c];
+            for (const TracedPhoton& t : chunks[c].*member) {
+                *out++ = t.photon;
+                sums[c] += static_cast<double>(luminance(t.photon.flux()));
+            }
+        });
+        for (const double sum : sums) flux_sum += sum;  // in chunk order: the same on every run
     }
 
     /// Calls f(photon) for every stride-th photon in emission order (the 0th, the stride-th, ...).
     template <typename F>
     void for_each_strided(size_t stride, F&& f) const {
-        size_t index = 0, next = 0;
-        for (const TracedPhotons& part : parts) {
-            for (; next < index + part.size(); next += stride) f(part[next - index]);
-            index += part.size();
-        }
+        for (size_t i = 0; i < count; i += stride) f(photons[i]);
     }
 };
 
@@ -139,7 +147,7 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
             const uint8_t flags = static_cast<uint8_t>((bounce == 0 ? photon_flags::kDirect : 0) |
                                                        (caustic_path ? photon_flags::kCaustic : 0));
             const Vec3 normal = glm::dot(si.surface_normal, wo) >= 0.0f ? si.surface_normal : -si.surface_normal;
-            const TracedPhoton photon{si.p, ray.direction, normal, flux, path_in_batch, flags};
+            const TracedPhoton photon{make_photon(si.p, ray.direction, flux, flags, normal), path_in_batch};
             if (want_global) out.global.push_back(photon);
             if (want_caustic && caustic_path) out.caustic.push_back(photon);
         }
@@ -195,13 +203,13 @@ uint32_t site_stride(size_t photons, uint32_t stride, uint32_t k) {
     return static_cast<uint32_t>(std::max<size_t>(stride, std::min<size_t>(widened, std::max<uint32_t>(k / 2, 1))));
 }
 
-/// Every stride-th traced photon of `traced`, in photon order, as an irradiance site. Kept apart
-/// so that the traced photons (56 bytes each) can be freed before the kd-tree is built.
+/// Every stride-th traced photon of `traced`, in photon order, as an irradiance site. Taken
+/// before the map's kd-tree is built in the photons' array, which reorders it.
 std::vector<IrradianceSite> irradiance_sites(const MapBuilder& traced, uint32_t stride) {
     std::vector<IrradianceSite> sites;
     if (stride == 0) return sites;
     sites.reserve((traced.count + stride - 1) / stride);
-    traced.for_each_strided(stride, [&](const TracedPhoton& t) { sites.push_back({t.position, t.normal}); });
+    traced.for_each_strided(stride, [&](const Photon& p) { sites.push_back({p.position, p.normal()}); });
     return sites;
 }
 
@@ -242,23 +250,14 @@ std::shared_ptr<const PhotonMap> precompute_irradiance(const PhotonMap& global, 
     return std::make_shared<const PhotonMap>(std::move(points), 0);
 }
 
-/// Packs the traced photons into a map and builds its kd-tree; the traced photons are freed
-/// first, so that they and the tree's build do not take memory at the same time.
+/// The traced photons, their flux divided by the photons emitted for the map, become the map;
+/// its kd-tree is built in their array.
 std::shared_ptr<const PhotonMap> finish_map(MapBuilder& builder) {
-    // Packing costs an acos and an atan2 a photon (the direction): in parallel, each part into
-    // its own range.
-    std::vector<size_t> offsets(builder.parts.size() + 1, 0);
-    for (size_t i = 0; i < builder.parts.size(); ++i) offsets[i + 1] = offsets[i] + builder.parts[i].size();
-    std::vector<Photon> packed(builder.count);
     const double scale = builder.emitted > 0 ? 1.0 / static_cast<double>(builder.emitted) : 0.0;
-    tbb::parallel_for(size_t(0), builder.parts.size(), [&](size_t i) {
-        Photon* out = packed.data() + offsets[i];
-        for (const TracedPhoton& p : builder.parts[i]) {
-            *out++ = make_photon(p.position, p.direction, Color(DVec3(p.flux) * scale), p.flags, p.normal);
-        }
-        TracedPhotons().swap(builder.parts[i]);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, builder.count, 1u << 14), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i < r.end(); ++i) builder.photons[i].scale_flux(scale);
     });
-    return std::make_shared<const PhotonMap>(std::move(packed), builder.emitted);
+    return std::make_shared<const PhotonMap>(std::exchange(builder.photons, {}), builder.emitted);
 }
 
 /// The caustic map's visibility test (photon_tracer.h): the largest ratio, over the caustic
@@ -291,12 +290,9 @@ bool caustic_test_drops(PhotonTracingStatistics& stats) {
 /// The caustic photons traced so far packed into a map of their own (the traced ones stay), their
 /// flux divided by the `emitted` photons so far: the visibility test's map while tracing goes on.
 PhotonMap partial_map(const MapBuilder& builder, uint64_t emitted) {
-    std::vector<Photon> packed;
-    packed.reserve(builder.count);
+    std::vector<Photon> packed(builder.photons.begin(), builder.photons.begin() + builder.count);
     const double scale = emitted > 0 ? 1.0 / static_cast<double>(emitted) : 0.0;
-    for (const TracedPhotons& part : builder.parts)
-        for (const TracedPhoton& p : part)
-            packed.push_back(make_photon(p.position, p.direction, Color(DVec3(p.flux) * scale), p.flags, p.normal));
+    for (Photon& p : packed) p.scale_flux(scale);
     return PhotonMap(std::move(packed), emitted);
 }
 
@@ -330,6 +326,9 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
     caustic.active = caustic.target > 0;
     global.cap = static_cast<uint64_t>(global.target) * settings.max_emitted_per_stored;
     caustic.cap = static_cast<uint64_t>(caustic.target) * settings.max_emitted_per_stored;
+    // Reserved whole, touched as photons arrive: no copy when the array grows.
+    global.photons.reserve(global.target);
+    caustic.photons.reserve(caustic.target);
 
     PhotonMaps maps;
     PhotonTracingStatistics& stats = maps.statistics;
@@ -353,27 +352,29 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
         // Size the next batch from the store rate so far (deterministic: it depends only on the
         // maps' contents), within [16K, 1M] photons: enough for the map that fills first, so
         // that photons past its fill point are not traced for it (the caustic map usually needs
-        // ten times the emissions; after the global map fills, its photons trace cheaply).
+        // ten times the emissions; after the global map fills, its photons trace cheaply), and
+        // storing at most 1 / kBatchesPerMap of any map.
         uint64_t batch = 16384;
         if (emitted > 0) {
-            double needed_first = 1048576.0;
+            double needed_first = 1048576.0, largest = 1048576.0;
             for (const MapBuilder* m : {&global, &caustic}) {
                 if (!m->active || m->count == 0) continue;
                 const double rate = static_cast<double>(m->count) / static_cast<double>(emitted);
                 needed_first = std::min(needed_first, 1.1 * static_cast<double>(m->target - m->count) / rate);
+                largest = std::min(largest, static_cast<double>(m->target) / kBatchesPerMap / rate);
             }
-            batch = std::max<uint64_t>(batch, static_cast<uint64_t>(needed_first));
+            batch = std::clamp<uint64_t>(static_cast<uint64_t>(needed_first), batch,
+                                         std::max<uint64_t>(batch, static_cast<uint64_t>(largest)));
         }
         const bool want_global = global.active, want_caustic = caustic.active;
         const size_t chunk_count = (batch + kChunkSize - 1) / kChunkSize;
         // Chunk buffers are kept from batch to batch: their capacity is reused, not reallocated.
         if (chunks.size() < chunk_count) chunks.resize(chunk_count);
-        // Buffers taken by a map are gone; size the new ones from the store rate so far (growing
-        // them photon by photon is copying and page faults).
+        // Size the buffers from the store rate so far (growing them photon by photon is copying
+        // and page faults); they keep their capacity from batch to batch.
         const auto expected = [&](const MapBuilder& m) {
             if (!m.active) return size_t(0);
-            // First guess: a global photon per emission; caustic photons are rarer, and kept
-            // buffers keep their capacity.
+            // First guess: a global photon per emission; caustic photons are rarer.
             if (emitted == 0) return &m == &global ? size_t(kChunkSize) : size_t(0);
             return static_cast<size_t>(1.2 * kChunkSize * static_cast<double>(m.count) / static_cast<double>(emitted)) + 16;
         };
@@ -400,8 +401,10 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
         if (settings.cancel && settings.cancel->load()) cancelled = true;
         const std::span<ChunkOutput> batch_chunks(chunks.data(), chunk_count);
         for (const ChunkOutput& c : batch_chunks) stats.rays += c.rays;
-        global.append(batch_chunks, &ChunkOutput::global, emitted);
-        caustic.append(batch_chunks, &ChunkOutput::caustic, emitted);
+        arena.execute([&] {
+            global.append(batch_chunks, &ChunkOutput::global, emitted);
+            caustic.append(batch_chunks, &ChunkOutput::caustic, emitted);
+        });
         emitted += batch;
         // A caustic map that carries next to no light is not worth its emissions: stop it.
         if (caustic.active && global.target > 0 && !global.active && global.emitted > 0 && global.flux_sum > 0.0 &&

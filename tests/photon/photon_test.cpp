@@ -97,6 +97,34 @@ TEST(Photon, EncodingIsIdempotent) {
     }
 }
 
+// The photon tracer packs a photon before its map's emissions are counted and divides after:
+// two roundings, each within max_channel / 1024, and every other field untouched.
+TEST(Photon, ScaledFluxStaysWithinTwoRoundings) {
+    Rng rng(5, 6);
+    float worst_absolute = 0.0f;
+    for (int i = 0; i < 100000; ++i) {
+        const Color flux = std::exp2(60.0f * rng.next_float() - 10.0f) *
+                           Color(0.1f + 0.9f * rng.next_float(), 0.1f + 0.9f * rng.next_float(), rng.next_float());
+        const double factor = 1.0 / (1.0 + std::floor(1e7 * double(rng.next_float())));
+        const Photon packed = make_photon(Vec3(1, 2, 3), Vec3(0.3f, -0.5f, 0.8f), flux, 17, Vec3(0, 1, 0));
+        Photon scaled = packed;
+        scaled.scale_flux(factor);
+        const DVec3 exact = DVec3(flux) * factor;
+        const double largest = std::max(exact.x, std::max(exact.y, exact.z));
+        const Color decoded = scaled.flux();
+        for (int c = 0; c < 3; ++c)
+            worst_absolute = std::max(worst_absolute, float(std::abs(double(decoded[c]) - exact[c]) / largest));
+        ASSERT_EQ(scaled.position, packed.position);
+        ASSERT_EQ(scaled.theta_bin(), packed.theta_bin());
+        ASSERT_EQ(scaled.phi_bin(), packed.phi_bin());
+        ASSERT_EQ(scaled.normal_u(), packed.normal_u());
+        ASSERT_EQ(scaled.normal_v(), packed.normal_v());
+        ASSERT_EQ(scaled.user_flags(), 17);
+    }
+    EXPECT_LE(worst_absolute, 2.0f / 1024.0f * 1.0001f);
+    EXPECT_GT(worst_absolute, 0.5f / 1024.0f);  // it measures rounding, not an identity
+}
+
 TEST(Photon, ZeroTinyHugeAndInvalidFlux) {
     EXPECT_EQ(decoded_flux(Color(0.0f)), Color(0.0f));
     EXPECT_EQ(decoded_flux(Color(-0.0f)), Color(0.0f));
