@@ -85,11 +85,14 @@ Color PhotonMap::estimate_radiance(const Vec3& p, const Vec3& normal, const Bsdf
 }
 
 Color PhotonMap::estimate_irradiance(const Vec3& p, const Vec3& normal, uint32_t k, float max_radius,
-                                     uint8_t exclude_flags) const {
+                                     uint8_t exclude_flags, float* radius_hint) const {
     if (tree_.empty()) return Color(0.0f);
     KnnResult& found = thread_scratch();
     max_radius = max_radius > 0.0f ? max_radius : std::numeric_limits<float>::infinity();
-    tree_.k_nearest_in_disc(p, normal, kPhotonDiscFlattening, k, max_radius, found);
+    const bool hinted = radius_hint && *radius_hint > 0.0f && *radius_hint < max_radius;
+    if (hinted) tree_.k_nearest_in_disc(p, normal, kPhotonDiscFlattening, k, *radius_hint, found);
+    if (!hinted || found.size() < k) tree_.k_nearest_in_disc(p, normal, kPhotonDiscFlattening, k, max_radius, found);
+    if (radius_hint) *radius_hint = found.size() >= k && k > 0 ? std::sqrt(found.radius2) : 0.0f;
     const double radius2 = estimate_radius2(found, k, max_radius);  // see estimate_radiance
     if (found.size() < kMinPhotonsPerEstimate || !(radius2 > 0.0)) return Color(0.0f);
     DVec3 sum(0.0);

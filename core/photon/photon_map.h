@@ -79,8 +79,14 @@ public:
 
     /// Irradiance at p (photon flux per area), for diffuse reflection L = rho / pi * E. Photons
     /// are skipped as in estimate_radiance.
+    ///
+    /// `radius_hint`, when given and positive, is a guess of the estimate's radius (a neighbouring
+    /// estimate's, a little widened): the k photons are first sought within it, and only if fewer
+    /// are there within max_radius. The k nearest within the hint are the k nearest anywhere, so
+    /// the estimate is exactly the one without a hint; the search is shorter when the guess is
+    /// good. On return it holds this estimate's radius (0 when fewer than k photons were found).
     Color estimate_irradiance(const Vec3& p, const Vec3& normal, uint32_t k, float max_radius,
-                              uint8_t exclude_flags = 0) const;
+                              uint8_t exclude_flags = 0, float* radius_hint = nullptr) const;
 
     /// Precomputed irradiance (Christensen 1999, "Faster photon map global illumination"): in a
     /// map whose photons hold irradiance (flux) and surface normal (normal, or direction for

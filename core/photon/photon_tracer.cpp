@@ -21,6 +21,8 @@ using Clock = std::chrono::steady_clock;
 constexpr uint64_t kPhotonStreamTag = 0x70686f746f6e73ull;  // separates photon streams from pixels
 constexpr uint32_t kChunkSize = 1024;                       // photons per parallel task
 constexpr uint64_t kEmptyMapTrial = 1u << 20;               // emissions before an empty map is given up
+// A precomputed irradiance estimate's search starts at its spatial neighbour's radius times this.
+constexpr float kRadiusHintWidening = 1.25f;
 // A batch stores at most about this share of a map's photons: the chunks' buffers of traced
 // photons (28 bytes each) then stay a small part of the map's memory (photon_series.py's peak).
 constexpr double kBatchesPerMap = 8.0;
@@ -241,11 +243,17 @@ std::shared_ptr<const PhotonMap> precompute_irradiance(const PhotonMap& global, 
     // walk the same kd-tree nodes and photons while they are in cache. Each estimate is
     // independent, so the result is the same in any order.
     const std::vector<uint32_t> order = morton_order(sites);
-    tbb::parallel_for(size_t(0), sites.size(), [&](size_t j) {
-        const size_t i = order[j];
-        const IrradianceSite& site = sites[i];
-        const Color e = global.estimate_irradiance(site.position, site.normal, k, max_radius);
-        points[i] = make_photon(site.position, site.normal, e, 0, site.normal);
+    // Each estimate's search starts from the previous one's radius, widened a little
+    // (PhotonMap::estimate_irradiance: the result is exactly that of a search without it).
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, sites.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
+        float hint = 0.0f;
+        for (size_t j = range.begin(); j < range.end(); ++j) {
+            const size_t i = order[j];
+            const IrradianceSite& site = sites[i];
+            hint *= kRadiusHintWidening;
+            const Color e = global.estimate_irradiance(site.position, site.normal, k, max_radius, 0, &hint);
+            points[i] = make_photon(site.position, site.normal, e, 0, site.normal);
+        }
     });
     return std::make_shared<const PhotonMap>(std::move(points), 0);
 }

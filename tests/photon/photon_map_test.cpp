@@ -144,5 +144,38 @@ TEST(PhotonMap, OnANormalMappedSurfaceEachPhotonCountsByTheBentNormal) {
     EXPECT_EQ(estimate(away), 0.0f);
 }
 
+// A radius hint shortens the search, never changes the estimate: good, too small, too large,
+// and after a search that found fewer than k photons.
+TEST(PhotonMap, ARadiusHintGivesExactlyTheEstimateWithoutOne) {
+    std::vector<Photon> photons;
+    Rng rng(8, 9);
+    for (int i = 0; i < 20000; ++i) {
+        const Vec3 p(rng.next_float(), 0.0f, rng.next_float() * rng.next_float());  // denser near z = 0
+        photons.push_back(make_photon(p, Vec3(0, -1, 0), Color(rng.next_float(), 1.0f, 0.5f), 0, Vec3(0, 1, 0)));
+    }
+    const PhotonMap map(std::move(photons), 20000);
+    const Vec3 up(0, 1, 0);
+    float previous = 0.0f;
+    int hinted = 0;
+    for (int i = 0; i < 400; ++i) {
+        const Vec3 p(rng.next_float(), 0.0f, rng.next_float());
+        const Color plain = map.estimate_irradiance(p, up, 50, 0.3f);
+        for (const float factor : {1.25f, 0.5f, 4.0f}) {
+            float hint = previous * factor;
+            const Color with_hint = map.estimate_irradiance(p, up, 50, 0.3f, 0, &hint);
+            ASSERT_EQ(with_hint, plain) << "at " << i << ", hint factor " << factor;
+        }
+        float radius = 0.0f;
+        map.estimate_irradiance(p, up, 50, 0.3f, 0, &radius);
+        hinted += radius > 0.0f && radius < 0.3f;
+        previous = radius;
+    }
+    EXPECT_GT(hinted, 300);  // most estimates found their k photons, and so a radius to pass on
+    // Far from every photon: fewer than k within the cap, radius 0.
+    float hint = 0.1f;
+    map.estimate_irradiance(Vec3(5, 0, 5), up, 50, 0.3f, 0, &hint);
+    EXPECT_EQ(hint, 0.0f);
+}
+
 }  // namespace
 }  // namespace photond
