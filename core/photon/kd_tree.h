@@ -54,8 +54,8 @@ struct KnnResult {
 /// [mid + 1, hi); ranges of at most kLeafSize photons are leaves scanned linearly. Each subtree
 /// is contiguous in memory and no pointers or extra node records are stored: 24 bytes per photon,
 /// like Jensen's left-balanced heap, and faster to query (bench/kd_tree_bench.cpp measures both).
-/// Split axis: the largest extent of the subtree's bounding box (lowest axis on ties); split at
-/// the median coordinate.
+/// Split axis: the largest extent of the subtree's bounding box, taken from at most about 1,024
+/// of its photons (lowest axis on ties); split at the median coordinate.
 ///
 /// Build: in place in the photons' own array (no memory beyond them), parallel over subtrees
 /// with oneTBB in the current task arena; the tree depends only on the input order, not on the
