@@ -4,6 +4,7 @@
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -21,10 +22,43 @@ constexpr uint8_t kLeafAxis = 3;
 // items and reordered copy took 1.7 times the map's bytes on top of it). Equal coordinates need
 // no tie-break: std::nth_element is a deterministic function of the range it is given, and each
 // subtree's range depends only on its parent's, never on timing.
+//
+// Large ranges first split around two pivots taken from an evenly spaced sample, at its
+// quantiles 0.5 -+ kPivotQuantileMargin: one pass (and a half) puts the photons below, between
+// and above them in order, and the median, which the sample places between them but for about
+// one range in a hundred thousand, is then selected in the middle part alone (about a tenth of
+// the range). std::nth_element by itself moves every photon two to three times over.
+constexpr uint32_t kPivotSampleMin = 1u << 16;  // ranges at least this large take pivots
+constexpr uint32_t kPivotSamples = 1023;
+constexpr float kPivotQuantileMargin = 0.06f;     // about 4 standard deviations of the sample's median rank
+
 template <int kAxis>
 void select_median(Photon* first, Photon* median, Photon* last) {
-    std::nth_element(first, median, last,
-                     [](const Photon& a, const Photon& b) { return a.position[kAxis] < b.position[kAxis]; });
+    const auto below = [](const Photon& a, const Photon& b) { return a.position[kAxis] < b.position[kAxis]; };
+    const size_t n = static_cast<size_t>(last - first);
+    if (n >= kPivotSampleMin) {
+        std::array<float, kPivotSamples> sample;
+        const size_t step = n / kPivotSamples;
+        for (uint32_t i = 0; i < kPivotSamples; ++i) sample[i] = first[i * step].position[kAxis];
+        std::sort(sample.begin(), sample.end());
+        const float low = sample[size_t((0.5f - kPivotQuantileMargin) * kPivotSamples)];
+        const float high = sample[size_t((0.5f + kPivotQuantileMargin) * kPivotSamples)];
+        Photon* const middle_begin =
+            std::partition(first, last, [low](const Photon& p) { return p.position[kAxis] < low; });
+        Photon* const middle_end =
+            std::partition(middle_begin, last, [high](const Photon& p) { return p.position[kAxis] <= high; });
+        // Every photon of a part lies below every one of the next: selecting inside the part
+        // that holds the median's place selects the median of all.
+        if (median < middle_begin) {
+            last = middle_begin;
+        } else if (median < middle_end) {
+            first = middle_begin;
+            last = middle_end;
+        } else {
+            first = middle_end;
+        }
+    }
+    std::nth_element(first, median, last, below);
 }
 
 // The axis of the largest extent of the photons [lo, hi), from at most about kAxisSamples of

@@ -244,6 +244,33 @@ TEST(PhotonKdTree, AllOnALine) {
     }
 }
 
+// Ranges of at least 2^16 photons are split around pivots from a sample before the median is
+// selected (kd_tree.cpp): large inputs with runs of equal coordinates, a plane and a sorted
+// order, checked by the adopting validator (every split separates its subtrees) and queries.
+TEST(PhotonKdTree, LargeRangesWithEqualCoordinatesSplitAtTheirMedian) {
+    Rng rng(21, 22);
+    std::vector<std::vector<Vec3>> inputs(3);
+    for (int i = 0; i < 150000; ++i) {
+        // Coordinates from 7 values on x: whole ranges of equal ones around every pivot.
+        inputs[0].push_back(Vec3(float(rng.next_u32() % 7), rng.next_float(), float(rng.next_u32() % 3)));
+        inputs[1].push_back(Vec3(rng.next_float(), 0.25f, rng.next_float()));  // a plane: y all equal
+        inputs[2].push_back(Vec3(float(i) * 1e-5f, 0.5f * rng.next_float(), 0.0f));  // sorted along x
+    }
+    for (const std::vector<Vec3>& points : inputs) {
+        const PhotonKdTree tree(photons_at(points));
+        ASSERT_EQ(tree.size(), points.size());
+        const std::vector<Photon> order(tree.photons().begin(), tree.photons().end());
+        const Expected<PhotonKdTree> adopted = PhotonKdTree::from_tree_order(order);
+        ASSERT_TRUE(adopted.has_value()) << adopted.error().message;
+        KnnResult result;
+        for (int q = 0; q < 40; ++q) {
+            const Vec3 p = points[rng.next_u32() % points.size()] + Vec3(0.01f * rng.next_float(), 0.0f, 0.0f);
+            expect_knn_matches(tree, p, 1 + q % 50, kInf, result);
+            if (HasFailure()) return;
+        }
+    }
+}
+
 TEST(PhotonKdTree, GridWithManyEqualDistances) {
     std::vector<Vec3> points;
     for (int y = 0; y < 150; ++y) {
