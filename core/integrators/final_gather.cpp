@@ -24,33 +24,32 @@ FinalGatherer::FinalGatherer(std::shared_ptr<const RenderScene> scene, std::shar
 
 namespace {
 
+/// Photons of an estimate at a gather hit on a normal-mapped surface read as diffuse.
+constexpr uint32_t kBentNormalPhotons = 32;
+
 /// Radiance leaving a non-delta surface towards wo, from the photon maps: precomputed
 /// irradiance times rho / pi where every lobe is diffuse or as rough as the photon passes take
 /// for diffuse (the rough metal and dielectric layer of most glTF materials: read by their
 /// albedo at wo, exact under uniform light, instead of evaluating the BSDF per photon), else the
 /// global map's estimate.
-///
-/// A normal map tilts the shading normal by theta from the surface's, and a plane so tilted
-/// receives (1 + cos theta) / 2 of the light of a uniform sky above the surface (the sky view
-/// factor of a tilted plane): the precomputed irradiance, about the untilted normal, is scaled by
-/// it. Read flat, normal-mapped surfaces would be as bright as smooth ones, and brighten what they
-/// light in turn; read photon by photon (32 photons, each through the BSDF at the bent normal)
-/// they were 4 in 5 of ClearCoatTest's estimates and a quarter of its time.
 Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si, const Bsdf& bsdf,
                             const Vec3& wo, const GatherSettings& settings, LobeMask lobes = kNonDeltaLobes) {
     if (!maps.global) return Color(0.0f);
     const bool front = glm::dot(si.surface_normal, wo) >= 0.0f;
     const Vec3 n = front ? si.surface_normal : -si.surface_normal;
-    if (maps.irradiance && bsdf.reads_as_diffuse(lobes)) {
+    // A normal map bends the shading normal: the precomputed irradiance (about the unbent
+    // normal) would light the surface as if flat, and brighten what it lights in turn.
+    const Vec3 bent = bent_shading_normal(si, front);
+    if (maps.irradiance && bsdf.reads_as_diffuse(lobes) && bent == Vec3(0.0f)) {
         Color e;
-        if (maps.irradiance->nearest_irradiance(si.p, n, settings.max_radius, &e)) {
-            const Vec3 bent = bent_shading_normal(si, front);
-            const float view = bent == Vec3(0.0f) ? 1.0f : 0.5f * (1.0f + std::clamp(glm::dot(bent, n), -1.0f, 1.0f));
-            return bsdf.diffuse_like_reflectance(wo) * (kInvPi * view) * e;
-        }
+        if (maps.irradiance->nearest_irradiance(si.p, n, settings.max_radius, &e))
+            return bsdf.diffuse_like_reflectance(wo) * kInvPi * e;
     }
     RadianceEstimateOptions options;
-    options.k = settings.k_global;
+    // Where only the bent normal keeps the precomputed irradiance from serving, fewer photons:
+    // each gather ray's value is averaged with the others' (the irradiance cache's hundreds).
+    const bool diffuse_but_bent = bent != Vec3(0.0f) && bsdf.reads_as_diffuse(lobes);
+    options.k = diffuse_but_bent ? std::min(settings.k_global, kBentNormalPhotons) : settings.k_global;
     options.max_radius = settings.max_radius;
     options.lobes = lobes;
     return maps.global->estimate_radiance(si.p, n, bsdf, wo, estimate_options_at(options, si, bsdf, front));

@@ -36,7 +36,7 @@ struct PhotonMapIntegratorSettings {
 
 /// Bump when the irradiance cache's prepass or gathering changes what it stores for the same
 /// inputs: every cached render cache then misses.
-inline constexpr uint32_t kRenderCacheAlgorithmVersion = 3;  // 3: normal-mapped gather hits read by their view factor
+inline constexpr uint32_t kRenderCacheAlgorithmVersion = 2;  // 2: the light tree (LightSelection)
 
 /// Nearest photons per estimate in the progressive preview's integrator (make_preview), at most.
 inline constexpr uint32_t kPreviewPhotons = 16;
