@@ -70,7 +70,7 @@ constexpr uint32_t kAxisSamples = 1024;
 uint8_t widest_axis(const Photon* photons, uint32_t lo, uint32_t hi) {
     Vec3 lower = photons[lo].position, upper = photons[lo].position;
     const uint32_t step = std::max<uint32_t>(1, (hi - lo) / kAxisSamples);
-    for (uint32_t i = lo + step; i < hi; i += step) {
+    for (uint64_t i = uint64_t(lo) + step; i < hi; i += step) {
         lower = glm::min(lower, photons[i].position);
         upper = glm::max(upper, photons[i].position);
     }

@@ -83,8 +83,10 @@ public:
     /// `radius_hint`, when given and positive, is a guess of the estimate's radius (a neighbouring
     /// estimate's, a little widened): the k photons are first sought within it, and only if fewer
     /// are there within max_radius. The k nearest within the hint are the k nearest anywhere, so
-    /// the estimate is exactly the one without a hint; the search is shorter when the guess is
-    /// good. On return it holds this estimate's radius (0 when fewer than k photons were found).
+    /// the estimate takes the same photons and radius as without a hint (their sum may differ in
+    /// its last bits: it adds them in the order the search met them); the search is shorter when
+    /// the guess is good. On return it holds this estimate's radius (0 when fewer than k photons
+    /// were found).
     Color estimate_irradiance(const Vec3& p, const Vec3& normal, uint32_t k, float max_radius,
                               uint8_t exclude_flags = 0, float* radius_hint = nullptr) const;
 

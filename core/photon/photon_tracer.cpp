@@ -23,6 +23,7 @@ constexpr uint32_t kChunkSize = 1024;                       // photons per paral
 constexpr uint64_t kEmptyMapTrial = 1u << 20;               // emissions before an empty map is given up
 // A precomputed irradiance estimate's search starts at its spatial neighbour's radius times this.
 constexpr float kRadiusHintWidening = 1.25f;
+constexpr size_t kHintBlock = 256;  // sites whose estimates pass the hint on, one after another
 // A batch stores at most about this share of a map's photons: the chunks' buffers of traced
 // photons (28 bytes each) then stay a small part of the map's memory (photon_series.py's peak).
 constexpr double kBatchesPerMap = 8.0;
@@ -240,14 +241,16 @@ std::shared_ptr<const PhotonMap> precompute_irradiance(const PhotonMap& global, 
                                                        uint32_t k, float max_radius) {
     std::vector<Photon> points(sites.size());
     // Estimated in spatial (Morton) order rather than photon order: neighbouring estimates then
-    // walk the same kd-tree nodes and photons while they are in cache. Each estimate is
-    // independent, so the result is the same in any order.
+    // walk the same kd-tree nodes and photons while they are in cache.
     const std::vector<uint32_t> order = morton_order(sites);
-    // Each estimate's search starts from the previous one's radius, widened a little
-    // (PhotonMap::estimate_irradiance: the result is exactly that of a search without it).
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, sites.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
+    // Each estimate's search starts from the previous one's radius in its block, widened a
+    // little (PhotonMap::estimate_irradiance). The blocks are fixed, not the scheduler's ranges:
+    // the hint decides the order in which an estimate meets its photons, and so the last bits of
+    // its sum, which must not depend on the thread count.
+    const size_t blocks = (sites.size() + kHintBlock - 1) / kHintBlock;
+    tbb::parallel_for(size_t(0), blocks, [&](size_t block) {
         float hint = 0.0f;
-        for (size_t j = range.begin(); j < range.end(); ++j) {
+        for (size_t j = block * kHintBlock; j < std::min(sites.size(), (block + 1) * kHintBlock); ++j) {
             const size_t i = order[j];
             const IrradianceSite& site = sites[i];
             hint *= kRadiusHintWidening;

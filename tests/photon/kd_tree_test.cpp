@@ -374,7 +374,7 @@ std::vector<Photon> build_with_threads(const std::vector<Photon>& photons, int t
 }
 
 TEST(PhotonKdTree, SameTreeForAnyThreadCount) {
-    // Many duplicate coordinates, so tie-breaking matters.
+    // Many duplicate coordinates: equal ones must land alike at every thread count.
     std::vector<Vec3> points = random_points(300000, 14);
     for (size_t i = 0; i < points.size(); i += 3) points[i].x = std::floor(points[i].x * 16.0f);
     for (size_t i = 0; i < points.size(); i += 7) points[i] = points[i / 2];

@@ -111,7 +111,11 @@ TEST(PhotonTracer, MapsAreBitIdenticalForAnyThreadCount) {
     const auto five = trace_photons(*rs, settings);
     ASSERT_TRUE(one && two && five);
     for (const auto* other : {&two, &five}) {
-        for (const auto& [a, b] : {std::pair{(*one).global, (**other).global}, std::pair{(*one).caustic, (**other).caustic}}) {
+        // The precomputed irradiance too: its estimates pass radius hints on (photon_tracer.cpp).
+        ASSERT_TRUE(one->irradiance && one->caustic_irradiance);
+        for (const auto& [a, b] : {std::pair{(*one).global, (**other).global}, std::pair{(*one).caustic, (**other).caustic},
+                                   std::pair{(*one).irradiance, (**other).irradiance},
+                                   std::pair{(*one).caustic_irradiance, (**other).caustic_irradiance}}) {
             ASSERT_EQ(a->size(), b->size());
             ASSERT_EQ(a->emitted(), b->emitted());
             ASSERT_EQ(0, std::memcmp(&a->tree().photon(0), &b->tree().photon(0), a->size() * sizeof(Photon)));
