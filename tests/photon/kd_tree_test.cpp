@@ -245,11 +245,20 @@ TEST(PhotonKdTree, AllOnALine) {
 }
 
 // Ranges of at least 2^16 photons are split around pivots from a sample before the median is
-// selected (kd_tree.cpp): large inputs with runs of equal coordinates, a plane and a sorted
-// order, checked by the adopting validator (every split separates its subtrees) and queries.
+// selected (kd_tree.cpp): large inputs with runs of equal coordinates, a plane, a sorted order
+// and samples that miss the median, checked by the adopting validator (every split separates
+// its subtrees) and queries.
 TEST(PhotonKdTree, LargeRangesWithEqualCoordinatesSplitAtTheirMedian) {
     Rng rng(21, 22);
-    std::vector<std::vector<Vec3>> inputs(3);
+    std::vector<std::vector<Vec3>> inputs(5);
+    // The pivot sample (every 146th photon of 150,000) all at one end: the median then lies
+    // above or below both pivots, and is selected in the part beyond them.
+    for (int i = 0; i < 150000; ++i) {
+        const bool sampled = i % (150000 / 1023) == 0 && i / (150000 / 1023) < 1023;
+        const float spread = float(i % 1000) * 1e-3f;
+        inputs[3].push_back(Vec3(sampled ? 0.0f : 1.0f + spread, 0.0f, 0.0f));
+        inputs[4].push_back(Vec3(sampled ? 3.0f : spread, 0.0f, 0.0f));
+    }
     for (int i = 0; i < 150000; ++i) {
         // Coordinates from 7 values on x: whole ranges of equal ones around every pivot.
         inputs[0].push_back(Vec3(float(rng.next_u32() % 7), rng.next_float(), float(rng.next_u32() % 3)));
