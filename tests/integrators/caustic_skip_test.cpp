@@ -11,6 +11,7 @@
 #include "core/integrators/photon_mapping.h"
 #include "core/render/tile_renderer.h"
 #include "core/scene/builtin_scenes.h"
+#include "tests/support/render_fixtures.h"
 
 namespace photond {
 namespace {
@@ -29,8 +30,7 @@ TileRenderResult render(const std::shared_ptr<const RenderScene>& rs, std::share
 }
 
 TEST(CausticSkip, SkipsOnlyWhereTheCausticWouldNotShow) {
-    auto scene = std::make_shared<const Scene>(make_builtin_scene("caustic-area").value());
-    auto rs = RenderScene::create(EmbreeDevice::create().value(), scene).value();
+    const auto rs = test_support::make_render_scene(make_builtin_scene("caustic-area").value());
     PhotonTracingSettings photons;
     photons.global_photons = 50000;
     photons.caustic_photons = 50000;
@@ -40,7 +40,7 @@ TEST(CausticSkip, SkipsOnlyWhereTheCausticWouldNotShow) {
     // The same maps without the precomputed caustic irradiance: every estimate is made.
     auto every = std::make_shared<PhotonMaps>(*maps);
     every->caustic_irradiance = nullptr;
-    const Camera camera = Camera::create(scene->cameras.at(0), kWidth, kHeight).value();
+    const Camera camera = Camera::create(rs->scene->cameras.at(0), kWidth, kHeight).value();
 
     const TileRenderResult skipped = render(rs, maps, camera);
     const TileRenderResult full = render(rs, every, camera);

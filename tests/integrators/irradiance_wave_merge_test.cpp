@@ -12,6 +12,7 @@
 #include "core/integrators/photon_mapping.h"
 #include "core/math/rng.h"
 #include "core/scene/builtin_scenes.h"
+#include "tests/support/render_fixtures.h"
 
 namespace photond {
 namespace {
@@ -110,13 +111,12 @@ TEST(IrradianceWaveMerge, EqualsInsertingOneByOneForAnyThreadCount) {
 }
 
 TEST(IrradianceWaveMerge, PrepassCacheIsTheSameForOneTwoAndSevenThreads) {
-    auto scene = std::make_shared<const Scene>(make_builtin_scene("cornell-box").value());
-    auto rs = RenderScene::create(EmbreeDevice::create().value(), scene).value();
+    const auto rs = test_support::make_render_scene(make_builtin_scene("cornell-box").value());
     PhotonTracingSettings photons;
     photons.global_photons = 20000;
     photons.caustic_photons = 10000;
     auto maps = std::make_shared<const PhotonMaps>(trace_photons(*rs, photons).value());
-    const Camera camera = Camera::create(scene->cameras.at(0), 64, 48).value();
+    const Camera camera = Camera::create(rs->scene->cameras.at(0), 64, 48).value();
     GatherSettings gather;
     gather.rays = 32;
     const FinalGatherer gatherer(rs, maps, gather);
