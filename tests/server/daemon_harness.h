@@ -327,6 +327,27 @@ inline std::vector<SseEvent> parse_sse(std::string_view text, size_t* consumed =
     return events;
 }
 
+/// Follows a job's SSE stream, calling `on_event` for each event, until the stream ends or
+/// `on_event` returns false (the client hangs up). Returns the events seen.
+inline std::vector<SseEvent> follow_events(const HttpClient& client, const std::string& id,
+                                           const std::function<bool(const SseEvent&)>& on_event = {},
+                                           std::chrono::seconds timeout = std::chrono::seconds(120)) {
+    std::vector<SseEvent> events;
+    std::string pending;
+    HttpResponse response;
+    client.stream("GET", "/v1/jobs/" + id + "/events", {}, {}, timeout, response, [&](std::string_view data) {
+        pending.append(data);
+        size_t consumed = 0;
+        for (SseEvent& e : parse_sse(pending, &consumed)) {
+            events.push_back(e);
+            if (on_event && !on_event(e)) return false;
+        }
+        pending.erase(0, consumed);
+        return true;
+    });
+    return events;
+}
+
 struct MultipartPart {
     std::map<std::string, std::string> headers;  // names lower-cased
     std::string body;

@@ -15,33 +15,13 @@ namespace photond::test {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+constexpr std::chrono::seconds kStreamTimeout(60);  // no job here streams for longer
 
 json path_job(int width, int height, int spp, int priority = 50) {
     return {{"scene", {{"builtin", "cornell-box"}}},
             {"integrator", "path"},
             {"priority", priority},
             {"image", {{"width", width}, {"height", height}, {"spp", spp}, {"tile_size", 16}}}};
-}
-
-/// Follows a job's SSE stream, calling `on_event` for each event; returns false from `on_event`
-/// to hang up. Returns the events seen.
-std::vector<SseEvent> follow_events(const HttpClient& client, const std::string& id,
-                                    const std::function<bool(const SseEvent&)>& on_event) {
-    std::vector<SseEvent> events;
-    std::string pending;
-    HttpResponse response;
-    client.stream("GET", "/v1/jobs/" + id + "/events", {}, {}, std::chrono::seconds(60), response,
-                  [&](std::string_view data) {
-                      pending.append(data);
-                      size_t consumed = 0;
-                      for (SseEvent& e : parse_sse(pending, &consumed)) {
-                          events.push_back(e);
-                          if (!on_event(e)) return false;
-                      }
-                      pending.erase(0, consumed);
-                      return true;
-                  });
-    return events;
 }
 
 class DaemonJobs : public ::testing::Test {
@@ -85,7 +65,7 @@ TEST_F(DaemonJobs, CancelMidRenderStopsWithinAboutATile) {
         EXPECT_TRUE(cancelled.status == 200 || cancelled.status == 202) << cancelled.body;
         EXPECT_EQ(status.at("state"), "cancelled");
         return true;  // read on: the stream must end by itself
-    });
+    }, kStreamTimeout);
     ASSERT_FALSE(first_tile.is_null());
     EXPECT_GE(cancel_seconds, 0.0);
     EXPECT_LT(cancel_seconds, 2.0);
@@ -125,7 +105,7 @@ TEST_F(DaemonJobs, ClientsHangingUpMidStreamDoNotDisturbTheJob) {
 
     // An SSE client that leaves after the first tile event.
     const std::vector<SseEvent> partial =
-        follow_events(client, id, [](const SseEvent& e) { return e.type != "tile"; });
+        follow_events(client, id, [](const SseEvent& e) { return e.type != "tile"; }, kStreamTimeout);
     EXPECT_EQ(partial.back().type, "tile");
     // A multipart client that leaves in the middle of its first part.
     HttpResponse response;
@@ -181,7 +161,7 @@ TEST_F(DaemonJobs, FiftyConcurrentStatusAndEventClientsWhileAJobRenders) {
     for (int i = 0; i < 25; ++i) {
         threads.emplace_back([&, i] {  // event clients: each sees the whole history and the end
             const std::vector<SseEvent> events =
-                follow_events(client, id, [](const SseEvent&) { return true; });
+                follow_events(client, id, {}, kStreamTimeout);
             int tile_events = 0;
             for (size_t k = 0; k < events.size(); ++k) {
                 if (events[k].id != k + 1)

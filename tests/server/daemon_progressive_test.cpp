@@ -24,26 +24,6 @@ json progressive_job() {
 
 constexpr size_t kTiles = 8 * 6;  // 256 x 192 in tiles of 32
 
-/// Follows a job's SSE stream to its end, calling `on_event` for each event.
-std::vector<SseEvent> follow_events(const HttpClient& client, const std::string& id,
-                                    const std::function<void(const SseEvent&)>& on_event = {}) {
-    std::vector<SseEvent> events;
-    std::string pending;
-    HttpResponse response;
-    client.stream("GET", "/v1/jobs/" + id + "/events", {}, {}, std::chrono::seconds(120), response,
-                  [&](std::string_view data) {
-                      pending.append(data);
-                      size_t consumed = 0;
-                      for (SseEvent& e : parse_sse(pending, &consumed)) {
-                          if (on_event) on_event(e);
-                          events.push_back(std::move(e));
-                      }
-                      pending.erase(0, consumed);
-                      return true;
-                  });
-    return events;
-}
-
 std::string submit(const HttpClient& client, const json& job) {
     const HttpResponse submitted = client.post("/v1/jobs", job.dump());
     EXPECT_EQ(submitted.status, 202) << submitted.body;
@@ -71,6 +51,7 @@ TEST_F(DaemonProgressive, PreviewTilesCoverTheFrameBeforeTheFinalTilesReplaceThe
             final_tile = client.get("/v1/jobs/" + id + "/tiles/3/2.exr");
             preview_png_tile = client.get("/v1/jobs/" + id + "/tiles/3/2.png?preview=true");
         }
+        return true;
     });
     ASSERT_FALSE(events.empty());
     EXPECT_EQ(events.back().type, "done") << events.back().data.dump();
@@ -187,6 +168,7 @@ TEST_F(DaemonProgressive, PreviewTilesAreNeverKeptForAResume) {
             kept_after_preview = kept_tiles();
             EXPECT_EQ(client.get("/v1/jobs/" + id).json_body().at("progress").at("tiles_done"), 0);
         }
+        return true;
     });
     ASSERT_TRUE(seen);
     EXPECT_EQ(kept_after_preview, 0u) << "preview tiles were written to the tile journal";
