@@ -191,6 +191,12 @@ JOBS = [
          "angular_diameter_deg": 0.53},
         {"type": "quad", "position": [-0.5, 1.9, -0.5], "edge_u": [1, 0, 0], "edge_v": [0, 0, 1],
          "radiance": 8, "two_sided": True}]},
+    {"scene": {"builtin": "cornell-box-diffuse"}, "integrator": "path",
+     "atmosphere": {"sigma_a": 0.05, "sigma_s": [0.3, 0.4, 0.5], "g": 0.6}},
+    {"scene": {"builtin": "sunlit-room"}, "integrator": "direct", "atmosphere": {"sigma_s": 0.2}},
+    {"scene": {"path": "models/glass.glb"}, "integrator": "path",
+     "material_media": {"Glass.001": {"sigma_s": [0.5, 0.25, 0.125], "g": 0.3},
+                        "jade": {"sigma_s": 2, "g": -0.2, "sigma_a": [0.1, 0.01, 0.1]}}},
 ]
 BAD_JOBS = [
     b"", b"{", b"[]", b"null", b'{"scene": {"builtin": "cornell-box"}, "image": {"sppp": 4}}',

@@ -11,6 +11,7 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -69,6 +70,15 @@ inline constexpr NumberRange kSpotConeDeg{0.0, 90.0};
 // A soft sun's angular diameter: the Sun is about 0.53 degrees; 0 is a delta light.
 inline constexpr NumberRange kAngularDiameterDeg{0.0, 90.0, false, true};
 inline constexpr IntegerRange kJobLights{0, 1024};
+// The atmosphere's absorption and scattering coefficients, per world unit (per metre in glTF
+// scenes): 0 is clear air; 1e6 (a mean free path of a micrometre) is far denser than any fog.
+inline constexpr NumberRange kMediumCoefficient{0.0, 1e6};
+// The atmosphere's Henyey-Greenstein asymmetry g: at |g| = 1 the phase function is a delta lobe
+// that cannot be sampled or evaluated as a density, so the ends stay out (haze is about 0.7-0.9).
+inline constexpr NumberRange kPhaseAsymmetry{-0.99, 0.99};
+// material_media: entries (one per glTF material, by name), and a name's length in bytes.
+inline constexpr IntegerRange kMaterialMedia{0, 1024};
+inline constexpr size_t kMaterialNameBytesMax = 256;
 inline constexpr std::string_view kSceneIdPrefix = "sha256:";
 inline constexpr size_t kSceneIdHexDigits = 64;
 }  // namespace limits
@@ -211,6 +221,37 @@ struct LightSpec {
     bool operator==(const LightSpec&) const = default;
 };
 
+/// "atmosphere": a homogeneous participating medium (fog, haze; god rays where it is lit through
+/// openings) filling the scene's bounding box, that is the box of its triangles and of the job's
+/// light positions, everywhere outside closed transmissive solids.
+/// Absent or null: none. {"sigma_a": A, "sigma_s": S, "g": G}: absorption and scattering
+/// coefficients per world unit (per metre for glTF scenes), each one number (grey) or [r, g, b],
+/// and the Henyey-Greenstein asymmetry G (0: isotropic, > 0: forward). Rendered by the
+/// integrators "path" and "direct"; "photon-map" refuses it (it has no volume photon map).
+struct AtmosphereSpec {
+    std::array<double, 3> sigma_a{0.0, 0.0, 0.0};
+    std::array<double, 3> sigma_s{0.0, 0.0, 0.0};
+    double g = 0.0;
+
+    bool operator==(const AtmosphereSpec&) const = default;
+};
+
+/// One entry of "material_media": the participating medium inside the closed transmissive solids
+/// (KHR_materials_transmission) made of the glTF material of that name. {"sigma_s": S, "g": G,
+/// "sigma_a": A}: the scattering coefficient per world unit (per metre for glTF scenes), one
+/// number (grey) or [r, g, b], required; the Henyey-Greenstein asymmetry G (default 0); and
+/// optionally the absorption coefficient A, which replaces the absorption the file's
+/// KHR_materials_volume gives (attenuationColor, attenuationDistance); absent, that absorption
+/// stays. Rendered by the integrator "path"; "photon-map" and "direct" refuse it. Whether the
+/// scene has such a material is checked when the scene is loaded, not here.
+struct MaterialMediumSpec {
+    std::array<double, 3> sigma_s{0.0, 0.0, 0.0};
+    double g = 0.0;
+    std::optional<std::array<double, 3>> sigma_a;
+
+    bool operator==(const MaterialMediumSpec&) const = default;
+};
+
 /// The JSON name of a light type's strength: "intensity", "irradiance" or "radiance".
 std::string_view light_strength_field(std::string_view type);
 
@@ -230,6 +271,9 @@ struct Job {
     OutputSpec output;
     EnvironmentSpec environment;
     std::vector<LightSpec> lights;
+    std::optional<AtmosphereSpec> atmosphere;  // absent (or null in the document): none
+    // By material name (a std::map: a deterministic order); absent, null or {}: none.
+    std::map<std::string, MaterialMediumSpec> material_media;
     int priority = 0;
     uint64_t seed = 0;  // the render's random streams (photons.seed drives photon tracing)
     /// The daemon streams a quick preview of the whole frame before the final tiles, which

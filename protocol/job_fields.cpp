@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <map>
 #include <regex>
 #include <type_traits>
 #include <utility>
@@ -20,6 +21,8 @@ constexpr std::array<std::string_view, 3> kSceneFields{"builtin", "path", "id"};
 constexpr std::array<std::string_view, 5> kCameraFields{"gltf_camera", "look_from", "look_at", "up", "vfov_deg"};
 constexpr std::array<std::string_view, 4> kEnvironmentFields{"color", "image", "intensity",
                                                              "rotation_deg"};
+constexpr std::array<std::string_view, 3> kAtmosphereFields{"sigma_a", "sigma_s", "g"};
+constexpr std::array<std::string_view, 3> kMaterialMediumFields{"sigma_s", "g", "sigma_a"};
 constexpr std::array<std::string_view, 4> kPointLightFields{"type", "position", "intensity",
                                                             "color"};
 constexpr std::array<std::string_view, 7> kSpotLightFields{
@@ -272,6 +275,72 @@ std::vector<LightSpec> parse_lights(const json& value) {
     return lights;
 }
 
+// ------------------------------------------------------------------------------ atmosphere
+
+/// An absorption or scattering coefficient: one number (grey, the same in r, g and b) or [r, g, b].
+std::array<double, 3> read_coefficient(const json& value, const std::string& path) {
+    if (value.is_number()) {
+        const double c = read_number(value, path, limits::kMediumCoefficient);
+        return {c, c, c};
+    }
+    if (!value.is_array() || value.size() != 3) {
+        fail(path, "must be a number in " + format_range(limits::kMediumCoefficient) +
+                       " or an array of 3 such numbers [r, g, b]" + got(value));
+    }
+    std::array<double, 3> c{};
+    for (size_t i = 0; i < 3; ++i)
+        c[i] = read_number(value[i], element_path(path, i), limits::kMediumCoefficient);
+    return c;
+}
+
+std::optional<AtmosphereSpec> parse_atmosphere(const json& value) {
+    if (value.is_null()) return std::nullopt;
+    ObjectFields fields(value, "atmosphere", kAtmosphereFields);
+    // An object with only "g" is a medium of nothing: most likely a coefficient misspelt or
+    // forgotten, so it is refused rather than rendered as clear air.
+    if (!fields.has("sigma_a") && !fields.has("sigma_s"))
+        fail("atmosphere", "must have \"sigma_a\" or \"sigma_s\" (or both)");
+    AtmosphereSpec atmosphere;
+    if (const json* v = fields.find("sigma_a")) atmosphere.sigma_a = read_coefficient(*v, fields.path_of("sigma_a"));
+    if (const json* v = fields.find("sigma_s")) atmosphere.sigma_s = read_coefficient(*v, fields.path_of("sigma_s"));
+    fields.overlay_number("g", limits::kPhaseAsymmetry, atmosphere.g);
+    return atmosphere;
+}
+
+// -------------------------------------------------------------------------- material_media
+
+MaterialMediumSpec parse_material_medium(const json& value, const std::string& path) {
+    ObjectFields fields(value, path, kMaterialMediumFields);
+    const json* sigma_s = fields.find("sigma_s");
+    if (!sigma_s)
+        fail(fields.path_of("sigma_s"), "required: the scattering coefficient per world unit, a number or [r, g, b]");
+    MaterialMediumSpec medium;
+    medium.sigma_s = read_coefficient(*sigma_s, fields.path_of("sigma_s"));
+    fields.overlay_number("g", limits::kPhaseAsymmetry, medium.g);
+    if (const json* v = fields.find("sigma_a")) medium.sigma_a = read_coefficient(*v, fields.path_of("sigma_a"));
+    return medium;
+}
+
+/// {"<material name>": medium, ...}; null (as absent) and {} are none.
+std::map<std::string, MaterialMediumSpec> parse_material_media(const json& value) {
+    std::map<std::string, MaterialMediumSpec> media;
+    if (value.is_null()) return media;
+    if (!value.is_object())
+        fail("material_media", "must be an object of media by material name" + got(value));
+    if (!integer_in_range(json(value.size()), limits::kMaterialMedia))
+        fail("material_media", "must hold at most " + std::to_string(limits::kMaterialMedia.max) +
+                                   " materials (got " + std::to_string(value.size()) + ")");
+    for (const auto& [name, entry] : value.items()) {
+        if (name.empty()) fail("material_media", "must name a material in every key (got \"\")");
+        if (name.size() > limits::kMaterialNameBytesMax)
+            fail("material_media", "a material name must be at most " + std::to_string(limits::kMaterialNameBytesMax) +
+                                       " bytes (got one of " + std::to_string(name.size()) + ")");
+        // The name as it is, dots and all: "material_media.Glass.001.sigma_s".
+        media.emplace(name, parse_material_medium(entry, child_path("material_media", name)));
+    }
+    return media;
+}
+
 // ----------------------------------------------------------------- schemas of the compound fields
 
 json vector3_schema(std::string description) {
@@ -355,6 +424,71 @@ json environment_schema() {
             {"oneOf", {{{"type", "null"}, {"description", "no environment"}}, environment}}};
 }
 
+/// read_coefficient's rule: one number or [r, g, b], each in limits::kMediumCoefficient.
+json coefficient_schema(std::string description) {
+    json rgb = {{"type", "array"},
+                {"items", number_schema(limits::kMediumCoefficient, "the coefficient in one channel")},
+                {"minItems", 3},
+                {"maxItems", 3},
+                {"description", "[r, g, b]"}};
+    return json{{"description", std::move(description)},
+                {"oneOf", {number_schema(limits::kMediumCoefficient, "the same in r, g and b"), rgb}}};
+}
+
+json atmosphere_schema() {
+    json medium = object_schema(
+        {{"sigma_a", coefficient_schema("absorption coefficient, per world unit (per metre for glTF scenes): one "
+                                 "number or [r, g, b] (default 0)")},
+         {"sigma_s", coefficient_schema("scattering coefficient, per world unit (per metre for glTF scenes): one "
+                                 "number or [r, g, b] (default 0)")},
+         {"g", number_schema(limits::kPhaseAsymmetry,
+                             "Henyey-Greenstein asymmetry of the scattering: 0 isotropic (default), > 0 "
+                             "forward, < 0 backward")}},
+        {}, "a homogeneous medium; sigma_a + sigma_s is its extinction per world unit");
+    medium["properties"]["g"]["default"] = AtmosphereSpec{}.g;
+    // At least one coefficient (parse_atmosphere's rule).
+    medium["anyOf"] = json::array({json{{"required", json::array({"sigma_a"})}},
+                                   json{{"required", json::array({"sigma_s"})}}});
+    return {{"description",
+             "a homogeneous participating medium (fog, god rays) filling the scene's bounding box (its "
+             "triangles and the job's light positions) outside closed transmissive solids; rendered by the "
+             "integrators path and direct (photon-map refuses it); absent or null: none"},
+            {"oneOf", {{{"type", "null"}, {"description", "no atmosphere"}}, medium}}};
+}
+
+json material_media_schema() {
+    json medium = object_schema(
+        {{"sigma_s", coefficient_schema("scattering coefficient, per world unit (per metre for glTF scenes): one "
+                                        "number or [r, g, b]")},
+         {"g", number_schema(limits::kPhaseAsymmetry,
+                             "Henyey-Greenstein asymmetry of the scattering: 0 isotropic (default), > 0 "
+                             "forward, < 0 backward")},
+         {"sigma_a", coefficient_schema("absorption coefficient, per world unit (per metre for glTF scenes): one "
+                                        "number or [r, g, b]; replaces the absorption of the file's "
+                                        "KHR_materials_volume (attenuationColor, attenuationDistance); absent: "
+                                        "that absorption stays")}},
+        {"sigma_s"}, "the homogeneous medium inside the solids of this material");
+    medium["properties"]["g"]["default"] = MaterialMediumSpec{}.g;
+    // JSON Schema counts a name's characters; the reader counts its UTF-8 bytes, so a name of
+    // multi-byte characters can pass maxLength and still be refused (the stricter rule).
+    json media = {{"type", "object"},
+                  {"additionalProperties", medium},
+                  {"maxProperties", limits::kMaterialMedia.max},
+                  {"propertyNames",
+                   {{"minLength", 1},
+                    {"maxLength", limits::kMaterialNameBytesMax},
+                    {"description", "a glTF material's name (at most " +
+                                        std::to_string(limits::kMaterialNameBytesMax) + " bytes of UTF-8)"}}},
+                  {"description", "media by glTF material name"}};
+    return {{"description",
+             "the participating media inside closed transmissive solids (KHR_materials_transmission) by "
+             "their glTF material's name: scattering per world unit (per metre for glTF scenes), phase "
+             "asymmetry and optionally the absorption in place of the file's KHR_materials_volume; rendered "
+             "by the integrator path (photon-map and direct refuse it); whether the scene has the material is "
+             "checked when it is loaded; absent, null or {}: none"},
+            {"oneOf", {{{"type", "null"}, {"description", "no media in materials"}}, media}}};
+}
+
 json lights_schema() {
     auto light = [](std::string_view type, json properties, std::vector<std::string> required,
                     std::string description) {
@@ -435,6 +569,23 @@ std::optional<json> write_environment(const EnvironmentSpec& environment) {
     return json{{"image", environment.image},
                 {"intensity", environment.intensity},
                 {"rotation_deg", environment.rotation_deg}};
+}
+
+// Always the full form, so that the document says what is rendered and reads back the same.
+json write_atmosphere(const AtmosphereSpec& atmosphere) {
+    return {{"sigma_a", atmosphere.sigma_a}, {"sigma_s", atmosphere.sigma_s}, {"g", atmosphere.g}};
+}
+
+/// Absent when empty; sigma_a only when the job replaces the file's absorption.
+std::optional<json> write_material_media(const std::map<std::string, MaterialMediumSpec>& media) {
+    if (media.empty()) return std::nullopt;
+    json written = json::object();
+    for (const auto& [name, medium] : media) {
+        json entry = {{"sigma_s", medium.sigma_s}, {"g", medium.g}};
+        if (medium.sigma_a) entry["sigma_a"] = *medium.sigma_a;
+        written[name] = std::move(entry);
+    }
+    return written;
 }
 
 json write_light(const LightSpec& light) {
@@ -689,6 +840,23 @@ std::vector<JobField> make_job_fields() {
                           return lights;
                       },
                       .schema = lights_schema()});
+    // No preset has an atmosphere: a job that wants one asks for it (and for "path" or "direct").
+    fields.push_back({.path = "atmosphere",
+                      .read = [](const json& value, const std::string&, Job& job) {
+                          job.atmosphere = parse_atmosphere(value);
+                      },
+                      .write = [](const Job& job) -> std::optional<json> {
+                          if (!job.atmosphere) return std::nullopt;
+                          return write_atmosphere(*job.atmosphere);
+                      },
+                      .schema = atmosphere_schema()});
+    // No preset has media in materials either (and "path" alone renders them).
+    fields.push_back({.path = "material_media",
+                      .read = [](const json& value, const std::string&, Job& job) {
+                          job.material_media = parse_material_media(value);
+                      },
+                      .write = [](const Job& job) { return write_material_media(job.material_media); },
+                      .schema = material_media_schema()});
     fields.push_back(integer_field(JOB_MEMBER(priority), limits::kPriority, "queue priority; higher runs first",
                                    {"50", "50", "50"}));
     fields.push_back(integer_field(JOB_MEMBER(seed), limits::kSeed, "seed of the render's random streams",

@@ -139,6 +139,8 @@ void JobManager::check_scene(const protocol::Job& job) const {
     }
     if (const auto error = check_job_lighting(job, pipeline_options()))
         throw ServiceError(ErrorKind::InvalidField, protocol::describe(*error), error->path);
+    if (const auto error = check_job_media(job, pipeline_options()))
+        throw ServiceError(ErrorKind::InvalidField, protocol::describe(*error), error->path);
 }
 
 int JobManager::retry_after_seconds_locked() const {

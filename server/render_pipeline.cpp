@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <set>
 
 #include "core/camera/camera.h"
 #include "core/image/png_preview.h"
@@ -90,6 +91,66 @@ std::string describe_colour(const std::array<double, 3>& c) {
     char text[96];
     std::snprintf(text, sizeof(text), "[%g, %g, %g]", c[0], c[1], c[2]);
     return text;
+}
+
+/// The job's atmosphere as the renderer's medium.
+HomogeneousMedium atmosphere_medium(const protocol::AtmosphereSpec& spec) {
+    HomogeneousMedium medium;
+    medium.sigma_a = to_vec3(spec.sigma_a);
+    medium.sigma_s = to_vec3(spec.sigma_s);
+    medium.g = static_cast<float>(spec.g);
+    return medium;
+}
+
+/// The plan's line for the atmosphere: what it is, where, and how dense.
+PassDecision atmosphere_decision(const Scene& scene) {
+    const HomogeneousMedium& medium = *scene.atmosphere;
+    const auto color_text = [](const Color& c) { return describe_colour({c.x, c.y, c.z}); };
+    // The optical depth across the box's diagonal, in its densest channel: how much of the light
+    // that crosses the scene the medium takes (e^-depth passes).
+    const float depth = max_component(medium.sigma_t()) * glm::length(scene.bounds.extent());
+    return {"atmosphere", !medium.empty(),
+            "a homogeneous medium (sigma_a " + color_text(medium.sigma_a) + ", sigma_s " + color_text(medium.sigma_s) +
+                " per unit, g " + format_number(medium.g) + ") filling the scene's bounds " +
+                color_text(scene.bounds.lower) + " to " + color_text(scene.bounds.upper) +
+                ", outside transmissive solids; optical depth " + format_number(depth) + " across them"};
+}
+
+/// The job's material_media applied to the scene's materials of those names (every one of a
+/// name: glTF names need not be unique); `applied` (when given) receives one line per entry for
+/// the plan. The error names the entry: no material of that name, or one that is not
+/// transmissive (its surface closes no medium).
+std::optional<protocol::FieldError> apply_material_media(const protocol::Job& job, Scene& scene,
+                                                         std::string* applied = nullptr) {
+    for (const auto& [name, spec] : job.material_media) {
+        const std::string path = "material_media." + name;
+        size_t found = 0;
+        for (Material& m : scene.materials) {
+            if (m.name != name) continue;
+            if (!(m.transmission > 0.0f))
+                return protocol::FieldError{path, "material '" + name + "' is not transmissive (no "
+                                                  "KHR_materials_transmission): its surface closes no medium"};
+            m.scattering = to_vec3(spec.sigma_s);
+            m.phase_g = static_cast<float>(spec.g);
+            if (spec.sigma_a) m.attenuation = to_vec3(*spec.sigma_a);
+            ++found;
+            if (applied && found == 1)
+                *applied += std::string(applied->empty() ? "" : "; ") + "'" + name + "': sigma_a " +
+                            describe_colour({m.attenuation.x, m.attenuation.y, m.attenuation.z}) + " (" +
+                            (spec.sigma_a ? "the job's" : "the file's") + "), sigma_s " + describe_colour(spec.sigma_s) +
+                            ", g " + format_number(spec.g);
+        }
+        if (found == 0) {
+            std::set<std::string> names;
+            std::string transmissive;
+            for (const Material& m : scene.materials)
+                if (m.transmission > 0.0f && names.insert(m.name).second)
+                    transmissive += (transmissive.empty() ? "'" : ", '") + m.name + "'";
+            return protocol::FieldError{path, "the scene has no material '" + name + "' (its transmissive materials: " +
+                                                  (transmissive.empty() ? std::string("none") : transmissive) + ")"};
+        }
+    }
+    return std::nullopt;
 }
 
 /// Plans the photon pass of a photon-map job and gets its maps: from the store when one is
@@ -381,6 +442,14 @@ Expected<AddedLighting> job_lighting(const protocol::Job& job, const Scene& scen
     return lighting;
 }
 
+std::optional<protocol::FieldError> check_job_media(const protocol::Job& job, const PipelineOptions& options) {
+    if (job.material_media.empty()) return std::nullopt;
+    auto scene = load_job_scene(job.scene, options);
+    if (!scene) return std::nullopt;  // the render says what is wrong with the scene itself
+    Scene copy = **scene;
+    return apply_material_media(job, copy);
+}
+
 std::optional<protocol::FieldError> check_job_lighting(const protocol::Job& job, const PipelineOptions& options) {
     if (job.environment.kind == protocol::EnvironmentSpec::Kind::Image) {
         auto file = environment_image_file(job, options);
@@ -448,9 +517,13 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     auto lighting = job_lighting(job, **scene, options, &environment_decision);
     if (!lighting) return lighting.error();
     std::shared_ptr<const Scene> lit_scene = *scene;
-    if (!lighting->empty()) {
+    std::string media_applied;
+    if (!lighting->empty() || job.atmosphere || !job.material_media.empty()) {
         auto lit = with_added_lighting(**scene, *lighting);
         if (!lit) return lit.error();
+        // The atmosphere fills the bounds grown by the job's lights too.
+        if (job.atmosphere) lit->atmosphere = atmosphere_medium(*job.atmosphere);
+        if (const auto error = apply_material_media(job, *lit, &media_applied)) return Error{protocol::describe(*error)};
         lit_scene = std::make_shared<const Scene>(std::move(lit).value());
     }
     stats.lighting.job_lights = job.lights.size();
@@ -464,6 +537,9 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
                                      std::string(protocol::light_strength_field(light.type)) +
                                      " or a black colour: it adds no light");
     }
+    if (lit_scene->atmosphere && lit_scene->atmosphere->empty())
+        stats.warnings.push_back("the atmosphere has neither absorption nor scattering (sigma_a and sigma_s are 0): "
+                                 "it changes nothing");
     if (lit_scene->environment && !environment_emits_light(*lit_scene->environment))
         stats.warnings.push_back("the environment '" + lit_scene->environment->name + "' is black: it adds no light");
 
@@ -482,6 +558,10 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     auto integrator = make_integrator(settings, *render_scene, options, stats);
     if (!integrator) return integrator.error();
     stats.plan.insert(stats.plan.begin(), environment_decision);
+    if (lit_scene->atmosphere) stats.plan.insert(stats.plan.begin() + 1, atmosphere_decision(*lit_scene));
+    if (!media_applied.empty())
+        stats.plan.insert(stats.plan.begin() + (lit_scene->atmosphere ? 2 : 1),
+                          PassDecision{"material_media", true, "the solids of " + media_applied});
 
     Integrator& renderer = **integrator;
     // The preview needs the photon maps (a cache hit has them at once) and nothing the

@@ -87,6 +87,10 @@ Expected<AddedLighting> job_lighting(const protocol::Job& job, const Scene& scen
 /// 422 at once): an environment image that is missing or outside the scene root or bundle, and
 /// `"environment": null` on a scene without light (this one loads the scene).
 std::optional<protocol::FieldError> check_job_lighting(const protocol::Job& job, const PipelineOptions& options);
+/// What the job's material_media would refuse, checked before a job is queued (this loads the
+/// scene when the job has entries): a material name the scene lacks, or one that is not
+/// transmissive.
+std::optional<protocol::FieldError> check_job_media(const protocol::Job& job, const PipelineOptions& options);
 /// Whether the caustic map stopped early because its photons carry a negligible share of the
 /// light (kNegligibleCausticShare; core/photon/photon_tracer.h), not at the emission cap.
 bool caustic_stopped_as_negligible(const PhotonTracingStatistics& photons, const PhotonTracingSettings& settings);

@@ -1,5 +1,7 @@
 #include "core/integrators/direct.h"
 
+#include "core/scene/atmosphere.h"
+
 namespace photond {
 
 DirectIntegrator::DirectIntegrator(std::shared_ptr<const RenderScene> scene, int max_specular_depth)
@@ -13,25 +15,45 @@ RadianceParts DirectIntegrator::radiance_along(const Ray& ray, int depth, Sample
                                                float path_length, float spread) const {
     const RenderScene& rs = *scene_;
     const std::optional<Hit> hit = trace_ray(rs, ray, context.counters);
-    // A camera ray or a delta bounce that leaves the scene sees the sky whole.
     RadianceParts radiance;
+    std::optional<SurfaceInteraction> si;
     if (!hit) {
+        // A camera ray or a delta bounce that leaves the scene sees the sky whole.
         radiance.add_emission(rs.lights->escaped_radiance(ray.direction, 0.0f));
-        return radiance;
+    } else {
+        // The camera's ray cone, widened along ideal specular bounces, picks the texture level.
+        const float length = path_length + hit->t;
+        si = make_interaction(*rs.scene, *hit, ray.direction, length * spread);
+        const Vec3 wo = -ray.direction;
+        radiance.add_emission(rs.lights->emitted_radiance(*si, wo));
+        const Bsdf bsdf = make_bsdf(rs, *si, wo);
+        if (bsdf.has_non_delta()) radiance.add_direct(sample_direct_light(rs, *si, bsdf, wo, context, false));
+        if (bsdf.has_delta() && depth < max_specular_depth_) {
+            radiance += follow_delta_lobes(bsdf, wo, depth < kBranchDepth, context.rng, [&](const BsdfSample& s) {
+                return radiance_along(spawn_ray(rs, *si, s.wi), depth + 1, context, length, spread);
+            });
+        }
+        radiance = volume_transmittance(*rs.scene, *si) * radiance;
     }
-    // The camera's ray cone, widened along ideal specular bounces, picks the texture level.
-    const float length = path_length + hit->t;
-    const SurfaceInteraction si = make_interaction(*rs.scene, *hit, ray.direction, length * spread);
-    const Vec3 wo = -ray.direction;
-    radiance.add_emission(rs.lights->emitted_radiance(si, wo));
-    const Bsdf bsdf = make_bsdf(rs, si, wo);
-    if (bsdf.has_non_delta()) radiance.add_direct(sample_direct_light(rs, si, bsdf, wo, context, false));
-    if (bsdf.has_delta() && depth < max_specular_depth_) {
-        radiance += follow_delta_lobes(bsdf, wo, depth < kBranchDepth, context.rng, [&](const BsdfSample& s) {
-            return radiance_along(spawn_ray(rs, si, s.wi), depth + 1, context, length, spread);
-        });
+    if (const std::optional<HomogeneousMedium>& atmosphere = rs.scene->atmosphere) {
+        // The atmosphere on the way: what lies beyond is seen through it, and it sends the light
+        // it scatters once towards the ray (single scattering, by one light sample at a distance
+        // drawn by its transmittance).
+        const MediumSpan span = atmosphere_span(*rs.scene, ray, si ? &*si : nullptr);
+        if (!span.empty()) {
+            const float length = span.t1 - span.t0;
+            radiance = atmosphere->transmittance(length) * radiance;
+            if (atmosphere->scatters()) {
+                const float u_channel = context.next_1d();
+                const SegmentDistance d = sample_distance_in_segment(*atmosphere, length, u_channel, context.next_1d());
+                const Vec3 x = ray.origin + (span.t0 + d.t) * ray.direction;
+                if (d.pdf > 0.0f)
+                    radiance.add_direct(atmosphere->sigma_s * atmosphere->transmittance(d.t) / d.pdf *
+                                        sample_direct_light_in_medium(rs, *atmosphere, x, -ray.direction, context, false));
+            }
+        }
     }
-    return volume_transmittance(*rs.scene, si) * radiance;
+    return radiance;
 }
 
 }  // namespace photond

@@ -1,5 +1,6 @@
 // Integrator `direct`: emitted light, direct light by light sampling, and ideal specular
-// reflection and refraction by recursion (Whitted). No indirect diffuse or glossy light.
+// reflection and refraction by recursion (Whitted), and the atmosphere's single scattering
+// (core/scene/atmosphere.h). No indirect diffuse or glossy light, no multiple scattering.
 #pragma once
 
 #include <memory>

@@ -1,5 +1,7 @@
 #include "core/integrators/integrator.h"
 
+#include "core/scene/atmosphere.h"
+
 namespace photond {
 
 namespace {
@@ -17,8 +19,22 @@ Color sample_distant_lights_by_bsdf(const RenderScene& rs, const LightSet& light
     const Color sky = lights.escaped_radiance(s->wi, s->pdf);
     if (is_black(sky)) return Color(0.0f);
     ++context.counters.shadow_rays;
-    if (rs.tracer->occluded(spawn_ray(rs, si, s->wi))) return Color(0.0f);
-    return s->weight * sky;
+    const Ray ray = spawn_ray(rs, si, s->wi);
+    if (rs.tracer->occluded(ray)) return Color(0.0f);
+    return s->weight * sky * atmosphere_transmittance(*rs.scene, ray);
+}
+
+/// The shadow ray from `origin` to a light sample: towards the light point moved off its own
+/// surface (direction unnormalised, tmax 1), or along wi for distant lights.
+Ray shadow_ray_to(const RenderScene& rs, const Vec3& origin, const LightSample& ls) {
+    Ray shadow{origin, ls.wi};
+    if (std::isfinite(ls.distance)) {
+        Vec3 target = ls.point;
+        if (glm::dot(ls.normal, ls.normal) > 0.0f) target = rs.tracer->offset_origin(ls.point, ls.normal, -ls.wi);
+        shadow.direction = target - origin;
+        shadow.tmax = 1.0f;
+    }
+    return shadow;
 }
 
 }  // namespace
@@ -40,16 +56,7 @@ Color sample_direct_light(const RenderScene& rs, const LightSet& lights, const S
     if (is_black(f)) return radiance;
     const float cos_theta = std::abs(glm::dot(ls->wi, si.shading_normal));
 
-    const Vec3 origin = rs.tracer->offset_origin(si.p, si.geometric_normal, ls->wi);
-    Ray shadow{origin, ls->wi};
-    if (std::isfinite(ls->distance)) {
-        // Aim at the light point moved off its own surface; direction unnormalised, tmax = 1.
-        Vec3 target = ls->point;
-        if (glm::dot(ls->normal, ls->normal) > 0.0f)
-            target = rs.tracer->offset_origin(ls->point, ls->normal, -ls->wi);
-        shadow.direction = target - origin;
-        shadow.tmax = 1.0f;
-    }
+    const Ray shadow = shadow_ray_to(rs, rs.tracer->offset_origin(si.p, si.geometric_normal, ls->wi), *ls);
     ++context.counters.shadow_rays;
     if (rs.tracer->occluded(shadow)) return radiance;
 
@@ -64,7 +71,21 @@ Color sample_direct_light(const RenderScene& rs, const LightSet& lights, const S
         const float w = power_heuristic(ls->pdf, mis_samples * bsdf.pdf(wo, ls->wi, mis_lobes));
         weighted = glm::max(f - f_mis, Color(0.0f)) + f_mis * w;
     }
-    return radiance + weighted * ls->radiance * (cos_theta / ls->pdf);
+    return radiance + weighted * ls->radiance * atmosphere_transmittance(*rs.scene, shadow) * (cos_theta / ls->pdf);
+}
+
+Color sample_direct_light_in_medium(const RenderScene& rs, const HomogeneousMedium& medium, const Vec3& x,
+                                    const Vec3& wo, SampleContext& context, bool use_mis) {
+    const float u_select = context.next_1d();
+    const Vec2 u = context.next_2d();
+    const std::optional<LightSample> ls = rs.lights->sample_incident(x, u_select, u);
+    if (!ls || !(ls->pdf > 0.0f) || is_black(ls->radiance)) return Color(0.0f);
+    const float phase = henyey_greenstein(medium.g, wo, ls->wi);
+    const Ray shadow = shadow_ray_to(rs, x, *ls);
+    ++context.counters.shadow_rays;
+    if (rs.tracer->occluded(shadow)) return Color(0.0f);
+    const float weight = use_mis && !ls->is_delta ? power_heuristic(ls->pdf, phase) : 1.0f;
+    return ls->radiance * atmosphere_transmittance(*rs.scene, shadow) * (phase * weight / ls->pdf);
 }
 
 }  // namespace photond

@@ -127,6 +127,13 @@ inline Ray primary_ray(const CameraRay& ray) {
 Color sample_direct_light(const RenderScene& rs, const LightSet& lights, const SurfaceInteraction& si,
                           const Bsdf& bsdf, const Vec3& wo, SampleContext& context, bool use_mis,
                           LobeMask mask = kAllLobes, LobeMask mis_lobes = 0, float mis_samples = 1.0f);
+/// Next-event estimation at a point x inside `medium` (the atmosphere) seen from wo: one light
+/// sample times the phase function and the atmosphere's transmittance to the light (the
+/// radiance scattered towards wo per unit of scattering coefficient: the caller's weight holds
+/// sigma_s). With `use_mis`, area lights are weighted by the power heuristic
+/// against phase-function sampling. The caller's throughput carries the transmittance up to x.
+Color sample_direct_light_in_medium(const RenderScene& rs, const HomogeneousMedium& medium, const Vec3& x,
+                                    const Vec3& wo, SampleContext& context, bool use_mis);
 /// The same with the scene's lights.
 inline Color sample_direct_light(const RenderScene& rs, const SurfaceInteraction& si, const Bsdf& bsdf,
                                  const Vec3& wo, SampleContext& context, bool use_mis,

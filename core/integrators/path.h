@@ -1,6 +1,9 @@
 // Integrator `path`: the unbiased reference. Path tracing with next-event estimation, multiple
 // importance sampling (power heuristic, Veach 1997 ch. 9) between light and BSDF sampling, and
-// Russian roulette. Every later integrator's error is measured against it.
+// Russian roulette; in participating media (the atmosphere, scattering solids) free flights by a
+// hero channel, light sampled at scattering events against the phase function
+// (docs/ARCHITECTURE.md, "Where each algorithm lives"). Every later integrator's error is
+// measured against it.
 #pragma once
 
 #include <memory>

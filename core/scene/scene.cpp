@@ -222,7 +222,8 @@ Status Scene::validate() const {
                              "' uses a texture out of range"};
         }
         if (!is_finite(m.base_color) || !is_finite(m.emission) || !std::isfinite(m.ior) ||
-            !std::isfinite(m.roughness) || !std::isfinite(m.metallic))
+            !std::isfinite(m.roughness) || !std::isfinite(m.metallic) || !is_finite(m.scattering) ||
+            min_component(m.scattering) < 0.0f || !(std::abs(m.phase_g) < 1.0f))
             return Error{"scene '" + name + "': material '" + m.name + "' has a non-finite factor"};
     }
     for (const PunctualLight& l : lights) {
@@ -247,6 +248,13 @@ Status Scene::validate() const {
                 return Error{"scene '" + name + "': environment image '" + e.name +
                              "' has a negative or non-finite texel"};
         }
+    }
+    if (atmosphere) {
+        const HomogeneousMedium& a = *atmosphere;
+        if (!is_finite(a.sigma_a) || !is_finite(a.sigma_s) || min_component(a.sigma_a) < 0.0f ||
+            min_component(a.sigma_s) < 0.0f || !(std::abs(a.g) < 1.0f))
+            return Error{"scene '" + name + "': the atmosphere has a negative or non-finite coefficient, or an "
+                         "asymmetry g outside (-1, 1)"};
     }
     return Status::ok();
 }

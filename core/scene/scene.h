@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/math/vec.h"
+#include "core/medium/homogeneous_medium.h"
 #include "core/util/expected.h"
 
 namespace photond {
@@ -96,6 +97,10 @@ struct Material {
     /// KHR_materials_volume inside a transmissive solid: Beer-Lambert attenuation coefficient
     /// -ln(attenuationColor) / attenuationDistance per channel, per world unit (0: clear).
     Color attenuation{0.0f};
+    /// Scattering inside a transmissive solid (per world unit) and its Henyey-Greenstein
+    /// asymmetry: glTF has no such property; a job sets it (material_media, README.md).
+    Color scattering{0.0f};
+    float phase_g = 0.0f;
     AlphaMode alpha_mode = AlphaMode::Opaque;
     float alpha_cutoff = 0.5f;   // MASK: covered where alpha >= cutoff
     bool double_sided = false;   // emits from both faces when true (else the front face only)
@@ -106,7 +111,12 @@ struct Material {
         return metallic_roughness_texture.present() || clearcoat_texture.present() ||
                clearcoat_roughness_texture.present();
     }
-    bool has_volume() const { return max_component(attenuation) > 0.0f; }
+    bool has_volume() const { return max_component(attenuation) > 0.0f || interior_scatters(); }
+    /// Light scatters inside its solid: a path samples free flights there (path.cpp) instead of
+    /// the Beer-Lambert factor of volume_transmittance.
+    bool interior_scatters() const { return transmission > 0.0f && max_component(scattering) > 0.0f; }
+    /// The medium inside its solid: absorption `attenuation`, scattering, asymmetry.
+    HomogeneousMedium interior_medium() const { return {attenuation, scattering, phase_g}; }
     /// Rays may pass its surface (MASK or BLEND): its triangles get Embree's alpha filter.
     bool alpha_tested() const { return alpha_mode != AlphaMode::Opaque; }
     /// Whether shading reads texture coordinates or vertex colours at all.
@@ -241,6 +251,9 @@ struct Scene {
     std::vector<CameraDesc> cameras;
     /// Distant light around the scene; absent: none (only the scene's own lights shine).
     std::optional<Environment> environment;
+    /// A homogeneous medium (fog) filling `bounds` outside closed transmissive solids
+    /// (core/scene/atmosphere.h); absent: clear air.
+    std::optional<HomogeneousMedium> atmosphere;
     /// What the scene's source holds and the renderer ignores or takes differently than the file
     /// may mean (unsupported extensions, dropped features), one self-contained sentence each.
     /// Anyone may append (SceneBuilder::add_warning); reported in the statistics and job status.

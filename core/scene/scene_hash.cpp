@@ -8,7 +8,7 @@ namespace {
 
 // These fire when a field is added to a struct the hashes read: hash the new field (if it affects
 // light transport) in scene_content_hash, then update the size here.
-static_assert(sizeof(Material) == sizeof(std::string) + 288,
+static_assert(sizeof(Material) == sizeof(std::string) + 304,
               "Material changed: hash the new field in scene_content_hash");
 static_assert(sizeof(PunctualLight) == sizeof(std::string) + 56,
               "PunctualLight changed: hash the new field in scene_content_hash");
@@ -19,8 +19,10 @@ static_assert(sizeof(Texture) == 16 + 3 * sizeof(std::vector<Color>),
 // hashing of their own; cameras and warnings do not affect light transport.
 static_assert(sizeof(Environment) == sizeof(std::string) + sizeof(std::vector<Color>) + 32,
               "Environment changed: hash the new field in scene_content_hash");
+static_assert(sizeof(HomogeneousMedium) == 28, "HomogeneousMedium changed: hash the new field in scene_content_hash");
 static_assert(sizeof(Scene) == sizeof(std::string) + 15 * sizeof(std::vector<int>) +
-                                   sizeof(std::optional<Environment>) + sizeof(Bounds3),
+                                   sizeof(std::optional<Environment>) +
+                                   sizeof(std::optional<HomogeneousMedium>) + sizeof(Bounds3),
               "Scene changed: hash the new field in scene_content_hash");
 
 void hash_float(Sha256& hasher, float value) {
@@ -90,6 +92,8 @@ Sha256Digest scene_content_hash(const Scene& scene) {
         hash_float(hasher, m.clearcoat_roughness);
         hash_ref(m.clearcoat_roughness_texture);
         hash_vec3(hasher, m.attenuation);
+        hash_vec3(hasher, m.scattering);
+        hash_float(hasher, m.phase_g);
         hasher.update_value(uint8_t(m.alpha_mode));
         hash_float(hasher, m.alpha_cutoff);
         hash_float(hasher, m.metallic);
@@ -128,6 +132,13 @@ Sha256Digest scene_content_hash(const Scene& scene) {
         hash_array(hasher, e->texels, [&](const Color& c) { hash_vec3(hasher, c); });
         hash_float(hasher, e->intensity);
         hash_float(hasher, e->rotation);
+    }
+    // The atmosphere scatters and absorbs light on its way, photons included.
+    hasher.update_value(uint8_t(scene.atmosphere ? 1 : 0));
+    if (const std::optional<HomogeneousMedium>& a = scene.atmosphere) {
+        hash_vec3(hasher, a->sigma_a);
+        hash_vec3(hasher, a->sigma_s);
+        hash_float(hasher, a->g);
     }
     return hasher.finish();
 }

@@ -21,7 +21,10 @@ Expected<std::shared_ptr<const RenderScene>> RenderScene::create(std::shared_ptr
         render_scene->lights_with_sky_peaks = std::make_unique<LightSet>(*scene, render_scene->sky_peaks.get(), selection);
     }
     render_scene->bsdf_materials.reserve(scene->materials.size());
-    for (const Material& material : scene->materials) render_scene->bsdf_materials.emplace_back(material);
+    for (const Material& material : scene->materials) {
+        render_scene->bsdf_materials.emplace_back(material);
+        render_scene->scattering_interiors = render_scene->scattering_interiors || material.interior_scatters();
+    }
     std::vector<uint32_t> specular;
     constexpr LobeMask kCausticLobes = mask_of(LobeKind::Delta);  // L S+ D: S ideal specular
     std::vector<LobeMask> lobes(scene->materials.size());

@@ -25,6 +25,8 @@ struct RenderScene {
     std::unique_ptr<const Environment> diffuse_sky_environment;
     std::unique_ptr<EnvironmentLight> diffuse_sky;
     std::unique_ptr<LightSet> lights_with_sky_peaks;
+    /// Some material's solid scatters light inside (Material::interior_scatters).
+    bool scattering_interiors = false;
     /// The triangles a caustic path (LS+D) can start on: those whose material has a delta or
     /// glossy lobe; null when there are none. Photons emitted for the caustic map alone that miss
     /// all of them are dropped after this one cheap ray instead of a trace through the scene.

@@ -13,6 +13,7 @@ from pathlib import Path
 LAYERS = [
     ["core/util"],
     ["core/math"],
+    ["core/medium"],                                        # participating media: coefficients, sampling
     ["core/scene"],                                         # the scene as data, and loading it
     ["core/accel", "core/camera", "core/image", "core/material"],
     ["core/light"],

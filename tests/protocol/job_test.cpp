@@ -182,6 +182,10 @@ Job full_job() {
                    .edge_v = {0, 0, 2},
                    .two_sided = true};
     job.lights = {point, spot, sun, quad};
+    job.atmosphere = AtmosphereSpec{.sigma_a = {0.01, 0.02, 0.03}, .sigma_s = {0.25, 0.5, 1e6}, .g = -0.99};
+    job.material_media = {
+        {"Glass.001", MaterialMediumSpec{.sigma_s = {0.5, 0.25, 0.125}, .g = 0.85, .sigma_a = std::array<double, 3>{0, 1e-3, 1e6}}},
+        {"marble", MaterialMediumSpec{.sigma_s = {1e6, 1e6, 1e6}, .g = -0.99}}};
     job.priority = 100;
     job.seed = std::numeric_limits<uint64_t>::max();
     return job;
@@ -697,8 +701,12 @@ TEST(JobText, ValidTextIsValidated) {
 
 // -------------------------------------------------------------------------------- schema
 
+/// Fields whose keys are names the document chooses (material names), not fields: their paths
+/// name any key "*", the schema's "additionalProperties".
+bool keys_are_names(const std::string& path) { return path == "material_media"; }
+
 /// The schema nodes for a document path such as "image.region" or "camera.gltf_camera": object
-/// properties, looking inside "oneOf" alternatives.
+/// properties (or additionalProperties for "*"), looking inside "oneOf" alternatives.
 std::vector<json> schema_nodes(const json& schema, const std::string& path) {
     std::vector<json> nodes{schema};
     size_t start = 0;
@@ -713,6 +721,9 @@ std::vector<json> schema_nodes(const json& schema, const std::string& path) {
             for (const json& candidate : candidates) {
                 if (candidate.contains("properties") && candidate["properties"].contains(key)) {
                     next.push_back(candidate["properties"][key]);
+                } else if (key == "*" && candidate.contains("additionalProperties") &&
+                           candidate["additionalProperties"].is_object()) {
+                    next.push_back(candidate["additionalProperties"]);
                 }
             }
         }
@@ -722,21 +733,27 @@ std::vector<json> schema_nodes(const json& schema, const std::string& path) {
     return nodes;
 }
 
-/// "image.width", "camera.look_from", ...: every field of a document (arrays are leaves).
+/// "image.width", "camera.look_from", "material_media.*.g", ...: every field of a document
+/// (arrays are leaves).
 void collect_fields(const json& value, const std::string& prefix, std::set<std::string>& out) {
     for (const auto& [key, child] : value.items()) {
-        std::string path = prefix.empty() ? key : prefix + "." + key;
+        std::string path = prefix.empty() ? key : prefix + "." + (keys_are_names(prefix) ? "*" : key);
         out.insert(path);
         if (child.is_object()) collect_fields(child, path, out);
     }
 }
 
-/// Every property path the schema declares, through "oneOf" alternatives.
+/// Every property path the schema declares, through "oneOf" alternatives ("*" for a schema of
+/// any key, additionalProperties).
 void collect_schema_fields(const json& node, const std::string& prefix,
                            std::set<std::string>& out) {
     std::vector<json> candidates{node};
     if (node.contains("oneOf")) candidates.assign(node["oneOf"].begin(), node["oneOf"].end());
     for (const json& candidate : candidates) {
+        if (candidate.contains("additionalProperties") && candidate["additionalProperties"].is_object()) {
+            out.insert(prefix + ".*");
+            collect_schema_fields(candidate["additionalProperties"], prefix + ".*", out);
+        }
         if (!candidate.contains("properties")) continue;
         for (const auto& [key, child] : candidate["properties"].items()) {
             std::string path = prefix.empty() ? key : prefix + "." + key;
@@ -811,6 +828,14 @@ TEST(JobSchema, NumericBoundsAgreeWithTheValidator) {
         auto document_with = [&](const json& value) {
             json document = base_job();
             if (field == "environment.rotation_deg") document["environment"]["image"] = "sky.exr";
+            if (field.starts_with("atmosphere.")) {
+                document["integrator"] = "path";          // photon-map refuses an atmosphere
+                document["atmosphere"]["sigma_s"] = 0.1;  // one coefficient is required
+            }
+            if (field.starts_with("material_media.")) {
+                document["integrator"] = "path";                   // only path renders them
+                document["material_media"]["*"]["sigma_s"] = 0.1;  // required; "*" names a material
+            }
             document[json::json_pointer("/" + std::regex_replace(field, std::regex("\\."), "/"))] =
                 value;
             return document;
@@ -956,6 +981,397 @@ TEST(JobLights, RefusesWhatCannotBeRightByName) {
     json not_array = base_job();
     not_array["lights"] = {{"type", "point"}};
     EXPECT_TRUE(rejects(not_array, "lights", "array"));
+}
+
+// ---------------------------------------------------------------------------- atmosphere
+
+/// The base job with this "atmosphere" and integrator ("path" renders an atmosphere).
+json with_atmosphere(json atmosphere, std::string_view integrator = "path") {
+    json document = base_job();
+    document["atmosphere"] = std::move(atmosphere);
+    if (!integrator.empty()) document["integrator"] = std::string(integrator);
+    return document;
+}
+
+TEST(JobAtmosphere, AbsentAndNullAreNone) {
+    EXPECT_FALSE(parsed(base_job()).atmosphere);
+    EXPECT_FALSE(to_json(parsed(base_job())).contains("atmosphere"));
+    const Job none = parsed(with_atmosphere(nullptr));
+    EXPECT_FALSE(none.atmosphere);
+    EXPECT_FALSE(to_json(none).contains("atmosphere"));  // null reads as absent, and writes so
+    // null is "none" whatever the integrator: the default preset's photon-map accepts it.
+    EXPECT_TRUE(accepts(with_atmosphere(nullptr, "")));
+    for (std::string_view preset : kPresetNames) EXPECT_FALSE(preset_defaults(preset)->atmosphere) << preset;
+}
+
+TEST(JobAtmosphere, ScalarAndArrayFormsParseWithDefaults) {
+    const Job grey = parsed(with_atmosphere({{"sigma_s", 0.2}}));
+    ASSERT_TRUE(grey.atmosphere);
+    EXPECT_EQ(grey.atmosphere->sigma_s, (std::array<double, 3>{0.2, 0.2, 0.2}));
+    EXPECT_EQ(grey.atmosphere->sigma_a, (std::array<double, 3>{0, 0, 0}));  // missing: 0
+    EXPECT_EQ(grey.atmosphere->g, 0.0);                                      // missing: isotropic
+
+    const Job absorbing = parsed(with_atmosphere({{"sigma_a", 3}}));  // an integer is a number
+    ASSERT_TRUE(absorbing.atmosphere);
+    EXPECT_EQ(absorbing.atmosphere->sigma_a, (std::array<double, 3>{3, 3, 3}));
+    EXPECT_EQ(absorbing.atmosphere->sigma_s, (std::array<double, 3>{0, 0, 0}));
+
+    const Job coloured =
+        parsed(with_atmosphere({{"sigma_a", {0.01, 0.02, 0.04}}, {"sigma_s", {0.5, 0.25, 0}}, {"g", 0.7}}));
+    ASSERT_TRUE(coloured.atmosphere);
+    EXPECT_EQ(*coloured.atmosphere,
+              (AtmosphereSpec{.sigma_a = {0.01, 0.02, 0.04}, .sigma_s = {0.5, 0.25, 0.0}, .g = 0.7}));
+
+    // The ends of the ranges are accepted.
+    const Job ends = parsed(with_atmosphere({{"sigma_a", 0}, {"sigma_s", {1e6, 0, 1e6}}, {"g", -0.99}}));
+    ASSERT_TRUE(ends.atmosphere);
+    EXPECT_EQ(ends.atmosphere->sigma_s, (std::array<double, 3>{1e6, 0, 1e6}));
+    EXPECT_EQ(ends.atmosphere->g, -0.99);
+    EXPECT_EQ(parsed(with_atmosphere({{"sigma_s", 1}, {"g", 0.99}})).atmosphere->g, 0.99);
+}
+
+TEST(JobAtmosphere, WriterGivesTheFullFormAndReadsBackTheSameJob) {
+    const Job job = parsed(with_atmosphere({{"sigma_s", 0.2}}));
+    const json written = to_json(job);
+    EXPECT_EQ(written.at("atmosphere"),
+              json({{"sigma_a", {0.0, 0.0, 0.0}}, {"sigma_s", {0.2, 0.2, 0.2}}, {"g", 0.0}}));
+    EXPECT_EQ(parsed(written), job);
+    Expected<Job> from_text = parse_job_text(written.dump());
+    ASSERT_TRUE(from_text) << from_text.error().message;
+    EXPECT_EQ(*from_text, job);
+
+    Job coloured = job;
+    coloured.integrator = "direct";
+    coloured.atmosphere = AtmosphereSpec{.sigma_a = {1e-7, 0.5, 1e6}, .sigma_s = {0.125, 0, 3}, .g = 0.3};
+    EXPECT_EQ(parsed(to_json(coloured)), coloured);
+    EXPECT_EQ(to_json(coloured)["atmosphere"]["g"], 0.3);
+}
+
+TEST(JobAtmosphere, RefusesWhatCannotBeRightByName) {
+    EXPECT_TRUE(rejects(with_atmosphere({{"sigma_s", 0.1}, {"density", 2}}), "atmosphere.density",
+                        "atmosphere.density: unknown field (expected one of \"sigma_a\", \"sigma_s\", \"g\")"));
+    EXPECT_TRUE(rejects(with_atmosphere({{"sigma_a", -0.5}}), "atmosphere.sigma_a",
+                        "atmosphere.sigma_a: must be in [0, 1e+06] (got -0.5)"));
+    EXPECT_TRUE(rejects(with_atmosphere({{"sigma_s", {0.1, -1, 0.1}}}), "atmosphere.sigma_s[1]",
+                        "atmosphere.sigma_s[1]: must be in [0, 1e+06] (got -1)"));
+    EXPECT_TRUE(rejects(with_atmosphere({{"sigma_s", 1.5e6}}), "atmosphere.sigma_s", "must be in [0, 1e+06]"));
+    EXPECT_TRUE(rejects(with_atmosphere({{"sigma_s", {0.1, 0.1, "x"}}}), "atmosphere.sigma_s[2]",
+                        "must be a number"));
+    EXPECT_TRUE(rejects(with_atmosphere({{"sigma_s", 0.1}, {"g", 1}}), "atmosphere.g",
+                        "atmosphere.g: must be in [-0.99, 0.99] (got 1)"));
+    EXPECT_TRUE(rejects(with_atmosphere({{"sigma_s", 0.1}, {"g", -1}}), "atmosphere.g", "[-0.99, 0.99]"));
+    EXPECT_TRUE(rejects(with_atmosphere({{"sigma_s", 0.1}, {"g", "forward"}}), "atmosphere.g", "must be a number"));
+    EXPECT_TRUE(rejects(with_atmosphere({{"sigma_a", {0.1, 0.2}}}), "atmosphere.sigma_a",
+                        "atmosphere.sigma_a: must be a number in [0, 1e+06] or an array of 3 such numbers "
+                        "[r, g, b] (got [0.1,0.2])"));
+    EXPECT_TRUE(rejects(with_atmosphere({{"sigma_a", {0.1, 0.2, 0.3, 0.4}}}), "atmosphere.sigma_a", "3 such"));
+    EXPECT_TRUE(rejects(with_atmosphere({{"sigma_s", "thick"}}), "atmosphere.sigma_s", "or an array of 3"));
+    EXPECT_TRUE(rejects(with_atmosphere({{"sigma_s", {{"r", 1}}}}), "atmosphere.sigma_s", "or an array of 3"));
+    EXPECT_TRUE(rejects(with_atmosphere({{"g", 0.5}}), "atmosphere",
+                        "atmosphere: must have \"sigma_a\" or \"sigma_s\" (or both)"));
+    EXPECT_TRUE(rejects(with_atmosphere(json::object()), "atmosphere", "must have \"sigma_a\" or \"sigma_s\""));
+    EXPECT_TRUE(rejects(with_atmosphere("fog"), "atmosphere", "atmosphere: must be an object (got \"fog\")"));
+    EXPECT_TRUE(rejects(with_atmosphere({0.1, 0.1, 0.1}), "atmosphere", "must be an object"));
+    // Non-finite numbers (only a document built in code can hold them; JSON text cannot).
+    for (double bad : {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+        EXPECT_TRUE(rejects(with_atmosphere({{"sigma_a", bad}}), "atmosphere.sigma_a", "must be in")) << bad;
+        EXPECT_TRUE(rejects(with_atmosphere({{"sigma_s", {0.0, 0.0, bad}}}), "atmosphere.sigma_s[2]", "must be in"))
+            << bad;
+        EXPECT_TRUE(rejects(with_atmosphere({{"sigma_s", 1}, {"g", bad}}), "atmosphere.g", "must be in")) << bad;
+    }
+}
+
+TEST(JobAtmosphere, PhotonMapRefusesItPathAndDirectRenderIt) {
+    const std::string refusal =
+        "atmosphere: integrator \"photon-map\" does not render participating media yet (its volume photon map is "
+        "not built); use \"path\" (the reference) or \"direct\" (single scattering)";
+    // The default preset "final" (and "preview") integrate with photon-map.
+    EXPECT_TRUE(rejects(with_atmosphere({{"sigma_s", 0.1}}, ""), "atmosphere", refusal));
+    json preview = with_atmosphere({{"sigma_s", 0.1}}, "");
+    preview["preset"] = "preview";
+    EXPECT_TRUE(rejects(preview, "atmosphere", refusal));
+    EXPECT_TRUE(rejects(with_atmosphere({{"sigma_s", 0.1}}, "photon-map"), "atmosphere", refusal));
+    // Even a medium of zero coefficients: the document asked for one.
+    EXPECT_TRUE(rejects(with_atmosphere({{"sigma_s", 0}}, "photon-map"), "atmosphere", refusal));
+    // Each field's own error comes first: the cross-field rule judges a job whose fields are valid.
+    EXPECT_TRUE(rejects(with_atmosphere({{"sigma_s", -1}}, ""), "atmosphere.sigma_s", "must be in"));
+
+    for (std::string_view integrator : {"path", "direct"}) {
+        const Job job = parsed(with_atmosphere({{"sigma_s", 0.1}}, integrator));
+        EXPECT_EQ(job.integrator, integrator);
+        ASSERT_TRUE(job.atmosphere) << integrator;
+        EXPECT_EQ(job.atmosphere->sigma_s, (std::array<double, 3>{0.1, 0.1, 0.1}));
+    }
+    // "reference" integrates with path: nothing else to name.
+    json reference = with_atmosphere({{"sigma_a", 0.05}}, "");
+    reference["preset"] = "reference";
+    EXPECT_TRUE(accepts(reference));
+}
+
+TEST(JobSchema, DescribesTheAtmosphere) {
+    const json schema = job_json_schema();
+    ASSERT_TRUE(schema["properties"].contains("atmosphere"));
+    const json& atmosphere = schema["properties"]["atmosphere"];
+    ASSERT_EQ(atmosphere["oneOf"].size(), 2u);
+    EXPECT_EQ(atmosphere["oneOf"][0]["type"], "null");
+    const json& medium = atmosphere["oneOf"][1];
+    EXPECT_EQ(medium["type"], "object");
+    EXPECT_EQ(medium["additionalProperties"], false);
+    EXPECT_EQ(medium["anyOf"], json::parse(R"([{"required": ["sigma_a"]}, {"required": ["sigma_s"]}])"));
+    EXPECT_FALSE(medium.contains("required"));
+    for (std::string key : {"sigma_a", "sigma_s"}) {
+        const json& coefficient = medium["properties"][key];
+        EXPECT_NE(coefficient["description"].get<std::string>().find("per world unit"), std::string::npos) << key;
+        ASSERT_EQ(coefficient["oneOf"].size(), 2u) << key;
+        const json& scalar = coefficient["oneOf"][0];
+        EXPECT_EQ(scalar["type"], "number");
+        EXPECT_EQ(scalar["minimum"], limits::kMediumCoefficient.min);
+        EXPECT_EQ(scalar["maximum"], limits::kMediumCoefficient.max);
+        const json& rgb = coefficient["oneOf"][1];
+        EXPECT_EQ(rgb["type"], "array");
+        EXPECT_EQ(rgb["minItems"], 3);
+        EXPECT_EQ(rgb["maxItems"], 3);
+        EXPECT_EQ(rgb["items"]["minimum"], limits::kMediumCoefficient.min);
+        EXPECT_EQ(rgb["items"]["maximum"], limits::kMediumCoefficient.max);
+    }
+    const json& g = medium["properties"]["g"];
+    EXPECT_EQ(g["type"], "number");
+    EXPECT_EQ(g["minimum"], -0.99);
+    EXPECT_EQ(g["maximum"], 0.99);
+    EXPECT_EQ(g["default"], 0.0);
+}
+
+// ------------------------------------------------------------------------ material_media
+
+/// The base job with this "material_media" and integrator ("path" renders media in solids).
+json with_material_media(json media, std::string_view integrator = "path") {
+    json document = base_job();
+    document["material_media"] = std::move(media);
+    if (!integrator.empty()) document["integrator"] = std::string(integrator);
+    return document;
+}
+
+TEST(JobMaterialMedia, AbsentNullAndEmptyAreNone) {
+    EXPECT_TRUE(parsed(base_job()).material_media.empty());
+    EXPECT_FALSE(to_json(parsed(base_job())).contains("material_media"));
+    for (const json& none : {json(nullptr), json::object()}) {
+        const Job job = parsed(with_material_media(none));
+        EXPECT_TRUE(job.material_media.empty()) << none;
+        EXPECT_FALSE(to_json(job).contains("material_media")) << none;  // read as absent, and written so
+        // None whatever the integrator: the default preset's photon-map and direct accept it.
+        EXPECT_TRUE(accepts(with_material_media(none, ""))) << none;
+        EXPECT_TRUE(accepts(with_material_media(none, "direct"))) << none;
+    }
+    for (std::string_view preset : kPresetNames) EXPECT_TRUE(preset_defaults(preset)->material_media.empty()) << preset;
+}
+
+TEST(JobMaterialMedia, OneEntryParsesWithDefaults) {
+    const Job job = parsed(with_material_media({{"glass", {{"sigma_s", 0.2}}}}));
+    ASSERT_EQ(job.material_media.size(), 1u);
+    ASSERT_TRUE(job.material_media.contains("glass"));
+    const MaterialMediumSpec& glass = job.material_media.at("glass");
+    EXPECT_EQ(glass.sigma_s, (std::array<double, 3>{0.2, 0.2, 0.2}));
+    EXPECT_EQ(glass.g, 0.0);      // missing: isotropic
+    EXPECT_FALSE(glass.sigma_a);  // missing: the file's KHR_materials_volume absorption stays
+    EXPECT_EQ(glass, (MaterialMediumSpec{.sigma_s = {0.2, 0.2, 0.2}}));
+}
+
+TEST(JobMaterialMedia, TwoEntriesParseByName) {
+    const Job job = parsed(with_material_media(
+        {{"Jade.001", {{"sigma_s", {0.5, 2, 0.25}}, {"g", 0.7}, {"sigma_a", {0.1, 0.01, 0.2}}}},
+         {"milk glass", {{"sigma_s", 3}, {"g", -0.3}}}}));
+    ASSERT_EQ(job.material_media.size(), 2u);
+    EXPECT_EQ(job.material_media.at("Jade.001"),
+              (MaterialMediumSpec{.sigma_s = {0.5, 2, 0.25}, .g = 0.7, .sigma_a = std::array<double, 3>{0.1, 0.01, 0.2}}));
+    EXPECT_EQ(job.material_media.at("milk glass"), (MaterialMediumSpec{.sigma_s = {3, 3, 3}, .g = -0.3}));
+    // The ends of the ranges are accepted; a zero scattering is still a medium the job asked for.
+    const Job ends = parsed(with_material_media({{"a", {{"sigma_s", {1e6, 0, 1e6}}, {"g", 0.99}, {"sigma_a", 0}}},
+                                                 {"b", {{"sigma_s", 0}, {"g", -0.99}}}}));
+    EXPECT_EQ(ends.material_media.at("a"),
+              (MaterialMediumSpec{.sigma_s = {1e6, 0, 1e6}, .g = 0.99, .sigma_a = std::array<double, 3>{0, 0, 0}}));
+    EXPECT_EQ(ends.material_media.at("b"), (MaterialMediumSpec{.sigma_s = {0, 0, 0}, .g = -0.99}));
+}
+
+TEST(JobMaterialMedia, SigmaAIsSetOnlyWhenTheJobGivesIt) {
+    const Job kept = parsed(with_material_media({{"glass", {{"sigma_s", 0.1}}}}));
+    EXPECT_FALSE(kept.material_media.at("glass").sigma_a);
+    // Zero absorption is not the same as none given: it replaces the file's absorption with none.
+    const Job clear = parsed(with_material_media({{"glass", {{"sigma_s", 0.1}, {"sigma_a", 0}}}}));
+    ASSERT_TRUE(clear.material_media.at("glass").sigma_a);
+    EXPECT_EQ(*clear.material_media.at("glass").sigma_a, (std::array<double, 3>{0, 0, 0}));
+    EXPECT_NE(kept, clear);
+    const Job grey = parsed(with_material_media({{"glass", {{"sigma_s", 0.1}, {"sigma_a", 4}}}}));
+    ASSERT_TRUE(grey.material_media.at("glass").sigma_a);
+    EXPECT_EQ(*grey.material_media.at("glass").sigma_a, (std::array<double, 3>{4, 4, 4}));
+}
+
+TEST(JobMaterialMedia, WriterGivesSigmaAOnlyWhenSetAndReadsBackTheSameJob) {
+    const Job job = parsed(with_material_media(
+        {{"glass", {{"sigma_s", 0.2}}}, {"jade", {{"sigma_s", {1, 2, 3}}, {"g", 0.5}, {"sigma_a", 0.25}}}}));
+    const json written = to_json(job);
+    EXPECT_EQ(written.at("material_media"),
+              json({{"glass", {{"sigma_s", {0.2, 0.2, 0.2}}, {"g", 0.0}}},
+                    {"jade", {{"sigma_s", {1.0, 2.0, 3.0}}, {"g", 0.5}, {"sigma_a", {0.25, 0.25, 0.25}}}}}));
+    EXPECT_EQ(parsed(written), job);
+    Expected<Job> from_text = parse_job_text(written.dump());
+    ASSERT_TRUE(from_text) << from_text.error().message;
+    EXPECT_EQ(*from_text, job);
+
+    Job other = job;
+    other.material_media = {{"Glass.001", {.sigma_s = {1e-7, 0.5, 1e6}, .g = -0.25}},
+                            {"x", {.sigma_s = {0, 0, 0}, .sigma_a = std::array<double, 3>{1e6, 0, 3}}}};
+    EXPECT_EQ(parsed(to_json(other)), other);
+    EXPECT_FALSE(to_json(other)["material_media"]["Glass.001"].contains("sigma_a"));
+    EXPECT_EQ(to_json(other)["material_media"]["x"]["sigma_a"], json({1e6, 0.0, 3.0}));
+}
+
+TEST(JobMaterialMedia, RefusesWhatCannotBeRightByName) {
+    EXPECT_TRUE(rejects(with_material_media({{"glass", {{"sigma_s", 0.1}, {"density", 2}}}}),
+                        "material_media.glass.density",
+                        "material_media.glass.density: unknown field (expected one of \"sigma_s\", \"g\", \"sigma_a\")"));
+    EXPECT_TRUE(rejects(with_material_media({{"glass", {{"g", 0.5}, {"sigma_a", 1}}}}), "material_media.glass.sigma_s",
+                        "material_media.glass.sigma_s: required: the scattering coefficient per world unit, a number "
+                        "or [r, g, b]"));
+    EXPECT_TRUE(rejects(with_material_media({{"glass", json::object()}}), "material_media.glass.sigma_s", "required"));
+    EXPECT_TRUE(rejects(with_material_media({{"glass", {{"sigma_s", -0.5}}}}), "material_media.glass.sigma_s",
+                        "material_media.glass.sigma_s: must be in [0, 1e+06] (got -0.5)"));
+    EXPECT_TRUE(rejects(with_material_media({{"glass", {{"sigma_s", 1}, {"sigma_a", {0.1, -1, 0.1}}}}}),
+                        "material_media.glass.sigma_a[1]", "material_media.glass.sigma_a[1]: must be in [0, 1e+06] (got -1)"));
+    EXPECT_TRUE(rejects(with_material_media({{"glass", {{"sigma_s", 1.5e6}}}}), "material_media.glass.sigma_s",
+                        "must be in [0, 1e+06]"));
+    EXPECT_TRUE(rejects(with_material_media({{"glass", {{"sigma_s", {0.1, 0.2}}}}}), "material_media.glass.sigma_s",
+                        "or an array of 3 such numbers [r, g, b] (got [0.1,0.2])"));
+    EXPECT_TRUE(rejects(with_material_media({{"glass", {{"sigma_s", 0.1}, {"g", 1}}}}), "material_media.glass.g",
+                        "material_media.glass.g: must be in [-0.99, 0.99] (got 1)"));
+    EXPECT_TRUE(rejects(with_material_media({{"glass", {{"sigma_s", 0.1}, {"g", -1}}}}), "material_media.glass.g",
+                        "[-0.99, 0.99]"));
+    EXPECT_TRUE(rejects(with_material_media({{"glass", {{"sigma_s", 0.1}, {"g", "forward"}}}}), "material_media.glass.g",
+                        "must be a number"));
+    // A name with dots stays whole in the path.
+    EXPECT_TRUE(rejects(with_material_media({{"Glass.001", {{"sigma_s", 0.1}, {"g", 2}}}}), "material_media.Glass.001.g",
+                        "must be in [-0.99, 0.99]"));
+    EXPECT_TRUE(rejects(with_material_media({{"", {{"sigma_s", 0.1}}}}), "material_media",
+                        "material_media: must name a material in every key (got \"\")"));
+    EXPECT_TRUE(rejects(with_material_media({{repeat('m', 257), {{"sigma_s", 0.1}}}}), "material_media",
+                        "material_media: a material name must be at most 256 bytes (got one of 257)"));
+    EXPECT_TRUE(accepts(with_material_media({{repeat('m', 256), {{"sigma_s", 0.1}}}})));
+    // Bytes, not characters: 129 two-byte characters are 258 bytes.
+    std::string wide;
+    for (int i = 0; i < 129; ++i) wide += "\xc3\xa9";
+    EXPECT_TRUE(rejects(with_material_media({{wide, {{"sigma_s", 0.1}}}}), "material_media", "at most 256 bytes"));
+    EXPECT_TRUE(rejects(with_material_media({{"glass", 0.3}}), "material_media.glass",
+                        "material_media.glass: must be an object (got 0.3)"));
+    EXPECT_TRUE(rejects(with_material_media({{"glass", nullptr}}), "material_media.glass", "must be an object"));
+    EXPECT_TRUE(rejects(with_material_media({{"glass", {0.1, 0.1, 0.1}}}), "material_media.glass", "must be an object"));
+    EXPECT_TRUE(rejects(with_material_media("glass"), "material_media",
+                        "material_media: must be an object of media by material name (got \"glass\")"));
+    EXPECT_TRUE(rejects(with_material_media(json::array({{{"sigma_s", 1}}})), "material_media", "must be an object"));
+    // The first bad entry in the order of the names is the one named.
+    EXPECT_TRUE(rejects(with_material_media({{"b", {{"sigma_s", -1}}}, {"a", {{"sigma_s", 1}, {"g", 5}}}}),
+                        "material_media.a.g", "must be in"));
+
+    json many = json::object();
+    for (int i = 0; i < 1025; ++i) many[std::to_string(i)] = {{"sigma_s", 0.1}};
+    EXPECT_TRUE(rejects(with_material_media(many), "material_media",
+                        "material_media: must hold at most 1024 materials (got 1025)"));
+    many.erase("0");
+    EXPECT_EQ(parsed(with_material_media(many)).material_media.size(), 1024u);
+
+    // Non-finite numbers (only a document built in code can hold them; JSON text cannot).
+    for (double bad : {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+        EXPECT_TRUE(rejects(with_material_media({{"glass", {{"sigma_s", bad}}}}), "material_media.glass.sigma_s",
+                            "must be in"))
+            << bad;
+        EXPECT_TRUE(rejects(with_material_media({{"glass", {{"sigma_s", 1}, {"sigma_a", {0.0, 0.0, bad}}}}}),
+                            "material_media.glass.sigma_a[2]", "must be in"))
+            << bad;
+        EXPECT_TRUE(rejects(with_material_media({{"glass", {{"sigma_s", 1}, {"g", bad}}}}), "material_media.glass.g",
+                            "must be in"))
+            << bad;
+    }
+}
+
+TEST(JobMaterialMedia, PhotonMapAndDirectRefuseItPathRendersIt) {
+    const json glass = {{"glass", {{"sigma_s", 0.1}}}};
+    const std::string photon_map_refusal =
+        "material_media: integrator \"photon-map\" does not render participating media yet (its volume photon map is "
+        "not built); use \"path\" (the reference)";
+    const std::string direct_refusal =
+        "material_media: integrator \"direct\" renders no light scattered inside solids (their surfaces block its "
+        "light samples); use \"path\" (the reference)";
+    // The default preset "final" (and "preview") integrate with photon-map.
+    EXPECT_TRUE(rejects(with_material_media(glass, ""), "material_media", photon_map_refusal));
+    json preview = with_material_media(glass, "");
+    preview["preset"] = "preview";
+    EXPECT_TRUE(rejects(preview, "material_media", photon_map_refusal));
+    EXPECT_TRUE(rejects(with_material_media(glass, "photon-map"), "material_media", photon_map_refusal));
+    EXPECT_TRUE(rejects(with_material_media(glass, "direct"), "material_media", direct_refusal));
+    // The whole message: the photon-map refusal does not offer "direct".
+    Expected<Job> refused = parse_job(with_material_media(glass, "photon-map"));
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error().message, photon_map_refusal);
+    refused = parse_job(with_material_media(glass, "direct"));
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error().message, direct_refusal);
+    // Even a medium of zero coefficients: the document asked for one.
+    EXPECT_TRUE(rejects(with_material_media({{"glass", {{"sigma_s", 0}}}}, "direct"), "material_media", direct_refusal));
+    // Each field's own error comes first: the cross-field rule judges a job whose fields are valid.
+    EXPECT_TRUE(rejects(with_material_media({{"glass", {{"sigma_s", -1}}}}, ""), "material_media.glass.sigma_s",
+                        "must be in"));
+    // The atmosphere's rule comes first; "direct" renders an atmosphere but not these media.
+    json both = with_material_media(glass, "direct");
+    both["atmosphere"] = {{"sigma_s", 0.1}};
+    EXPECT_TRUE(rejects(both, "material_media", direct_refusal));
+    both["integrator"] = "photon-map";
+    EXPECT_TRUE(rejects(both, "atmosphere", "photon-map"));
+
+    const Job job = parsed(with_material_media(glass, "path"));
+    EXPECT_EQ(job.integrator, "path");
+    ASSERT_EQ(job.material_media.size(), 1u);
+    EXPECT_EQ(job.material_media.at("glass").sigma_s, (std::array<double, 3>{0.1, 0.1, 0.1}));
+    both["integrator"] = "path";
+    EXPECT_TRUE(accepts(both));
+    // "reference" integrates with path: nothing else to name.
+    json reference = with_material_media(glass, "");
+    reference["preset"] = "reference";
+    EXPECT_TRUE(accepts(reference));
+}
+
+TEST(JobSchema, DescribesTheMaterialMedia) {
+    const json schema = job_json_schema();
+    ASSERT_TRUE(schema["properties"].contains("material_media"));
+    const json& field = schema["properties"]["material_media"];
+    EXPECT_NE(field["description"].get<std::string>().find("KHR_materials_transmission"), std::string::npos);
+    ASSERT_EQ(field["oneOf"].size(), 2u);
+    EXPECT_EQ(field["oneOf"][0]["type"], "null");
+    const json& media = field["oneOf"][1];
+    EXPECT_EQ(media["type"], "object");
+    EXPECT_FALSE(media.contains("properties"));
+    EXPECT_EQ(media["maxProperties"], limits::kMaterialMedia.max);
+    EXPECT_EQ(media["propertyNames"]["minLength"], 1);
+    EXPECT_EQ(media["propertyNames"]["maxLength"], limits::kMaterialNameBytesMax);
+    const json& medium = media["additionalProperties"];
+    EXPECT_EQ(medium["type"], "object");
+    EXPECT_EQ(medium["additionalProperties"], false);
+    EXPECT_EQ(medium["required"], json({"sigma_s"}));
+    EXPECT_EQ(medium["properties"].size(), 3u);
+    for (std::string key : {"sigma_s", "sigma_a"}) {
+        const json& coefficient = medium["properties"][key];
+        EXPECT_NE(coefficient["description"].get<std::string>().find("per world unit"), std::string::npos) << key;
+        ASSERT_EQ(coefficient["oneOf"].size(), 2u) << key;
+        EXPECT_EQ(coefficient["oneOf"][0]["minimum"], limits::kMediumCoefficient.min);
+        EXPECT_EQ(coefficient["oneOf"][0]["maximum"], limits::kMediumCoefficient.max);
+        EXPECT_EQ(coefficient["oneOf"][1]["minItems"], 3);
+        EXPECT_EQ(coefficient["oneOf"][1]["maxItems"], 3);
+        EXPECT_EQ(coefficient["oneOf"][1]["items"]["maximum"], limits::kMediumCoefficient.max);
+    }
+    EXPECT_NE(medium["properties"]["sigma_a"]["description"].get<std::string>().find("KHR_materials_volume"),
+              std::string::npos);
+    const json& g = medium["properties"]["g"];
+    EXPECT_EQ(g["type"], "number");
+    EXPECT_EQ(g["minimum"], -0.99);
+    EXPECT_EQ(g["maximum"], 0.99);
+    EXPECT_EQ(g["default"], 0.0);
 }
 
 TEST(JobErrors, DescribeJoinsPathAndMessage) {
