@@ -37,20 +37,12 @@ RadianceParts DirectIntegrator::radiance_along(const Ray& ray, int depth, Sample
     }
     if (const std::optional<HomogeneousMedium>& atmosphere = rs.scene->atmosphere) {
         // The atmosphere on the way: what lies beyond is seen through it, and it sends the light
-        // it scatters once towards the ray (single scattering, by one light sample at a distance
-        // drawn by its transmittance).
+        // it scatters once towards the ray (single_scattering).
         const MediumSpan span = atmosphere_span(*rs.scene, ray, si ? &*si : nullptr);
         if (!span.empty()) {
             const float length = span.t1 - span.t0;
             radiance = atmosphere->transmittance(length) * radiance;
-            if (atmosphere->scatters()) {
-                const float u_channel = context.next_1d();
-                const SegmentDistance d = sample_distance_in_segment(*atmosphere, length, u_channel, context.next_1d());
-                const Vec3 x = ray.origin + (span.t0 + d.t) * ray.direction;
-                if (d.pdf > 0.0f)
-                    radiance.add_direct(atmosphere->sigma_s * atmosphere->transmittance(d.t) / d.pdf *
-                                        sample_direct_light_in_medium(rs, *atmosphere, x, -ray.direction, context, false));
-            }
+            if (atmosphere->scatters()) radiance.add_direct(single_scattering(rs, *atmosphere, ray, span, context));
         }
     }
     return radiance;

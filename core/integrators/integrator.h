@@ -16,6 +16,7 @@
 #include "core/math/rng.h"
 #include "core/shading/render_scene.h"
 #include "core/shading/scene_queries.h"
+#include "core/scene/atmosphere.h"
 #include "core/scene/interaction.h"
 #include "core/util/expected.h"
 
@@ -134,6 +135,15 @@ Color sample_direct_light(const RenderScene& rs, const LightSet& lights, const S
 /// against phase-function sampling. The caller's throughput carries the transmittance up to x.
 Color sample_direct_light_in_medium(const RenderScene& rs, const HomogeneousMedium& medium, const Vec3& x,
                                     const Vec3& wo, SampleContext& context, bool use_mis);
+/// Points along a ray segment at which single_scattering samples the light.
+inline constexpr int kSingleScatteringPoints = 4;
+/// The light `medium` scatters once towards the ray's origin over `span` of the ray (unit
+/// direction): kSingleScatteringPoints distances stratified by the transmittance truncated to
+/// the span (sample_distance_in_segment, one channel for all), each lit by one light sample
+/// (sample_direct_light_in_medium, no MIS). Not attenuated by the span's own transmittance
+/// before it: the caller's throughput holds that.
+Color single_scattering(const RenderScene& rs, const HomogeneousMedium& medium, const Ray& ray, const MediumSpan& span,
+                        SampleContext& context);
 /// The same with the scene's lights.
 inline Color sample_direct_light(const RenderScene& rs, const SurfaceInteraction& si, const Bsdf& bsdf,
                                  const Vec3& wo, SampleContext& context, bool use_mis,
