@@ -104,6 +104,24 @@ Color PhotonMap::estimate_irradiance(const Vec3& p, const Vec3& normal, uint32_t
     return Color(sum / (kPiDouble * radius2));
 }
 
+Color PhotonMap::estimate_in_scattering(const Vec3& x, const Vec3& wo, float g, uint32_t k, float max_radius,
+                                        uint8_t exclude_flags) const {
+    if (tree_.empty()) return Color(0.0f);
+    KnnResult& found = thread_scratch();
+    max_radius = max_radius > 0.0f ? max_radius : std::numeric_limits<float>::infinity();
+    tree_.k_nearest(x, k, max_radius, found);
+    const double radius2 = estimate_radius2(found, k, max_radius);  // see estimate_radiance
+    if (found.size() < kMinPhotonsPerEstimate || !(radius2 > 0.0)) return Color(0.0f);
+    DVec3 sum(0.0);
+    for (const KnnNeighbor& n : found.neighbors) {
+        const Photon& photon = tree_.photon(n.index);
+        if (photon.user_flags() & exclude_flags) continue;
+        sum += static_cast<double>(henyey_greenstein(g, wo, -photon.direction())) * DVec3(photon.flux());
+    }
+    const double volume = 4.0 / 3.0 * kPiDouble * radius2 * std::sqrt(radius2);
+    return Color(sum / volume);
+}
+
 bool PhotonMap::nearest_irradiance(const Vec3& p, const Vec3& normal, float max_radius,
                                    Color* irradiance) const {
     if (tree_.empty()) return false;

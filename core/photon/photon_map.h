@@ -90,6 +90,16 @@ public:
     Color estimate_irradiance(const Vec3& p, const Vec3& normal, uint32_t k, float max_radius,
                               uint8_t exclude_flags = 0, float* radius_hint = nullptr) const;
 
+    /// In a volume map (PhotonMaps::volume): the in-scattered radiance source at x towards wo,
+    /// sigma_s times the phase-weighted integral of the radiance arriving there (Jensen &
+    /// Christensen 1998): the sum over the k nearest photons of HG(g, wo, -direction) times their
+    /// flux (stored with the event's albedo), over the volume (4/3) pi r^3 of the sphere they
+    /// fill. Photons with any of exclude_flags are skipped (photon_flags::kDirect: the single
+    /// scattering a ray march takes by light samples). Zero with fewer than
+    /// kMinPhotonsPerEstimate photons.
+    Color estimate_in_scattering(const Vec3& x, const Vec3& wo, float g, uint32_t k, float max_radius,
+                                 uint8_t exclude_flags = 0) const;
+
     /// Precomputed irradiance (Christensen 1999, "Faster photon map global illumination"): in a
     /// map whose photons hold irradiance (flux) and surface normal (normal, or direction for
     /// photons without one), the nearest one within max_radius whose normal agrees with `normal`

@@ -19,7 +19,7 @@ constexpr size_t kChecksumSize = 32;
 
 // Fires when PhotonTracingStatistics gains a field: add it to the layout (and bump
 // kPhotonMapFormatVersion).
-static_assert(sizeof(PhotonTracingStatistics) == 104,
+static_assert(sizeof(PhotonTracingStatistics) == 120,
               "PhotonTracingStatistics changed: store the new field in photon_map_io");
 
 // ---- Writing ----------------------------------------------------------------------------------
@@ -95,7 +95,10 @@ bool read_statistics(ByteReader& in, PhotonTracingStatistics& s) {
                     in.get_flag(s.caustic_complete, "statistics.caustic_complete") &&
                     in.get_flag(s.caustic_tested, "statistics.caustic_tested") &&
                     in.get_u64(ratio_bits, "statistics.caustic_peak_ratio") &&
-                    in.get_flag(s.caustic_dropped, "statistics.caustic_dropped");
+                    in.get_flag(s.caustic_dropped, "statistics.caustic_dropped") &&
+                    in.get_u64(s.emitted_volume, "statistics.emitted_volume") &&
+                    in.get_u64(s.stored_volume, "statistics.stored_volume") &&
+                    in.get_flag(s.volume_complete, "statistics.volume_complete");
     s.tracing_seconds = std::bit_cast<double>(tracing_bits);
     s.build_seconds = std::bit_cast<double>(build_bits);
     s.irradiance_seconds = std::bit_cast<double>(irradiance_bits);
@@ -160,7 +163,7 @@ Expected<PhotonMaps> deserialize_checked(std::span<const uint8_t> bytes,
     PhotonMaps maps;
     if (!read_statistics(in, maps.statistics) || !read_map(in, "global", maps.global) ||
         !read_map(in, "caustic", maps.caustic) || !read_map(in, "irradiance", maps.irradiance) ||
-        !read_map(in, "caustic irradiance", maps.caustic_irradiance)) {
+        !read_map(in, "caustic irradiance", maps.caustic_irradiance) || !read_map(in, "volume", maps.volume)) {
         return Error{in.error()};
     }
     if (in.remaining() != 0) {
@@ -183,7 +186,8 @@ Expected<std::vector<uint8_t>> serialize_photon_maps(const PhotonMaps& maps,
         const size_t photons = (maps.global ? maps.global->size() : 0) +
                                (maps.caustic ? maps.caustic->size() : 0) +
                                (maps.irradiance ? maps.irradiance->size() : 0) +
-                               (maps.caustic_irradiance ? maps.caustic_irradiance->size() : 0);
+                               (maps.caustic_irradiance ? maps.caustic_irradiance->size() : 0) +
+                               (maps.volume ? maps.volume->size() : 0);
         out.reserve(256 + key.size() + photons * sizeof(Photon));
         out.put_bytes(kMagic.data(), kMagic.size());
         out.put_u32(kPhotonMapFormatVersion);
@@ -207,10 +211,14 @@ Expected<std::vector<uint8_t>> serialize_photon_maps(const PhotonMaps& maps,
         out.put_u8(s.caustic_tested ? 1 : 0);
         out.put_u64(std::bit_cast<uint64_t>(s.caustic_peak_ratio));
         out.put_u8(s.caustic_dropped ? 1 : 0);
+        out.put_u64(s.emitted_volume);
+        out.put_u64(s.stored_volume);
+        out.put_u8(s.volume_complete ? 1 : 0);
         put_map(out, maps.global);
         put_map(out, maps.caustic);
         put_map(out, maps.irradiance);
         put_map(out, maps.caustic_irradiance);
+        put_map(out, maps.volume);
         const Sha256Digest checksum = sha256(out.bytes());
         out.put_bytes(checksum.data(), checksum.size());
         return std::move(out.bytes());

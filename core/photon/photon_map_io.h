@@ -16,8 +16,10 @@
 //                                            bits, u64 each), global_complete, caustic_complete
 //                                            (u8 each, 0 or 1), caustic_tested (u8),
 //                                            caustic_peak_ratio (binary64 bits, u64),
-//                                            caustic_dropped (u8)
-//   global, caustic, irradiance, caustic irradiance map, each:   present u8 (0 or 1), emitted u64, photon count u64
+//                                            caustic_dropped (u8), emitted_volume,
+//                                            stored_volume (u64 each), volume_complete (u8)
+//   global, caustic, irradiance, caustic irradiance, volume map, each: present u8 (0 or 1),
+//                                            emitted u64, photon count u64
 //                                            (both 0 when absent), photons in tree order
 //   SHA-256 of every byte before it          32 bytes
 //
@@ -39,8 +41,9 @@ namespace photond {
 
 /// Bump when the layout changes; files of any other version are refused. Version 2: photons
 /// carry their surface normal (24 bytes, was 20). Version 3: the caustic map's visibility test
-/// in the statistics, and its precomputed irradiance.
-inline constexpr uint32_t kPhotonMapFormatVersion = 3;
+/// in the statistics, and its precomputed irradiance. Version 4: the volume map and its
+/// statistics.
+inline constexpr uint32_t kPhotonMapFormatVersion = 4;
 /// The longest key a file may carry (photon_map_key gives 68 characters).
 inline constexpr uint32_t kMaxPhotonMapKey = 4096;
 

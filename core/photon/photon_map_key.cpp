@@ -7,7 +7,7 @@ namespace photond {
 
 // Fires when a field is added to PhotonTracingSettings: add it to photon_map_key if the maps
 // depend on it, then update the size here.
-static_assert(sizeof(void*) != 8 || sizeof(PhotonTracingSettings) == 48,
+static_assert(sizeof(void*) != 8 || sizeof(PhotonTracingSettings) == 56,
               "PhotonTracingSettings changed: add the new field to photon_map_key if the maps "
               "depend on it");
 
@@ -18,6 +18,7 @@ std::string photon_map_key(const Scene& scene, const PhotonTracingSettings& sett
     hasher.update(scene_content_hash(scene));
     hasher.update_value(uint32_t(settings.global_photons));
     hasher.update_value(uint32_t(settings.caustic_photons));
+    hasher.update_value(uint32_t(settings.volume_photons));
     hasher.update_value(uint64_t(settings.seed));
     hasher.update_value(int32_t(settings.max_bounces));
     hasher.update_value(uint32_t(settings.max_emitted_per_stored));

@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "core/math/rng.h"
+#include "core/scene/atmosphere.h"
 #include "core/shading/scene_queries.h"
 
 namespace photond {
@@ -53,6 +54,7 @@ using TracedPhotons = std::vector<TracedPhoton, tbb::scalable_allocator<TracedPh
 struct ChunkOutput {
     TracedPhotons global;
     TracedPhotons caustic;
+    TracedPhotons volume;
     uint64_t rays = 0;
 };
 
@@ -104,9 +106,11 @@ struct MapBuilder {
     }
 };
 
-/// Traces photon `index` and appends what it stores to `out`.
+/// Traces photon `index` and appends what it stores to `out`: global and volume photons along
+/// whole paths (`want_global`, `want_volume`), caustic photons along L S+ D paths.
 void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settings, const RngStreamFamily& streams,
-                      uint64_t index, uint32_t path_in_batch, bool want_global, bool want_caustic, ChunkOutput& out) {
+                      uint64_t index, uint32_t path_in_batch, bool want_global, bool want_caustic, bool want_volume,
+                      ChunkOutput& out) {
     Rng rng = streams.stream(index);  // Rng::for_stream(settings.seed, kPhotonStreamTag, index)
     const float u_select = rng.next_float();
     const Vec2 u_position = rng.next_vec2();
@@ -115,9 +119,11 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
     // through specular surfaces (RenderScene::diffuse_sky): caustic photons then come from the
     // other lights and the sky's peaks only.
     const bool sky_gathered = settings.global_photons > 0 && rs.lights_with_sky_peaks;
-    const LightSet& lights = !want_global && sky_gathered ? *rs.lights_with_sky_peaks : *rs.lights;
+    // Whole paths: for the global or the volume map; else only caustic paths are wanted.
+    const bool whole_paths = want_global || want_volume;
+    const LightSet& lights = !whole_paths && sky_gathered ? *rs.lights_with_sky_peaks : *rs.lights;
     // Photons for the caustic map alone are aimed at its casters when they come from far away.
-    const EmissionFocus* focus = !want_global && rs.caustic_casters ? &rs.caustic_focus : nullptr;
+    const EmissionFocus* focus = !whole_paths && rs.caustic_casters ? &rs.caustic_focus : nullptr;
     const std::optional<EmissionSample> emission = lights.sample_emission(u_select, u_position, u_direction, focus);
     if (!emission || is_black(emission->flux_weight)) return;
     if (want_caustic && want_global && sky_gathered && lights.kind(emission->light) == LightKind::Environment) {
@@ -132,13 +138,52 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
     int specular_bounces = 0;
     bool diffuse_seen = false;
     // For the caustic map alone, a photon that no specular surface lies ahead of stores nothing.
-    if (!want_global && rs.caustic_casters && !rs.caustic_casters->occluded(ray)) return;
+    if (!whole_paths && rs.caustic_casters && !rs.caustic_casters->occluded(ray)) return;
+    // In a scattering atmosphere, free flights by a hero channel drawn once for the photon, and
+    // what it stores divided by the channel average of the pdf ratios (sample_free_flight), as
+    // path tracing does.
+    const std::optional<HomogeneousMedium>& atmosphere = rs.scene->atmosphere;
+    const int hero = atmosphere ? std::min(2, static_cast<int>(rng.next_float() * 3.0f)) : 0;
+    Color spectral(1.0f);
+    const auto stored_flux = [&](const Color& f) { return atmosphere ? f / average(spectral) : f; };
 
     for (int bounce = 0; bounce < settings.max_bounces; ++bounce) {
         ++out.rays;
         const std::optional<Hit> hit = rs.tracer->intersect(ray);
+        std::optional<SurfaceInteraction> hit_point;
+        if (hit) hit_point = make_interaction(*rs.scene, *hit, ray.direction);
+        if (atmosphere) {
+            const MediumSpan span = atmosphere_span(*rs.scene, ray, hit_point ? &*hit_point : nullptr);
+            if (!span.empty() && !atmosphere->scatters()) {
+                flux *= atmosphere->transmittance(span.t1 - span.t0);
+            } else if (!span.empty()) {
+                const FreeFlight flight = sample_free_flight(*atmosphere, span.t1 - span.t0, hero, rng.next_float());
+                const Color before = stored_flux(flux);
+                flux *= flight.weight;
+                spectral *= flight.pdf_ratio;
+                if (flight.scattered) {
+                    // A scattering event: the photon is stored with the flux it scatters
+                    // (estimate_in_scattering), then goes on by the phase function, surviving
+                    // Russian roulette with the ratio of its flux to what it arrived with.
+                    const Vec3 x = ray.origin + (span.t0 + flight.t) * ray.direction;
+                    const Color scattered = stored_flux(flux);
+                    if (want_volume)
+                        out.volume.push_back({make_photon(x, ray.direction, scattered,
+                                                          bounce == 0 ? photon_flags::kDirect : uint8_t(0)),
+                                              path_in_batch});
+                    diffuse_seen = true;
+                    if (!whole_paths) return;
+                    const float survive = std::min(1.0f, max_component(scattered) / max_component(before));
+                    if (!(survive > 0.0f) || rng.next_float() >= survive) return;
+                    flux *= 1.0f / survive;
+                    if (!is_finite(flux)) return;
+                    ray = Ray{x, sample_henyey_greenstein(atmosphere->g, -ray.direction, rng.next_vec2())};
+                    continue;
+                }
+            }
+        }
         if (!hit) return;
-        const SurfaceInteraction si = make_interaction(*rs.scene, *hit, ray.direction);
+        const SurfaceInteraction& si = *hit_point;
         const Vec3 wo = -ray.direction;  // towards where the photon came from
         if (rs.scene->materials[si.material].has_volume()) {
             flux *= volume_transmittance(*rs.scene, si);
@@ -150,12 +195,12 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
             const uint8_t flags = static_cast<uint8_t>((bounce == 0 ? photon_flags::kDirect : 0) |
                                                        (caustic_path ? photon_flags::kCaustic : 0));
             const Vec3 normal = glm::dot(si.surface_normal, wo) >= 0.0f ? si.surface_normal : -si.surface_normal;
-            const TracedPhoton photon{make_photon(si.p, ray.direction, flux, flags, normal), path_in_batch};
+            const TracedPhoton photon{make_photon(si.p, ray.direction, stored_flux(flux), flags, normal), path_in_batch};
             if (want_global) out.global.push_back(photon);
             if (want_caustic && caustic_path) out.caustic.push_back(photon);
         }
         // Only caustic paths wanted, and no ideal specular way on from here: no need to sample it.
-        if (!want_global && !bsdf.has_delta()) return;
+        if (!whole_paths && !bsdf.has_delta()) return;
         const float u_lobe = bsdf.samples_lobe_choice() ? rng.next_float() : 0.0f;
         const Vec2 u = rng.next_vec2();
         const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Importance);
@@ -164,7 +209,7 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
         // final gather's, which follows glossy lobes by sampling (FinalGatherer).
         if (s->kind != LobeKind::Delta) {
             diffuse_seen = true;
-            if (!want_global) return;  // only caustic paths are wanted, and this is none any more
+            if (!whole_paths) return;  // only caustic paths are wanted, and this is none any more
         } else {
             ++specular_bounces;
         }
@@ -330,16 +375,18 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
     if (rs.lights->empty())
         return Error{"photon pass: the scene has no light with positive power, so no photon can be emitted"};
     const Clock::time_point start = Clock::now();
-    MapBuilder global, caustic;
+    MapBuilder global, caustic, volume;
     global.target = settings.global_photons;
     caustic.target = settings.caustic_photons;
-    global.active = global.target > 0;
-    caustic.active = caustic.target > 0;
-    global.cap = static_cast<uint64_t>(global.target) * settings.max_emitted_per_stored;
-    caustic.cap = static_cast<uint64_t>(caustic.target) * settings.max_emitted_per_stored;
-    // Reserved whole, touched as photons arrive: no copy when the array grows.
-    global.photons.reserve(global.target);
-    caustic.photons.reserve(caustic.target);
+    // The volume map: only where the atmosphere scatters light.
+    const bool scattering_atmosphere = rs.scene->atmosphere && rs.scene->atmosphere->scatters();
+    volume.target = scattering_atmosphere ? settings.volume_photons : 0;
+    for (MapBuilder* m : {&global, &caustic, &volume}) {
+        m->active = m->target > 0;
+        m->cap = static_cast<uint64_t>(m->target) * settings.max_emitted_per_stored;
+        // Reserved whole, touched as photons arrive: no copy when the array grows.
+        m->photons.reserve(m->target);
+    }
 
     PhotonMaps maps;
     PhotonTracingStatistics& stats = maps.statistics;
@@ -359,7 +406,7 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
     bool cancelled = false;
     const RngStreamFamily streams(settings.seed, kPhotonStreamTag);
     std::vector<ChunkOutput> chunks;
-    while ((global.active || caustic.active) && !cancelled) {
+    while ((global.active || caustic.active || volume.active) && !cancelled) {
         // Size the next batch from the store rate so far (deterministic: it depends only on the
         // maps' contents), within [16K, 1M] photons: enough for the map that fills first, so
         // that photons past its fill point are not traced for it (the caustic map usually needs
@@ -368,7 +415,7 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
         uint64_t batch = 16384;
         if (emitted > 0) {
             double needed_first = 1048576.0, largest = 1048576.0;
-            for (const MapBuilder* m : {&global, &caustic}) {
+            for (const MapBuilder* m : {&global, &caustic, &volume}) {
                 if (!m->active || m->count == 0) continue;
                 const double rate = static_cast<double>(m->count) / static_cast<double>(emitted);
                 needed_first = std::min(needed_first, 1.1 * static_cast<double>(m->target - m->count) / rate);
@@ -377,7 +424,7 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
             batch = std::clamp<uint64_t>(static_cast<uint64_t>(needed_first), batch,
                                          std::max<uint64_t>(batch, static_cast<uint64_t>(largest)));
         }
-        const bool want_global = global.active, want_caustic = caustic.active;
+        const bool want_global = global.active, want_caustic = caustic.active, want_volume = volume.active;
         const size_t chunk_count = (batch + kChunkSize - 1) / kChunkSize;
         // Chunk buffers are kept from batch to batch: their capacity is reused, not reallocated.
         if (chunks.size() < chunk_count) chunks.resize(chunk_count);
@@ -385,16 +432,19 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
         // and page faults); they keep their capacity from batch to batch.
         const auto expected = [&](const MapBuilder& m) {
             if (!m.active) return size_t(0);
-            // First guess: a global photon per emission; caustic photons are rarer.
-            if (emitted == 0) return &m == &global ? size_t(kChunkSize) : size_t(0);
+            // First guess: a global or volume photon per emission; caustic photons are rarer.
+            if (emitted == 0) return &m == &caustic ? size_t(0) : size_t(kChunkSize);
             return static_cast<size_t>(1.2 * kChunkSize * static_cast<double>(m.count) / static_cast<double>(emitted)) + 16;
         };
-        const size_t expected_global = expected(global), expected_caustic = expected(caustic);
+        const size_t expected_global = expected(global), expected_caustic = expected(caustic),
+                     expected_volume = expected(volume);
         for (size_t c = 0; c < chunk_count; ++c) {
             chunks[c].global.clear();
             chunks[c].caustic.clear();
+            chunks[c].volume.clear();
             chunks[c].global.reserve(expected_global);
             chunks[c].caustic.reserve(expected_caustic);
+            chunks[c].volume.reserve(expected_volume);
             chunks[c].rays = 0;
         }
         arena.execute([&] {
@@ -405,7 +455,7 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
                 const uint64_t last = std::min<uint64_t>(first + kChunkSize, batch);
                 for (uint64_t i = first; i < last; ++i) {
                     trace_one_photon(rs, settings, streams, emitted + i, static_cast<uint32_t>(i), want_global,
-                                     want_caustic, chunks[c]);
+                                     want_caustic, want_volume, chunks[c]);
                 }
             });
         });
@@ -415,6 +465,7 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
         arena.execute([&] {
             global.append(batch_chunks, &ChunkOutput::global, emitted);
             caustic.append(batch_chunks, &ChunkOutput::caustic, emitted);
+            volume.append(batch_chunks, &ChunkOutput::volume, emitted);
         });
         emitted += batch;
         // A caustic map that carries next to no light is not worth its emissions: stop it.
@@ -428,7 +479,7 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
                 caustic.emitted = emitted;
             }
         }
-        for (MapBuilder* m : {&global, &caustic}) {
+        for (MapBuilder* m : {&global, &caustic, &volume}) {
             // A map that nothing reached after a fair trial will not fill: stop early.
             const bool hopeless = m->count == 0 && emitted >= std::max<uint64_t>(kEmptyMapTrial, m->target);
             if (m->active && (emitted >= m->cap || hopeless)) {  // keep what arrived, say so
@@ -476,6 +527,9 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
     stats.stored_caustic = caustic.count;
     stats.global_complete = global.complete;
     stats.caustic_complete = caustic.complete;
+    stats.emitted_volume = volume.emitted;
+    stats.stored_volume = volume.count;
+    stats.volume_complete = volume.complete;
 
     const Clock::time_point build_start = Clock::now();
     // A caustic map not tested yet (it filled or stopped before the global map was full, or the
@@ -487,7 +541,8 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
                               : irradiance_sites(caustic, site_stride(caustic.count, settings.irradiance_stride, kCausticTestPhotons));
     arena.execute([&] {
         tbb::parallel_invoke([&] { if (global.target > 0 && !maps.global) finish_global(); },
-                             [&] { if (caustic.target > 0 && !stats.caustic_dropped) maps.caustic = finish_map(caustic); });
+                             [&] { if (caustic.target > 0 && !stats.caustic_dropped) maps.caustic = finish_map(caustic); },
+                             [&] { if (volume.target > 0) maps.volume = finish_map(volume); });
     });
     if (test_at_end) {
         const uint32_t k = static_cast<uint32_t>(std::min<uint64_t>(kCausticTestPhotons, caustic.count));

@@ -64,6 +64,9 @@ inline constexpr float kCausticRadiusShare = 0.05f;
 struct PhotonTracingSettings {
     uint32_t global_photons = 200000;   // photons to store in the global map (0: no global map)
     uint32_t caustic_photons = 100000;  // photons to store in the caustic map (0: no caustic map)
+    /// Photons to store in the volume map at scattering events in the atmosphere (0, or a scene
+    /// whose atmosphere does not scatter: no volume map); Jensen & Christensen 1998.
+    uint32_t volume_photons = 0;
     uint64_t seed = 1;
     int max_bounces = 64;               // safety net; Russian roulette ends paths first
     /// Emission stops after this many photons per requested stored photon, and the pass fails
@@ -85,6 +88,8 @@ struct PhotonTracingStatistics {
     uint64_t emitted_caustic = 0;    // emitted when the caustic map was filled
     uint64_t stored_global = 0;
     uint64_t stored_caustic = 0;
+    uint64_t emitted_volume = 0;     // emitted when the volume map was filled
+    uint64_t stored_volume = 0;
     uint64_t rays = 0;
     double tracing_seconds = 0.0;
     double build_seconds = 0.0;      // kd-trees
@@ -92,6 +97,7 @@ struct PhotonTracingStatistics {
     uint64_t irradiance_photons = 0;
     bool global_complete = true;     // false: the emission cap stopped it short
     bool caustic_complete = true;    // false: the emission cap, or a negligible share, stopped it
+    bool volume_complete = true;     // false: the emission cap stopped it short
     /// The caustic map's visibility test: whether it ran, its largest ratio of caustic to all
     /// irradiance at the photons tested, and whether the map was dropped for it (then
     /// PhotonMaps::caustic is null; stored_caustic and emitted_caustic say what was traced).
@@ -100,7 +106,7 @@ struct PhotonTracingStatistics {
     bool caustic_dropped = false;
 };
 
-/// Both maps of a scene; a map not asked for is null. `irradiance` holds precomputed irradiance
+/// The maps of a scene; a map not asked for is null. `irradiance` holds precomputed irradiance
 /// at a subset of the global photons (photon flux = irradiance, direction and normal = surface
 /// normal), `caustic_irradiance` the caustic map's at a subset of the caustic photons (with
 /// kCausticTestPhotons an estimate), when both maps exist.
@@ -109,11 +115,16 @@ struct PhotonMaps {
     std::shared_ptr<const PhotonMap> caustic;
     std::shared_ptr<const PhotonMap> irradiance;
     std::shared_ptr<const PhotonMap> caustic_irradiance;
+    /// Photons at scattering events in the atmosphere (flux after the event's albedo, direction
+    /// of travel before it, no normal; photon_flags::kDirect on a photon's first event), for
+    /// PhotonMap::estimate_in_scattering; null without a scattering atmosphere.
+    std::shared_ptr<const PhotonMap> volume;
     PhotonTracingStatistics statistics;
 
     size_t bytes() const {
         return (global ? global->bytes() : 0) + (caustic ? caustic->bytes() : 0) +
-               (irradiance ? irradiance->bytes() : 0) + (caustic_irradiance ? caustic_irradiance->bytes() : 0);
+               (irradiance ? irradiance->bytes() : 0) + (caustic_irradiance ? caustic_irradiance->bytes() : 0) +
+               (volume ? volume->bytes() : 0);
     }
 };
 

@@ -345,6 +345,9 @@ TEST(PhotonMapIo, RoundTripIsExact) {
     EXPECT_EQ(a.emitted_caustic, b.emitted_caustic);
     EXPECT_EQ(a.stored_global, b.stored_global);
     EXPECT_EQ(a.stored_caustic, b.stored_caustic);
+    EXPECT_EQ(a.emitted_volume, b.emitted_volume);
+    EXPECT_EQ(a.stored_volume, b.stored_volume);
+    EXPECT_EQ(a.volume_complete, b.volume_complete);
     EXPECT_EQ(a.rays, b.rays);
     EXPECT_EQ(a.tracing_seconds, b.tracing_seconds);
     EXPECT_EQ(a.build_seconds, b.build_seconds);
@@ -438,15 +441,15 @@ TEST(PhotonMapIo, ForeignDataIsRefused) {
 
 TEST(PhotonMapIo, OtherVersionsAndPhotonSizesAreRefused) {
     // Version 1 stored 20-byte photons without a normal; version 2 had no caustic visibility
-    // test and no precomputed caustic irradiance.
-    for (uint32_t version : {0u, 1u, 2u, 4u, 1000u}) {
+    // test and no precomputed caustic irradiance; version 3 no volume map.
+    for (uint32_t version : {0u, 1u, 2u, 3u, 5u, 1000u}) {
         std::vector<uint8_t> bytes = cornell_bytes();
         for (int i = 0; i < 4; ++i) bytes[8 + i] = uint8_t(version >> (8 * i));
         reseal(bytes);  // a well-formed file of that version
         Expected<PhotonMaps> result = deserialize_photon_maps(bytes, kKey);
         ASSERT_FALSE(result);
         EXPECT_EQ(result.error().message, "unsupported photon-map format version " +
-                                              std::to_string(version) + " (this build reads 3)");
+                                              std::to_string(version) + " (this build reads 4)");
         EXPECT_EQ(read_photon_map_key(bytes), "");
     }
     std::vector<uint8_t> bytes = cornell_bytes();
@@ -470,9 +473,9 @@ TEST(PhotonMapIo, AResealedBrokenTreeIsRefused) {
     // The checksum is not a signature: a rewritten file with a valid checksum but an unsorted
     // tree still reaches the kd-tree checks and is refused.
     std::vector<uint8_t> bytes = cornell_bytes();
-    // Header and key, the statistics (10 u64, 3 flags, 1 u64, 1 flag), the global map's present
-    // flag, emitted and count.
-    const size_t photons_start = 24 + kKey.size() + 82 + 10 + 17;
+    // Header and key, the statistics (10 u64, 3 flags, 1 u64, 1 flag, 2 u64, 1 flag), the global
+    // map's present flag, emitted and count.
+    const size_t photons_start = 24 + kKey.size() + 82 + 10 + 17 + 17;
     const PhotonKdTree& tree = cornell_maps().global->tree();
     const uint32_t root = tree.size() / 2;
     const uint32_t axis = tree.photon(root).split_axis();
