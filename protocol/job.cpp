@@ -54,24 +54,14 @@ void check_irradiance_cache(const IrradianceCacheSpec& cache) {
     }
 }
 
-/// The photon-map integrator traces no photons through media and gathers none from them: it
-/// would render the surfaces as if the air were clear, so the job is refused instead.
-void check_atmosphere(const Job& job) {
-    if (job.atmosphere && job.integrator == "photon-map") {
-        fail("atmosphere",
-             "integrator \"photon-map\" does not render participating media yet (its volume photon map is "
-             "not built); use \"path\" (the reference) or \"direct\" (single scattering)");
-    }
-}
-
 /// Media inside solids: photon-map traces no photons through them, and direct's light samples
 /// stop at the solids' surfaces, so no light scattered inside them reaches it; both refuse the job.
 void check_material_media(const Job& job) {
     if (job.material_media.empty()) return;
     if (job.integrator == "photon-map") {
         fail("material_media",
-             "integrator \"photon-map\" does not render participating media yet (its volume photon map is "
-             "not built); use \"path\" (the reference)");
+             "integrator \"photon-map\" does not render media inside solids yet (its volume photon map holds "
+             "the atmosphere's light only); use \"path\" (the reference)");
     }
     if (job.integrator == "direct") {
         fail("material_media",
@@ -120,7 +110,6 @@ Job read_job(const json& document) {
     }
     check_image(job.image);
     check_irradiance_cache(job.irradiance_cache);
-    check_atmosphere(job);
     check_material_media(job);
     return job;
 }

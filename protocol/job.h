@@ -45,7 +45,7 @@ inline constexpr IntegerRange kImageSize{1, 16384};            // image.width, i
 inline constexpr int64_t kImagePixelsMax = int64_t{64} << 20;  // width * height: 64 Mpixel
 inline constexpr IntegerRange kTileSize{8, 256};
 inline constexpr IntegerRange kSamplesPerPixel{1, 65536};
-inline constexpr IntegerRange kPhotonCount{0, 50'000'000};  // photons.global, photons.caustic
+inline constexpr IntegerRange kPhotonCount{0, 50'000'000};  // photons.global, .caustic, .volume
 // k nearest photons of a radiance estimate: below about 8 the density estimate is mostly noise.
 inline constexpr IntegerRange kPhotonNeighbours{8, 1000};
 inline constexpr IntegerRange kSeed{0, std::numeric_limits<uint64_t>::max()};
@@ -140,6 +140,10 @@ struct PhotonSpec {
     uint32_t caustic = 0;
     uint32_t k_global = 0;
     uint32_t k_caustic = 0;
+    // The volume photon map (Jensen & Christensen 1998): photons stored where they scatter in the
+    // atmosphere, and the nearest ones per estimate of the light scattered in.
+    uint32_t volume = 0;
+    uint32_t k_volume = 0;
     uint64_t seed = 0;
 
     bool operator==(const PhotonSpec&) const = default;
@@ -226,8 +230,8 @@ struct LightSpec {
 /// light positions, everywhere outside closed transmissive solids.
 /// Absent or null: none. {"sigma_a": A, "sigma_s": S, "g": G}: absorption and scattering
 /// coefficients per world unit (per metre for glTF scenes), each one number (grey) or [r, g, b],
-/// and the Henyey-Greenstein asymmetry G (0: isotropic, > 0: forward). Rendered by the
-/// integrators "path" and "direct"; "photon-map" refuses it (it has no volume photon map).
+/// and the Henyey-Greenstein asymmetry G (0: isotropic, > 0: forward). Rendered by every
+/// integrator: "photon-map" with a volume photon map (photons.volume, photons.k_volume).
 struct AtmosphereSpec {
     std::array<double, 3> sigma_a{0.0, 0.0, 0.0};
     std::array<double, 3> sigma_s{0.0, 0.0, 0.0};

@@ -451,8 +451,9 @@ json atmosphere_schema() {
                                    json{{"required", json::array({"sigma_s"})}}});
     return {{"description",
              "a homogeneous participating medium (fog, god rays) filling the scene's bounding box (its "
-             "triangles and the job's light positions) outside closed transmissive solids; rendered by the "
-             "integrators path and direct (photon-map refuses it); absent or null: none"},
+             "triangles and the job's light positions) outside closed transmissive solids; rendered by every "
+             "integrator (photon-map with a volume photon map: photons.volume, photons.k_volume); absent or "
+             "null: none"},
             {"oneOf", {{{"type", "null"}, {"description", "no atmosphere"}}, medium}}};
 }
 
@@ -774,6 +775,13 @@ std::vector<JobField> make_job_fields() {
                                    "nearest photons per global-map radiance estimate", {"50", "50", "50"}));
     fields.push_back(integer_field(JOB_MEMBER(photons.k_caustic), limits::kPhotonNeighbours,
                                    "nearest photons per caustic-map radiance estimate", {"100", "100", "100"}));
+    fields.push_back(integer_field(JOB_MEMBER(photons.volume), limits::kPhotonCount,
+                                   "photons stored in the volume map at scattering events in the atmosphere "
+                                   "(photon-map integrator; only when the job has an atmosphere that scatters)",
+                                   {"100000", "400000", "2000000"}));
+    fields.push_back(integer_field(JOB_MEMBER(photons.k_volume), limits::kPhotonNeighbours,
+                                   "nearest photons per volume-map estimate of in-scattered light",
+                                   {"100", "200", "400"}));
     fields.push_back(integer_field(JOB_MEMBER(photons.seed), limits::kSeed, "seed of the photon tracing",
                                    {"1", "1", "1"}));
     fields.push_back(integer_field(JOB_MEMBER(gather.rays), limits::kGatherRays, "final-gather rays per record",
@@ -840,7 +848,7 @@ std::vector<JobField> make_job_fields() {
                           return lights;
                       },
                       .schema = lights_schema()});
-    // No preset has an atmosphere: a job that wants one asks for it (and for "path" or "direct").
+    // No preset has an atmosphere: a job that wants one asks for it (every integrator renders it).
     fields.push_back({.path = "atmosphere",
                       .read = [](const json& value, const std::string&, Job& job) {
                           job.atmosphere = parse_atmosphere(value);

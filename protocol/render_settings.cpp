@@ -12,11 +12,13 @@ RenderSettings to_render_settings(const Job& job) {
 
     settings.photon_tracing.global_photons = job.photons.global;
     settings.photon_tracing.caustic_photons = job.photons.caustic;
+    settings.photon_tracing.volume_photons = job.photons.volume;
     settings.photon_tracing.seed = job.photons.seed;
 
     PhotonMapIntegratorSettings& photon_map = settings.photon_map;
     photon_map.k_global = job.photons.k_global;
     photon_map.k_caustic = job.photons.k_caustic;
+    photon_map.k_volume = job.photons.k_volume;
     photon_map.gather.rays = job.gather.rays;
     photon_map.use_irradiance_cache = job.irradiance_cache.enabled;
     CacheBuildSettings& cache = photon_map.irradiance_cache;

@@ -195,10 +195,11 @@ void print_statistics(const RenderStatistics& s) {
     for (const PassDecision& d : s.plan)
         std::fprintf(stderr, "  plan: %-12s %-8s %s\n", d.pass.c_str(), d.enabled ? "run" : "skipped", d.reason.c_str());
     if (s.photons && s.photons->emitted > 0) {
-        std::fprintf(stderr, "  photons: %llu emitted, %llu global, %llu caustic, %.1f MB\n",
+        std::fprintf(stderr, "  photons: %llu emitted, %llu global, %llu caustic, %llu volume, %.1f MB\n",
                      static_cast<unsigned long long>(s.photons->emitted),
                      static_cast<unsigned long long>(s.photons->stored_global),
-                     static_cast<unsigned long long>(s.photons->stored_caustic), s.photon_map_bytes / 1e6);
+                     static_cast<unsigned long long>(s.photons->stored_caustic),
+                     static_cast<unsigned long long>(s.photons->stored_volume), s.photon_map_bytes / 1e6);
     }
     if (s.caustic_points > 0) {
         std::fprintf(stderr, "  caustic map read at %.1f %% of %llu visible points (the rest too faint to show)\n",

@@ -159,11 +159,12 @@ Expected<std::shared_ptr<const PhotonMaps>> build_photon_maps(const protocol::Re
                                                               const PipelineOptions& options,
                                                               RenderStatistics& stats) {
     const RenderPlan plan = plan_photon_passes(*scene.scene, *scene.lights,
-                                               {render_settings.photon_tracing.global_photons, render_settings.photon_tracing.caustic_photons},
+                                               {render_settings.photon_tracing.global_photons, render_settings.photon_tracing.caustic_photons,
+                                                render_settings.photon_tracing.volume_photons},
                                                scene.lights_with_sky_peaks.get());
     stats.plan = plan.decisions;
     const PhotonTracingSettings settings = photon_settings(render_settings, plan, options);
-    if (settings.global_photons == 0 && settings.caustic_photons == 0) {
+    if (settings.global_photons == 0 && settings.caustic_photons == 0 && settings.volume_photons == 0) {
         stats.photons = PhotonTracingStatistics{};
         return std::make_shared<const PhotonMaps>();
     }
@@ -302,6 +303,10 @@ std::vector<std::string> incomplete_photon_map_warnings(const PhotonTracingStati
         incomplete("global", photons.stored_global, settings.global_photons, photons.emitted_global,
                    "most photons leave the scene or land on nothing, so indirect light is noisy. Aim the lights "
                    "at the geometry or close the scene");
+    if (settings.volume_photons > 0 && !photons.volume_complete)
+        incomplete("volume", photons.stored_volume, settings.volume_photons, photons.emitted_volume,
+                   "few photons scatter in the atmosphere before they leave it, so its light scattered more than "
+                   "once is noisy. Thicken the atmosphere (sigma_s) or lower photons.volume");
     return warnings;
 }
 
@@ -310,6 +315,7 @@ PhotonTracingSettings photon_settings(const protocol::RenderSettings& render_set
     PhotonTracingSettings settings = render_settings.photon_tracing;
     if (!plan.global_map) settings.global_photons = 0;
     if (!plan.caustic_map) settings.caustic_photons = 0;
+    if (!plan.volume_map) settings.volume_photons = 0;  // and the key stays that of a clear scene
     settings.threads = options.threads;
     settings.cancel = options.callbacks.cancel;
     return settings;

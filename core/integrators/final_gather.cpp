@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "core/integrators/direct.h"
+#include "core/integrators/volume_radiance.h"
 
 namespace photond {
 
@@ -80,7 +81,28 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
                     const GlossyOrigin* from = nullptr) const {
             const std::optional<Hit> hit = trace_ray(rs, r, counters);
             if (first_distance) *first_distance = hit ? hit->t : std::numeric_limits<float>::infinity();
-            if (!hit) {
+            std::optional<SurfaceInteraction> hit_point;
+            if (hit) hit_point = make_interaction(*rs.scene, *hit, r.direction);
+            // The atmosphere on the way: what lies beyond is seen through it, and it adds all the
+            // light it scatters towards the ray (the volume map, first events included).
+            Color fog(1.0f), in_scattered(0.0f);
+            if (const std::optional<HomogeneousMedium>& atmosphere = rs.scene->atmosphere) {
+                const MediumSpan span = atmosphere_span(*rs.scene, r, hit_point ? &*hit_point : nullptr);
+                if (!span.empty()) {
+                    fog = atmosphere->transmittance(span.t1 - span.t0);
+                    if (g.maps_->volume && atmosphere->scatters()) {
+                        SampleContext context{rng, counters};
+                        in_scattered = volume_in_scattering(*g.maps_->volume, *atmosphere, &rs.scene->bounds, r, span, g.settings_.k_volume,
+                                                            g.settings_.max_radius, 0, 1, context);
+                    }
+                }
+            }
+            return in_scattered + fog * from_surface(r, hit_point ? &*hit_point : nullptr, depth, first, glossy_bounces, from);
+        }
+        /// What the ray's hit sends back (null: it left the scene), before the atmosphere.
+        Color from_surface(const Ray& r, const SurfaceInteraction* hit_point, int depth, bool first,
+                           int glossy_bounces, const GlossyOrigin* from) const {
+            if (!hit_point) {
                 // After a glossy lobe, the whole sky and soft suns, weighted against the light
                 // samples taken where the lobe was sampled.
                 if (from) return rs.lights->escaped_radiance(r.direction, from->pdf);
@@ -89,10 +111,16 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
                 if (g.settings_.gather_diffuse_sky && rs.diffuse_sky) return rs.diffuse_sky->radiance(r.direction);
                 return Color(0.0f);
             }
-            const SurfaceInteraction si = make_interaction(*rs.scene, *hit, r.direction);
+            const SurfaceInteraction& si = *hit_point;
             const Vec3 wo = -r.direction;
             if (first && emission) {
-                emission->radiance = volume_transmittance(*rs.scene, si) * rs.lights->emitted_radiance(si, wo);
+                // Through the atmosphere too (its transmittance before the hit).
+                const Color fog = rs.scene->atmosphere
+                                      ? rs.scene->atmosphere->transmittance(
+                                            [&] { const MediumSpan s = atmosphere_span(*rs.scene, r, &si);
+                                                  return s.empty() ? 0.0f : s.t1 - s.t0; }())
+                                      : Color(1.0f);
+                emission->radiance = fog * volume_transmittance(*rs.scene, si) * rs.lights->emitted_radiance(si, wo);
                 emission->triangle = si.triangle;
                 emission->point = si.p;
             }

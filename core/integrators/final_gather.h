@@ -27,6 +27,7 @@ struct GatherSettings {
     /// heuristic) before it reads the photon maps with the lobe; 0 reads them at once.
     int max_glossy_bounces = 2;
     uint32_t k_global = 50;      // photons per radiance estimate where no precomputed irradiance fits
+    uint32_t k_volume = 200;     // photons per volume-map estimate of the atmosphere's in-scattered light
     float max_radius = 0.0f;     // estimate radius cap (world units)
     /// Gather rays that leave the scene, straight away or through ideal specular surfaces, see
     /// the environment's diffuse sky (RenderScene::diffuse_sky), which light sampling and the

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "core/integrators/direct.h"
+#include "core/integrators/volume_radiance.h"
 #include "core/integrators/render_cache_store.h"
 #include "core/util/sha256.h"
 
@@ -33,6 +34,9 @@ PhotonMapIntegrator::PhotonMapIntegrator(std::shared_ptr<const RenderScene> scen
     if (settings_.final_gather && maps_->global) {
         GatherSettings gather = settings_.gather;
         gather.k_global = settings_.k_global;
+        // Each gather ray's in-scattered light is averaged with the other rays' (hundreds a
+        // record): fewer photons an estimate, as at normal-mapped gather hits.
+        gather.k_volume = std::min(settings_.k_volume, kGatherVolumePhotons);
         gather.max_radius = global_options_.max_radius;
         gather.gather_diffuse_sky = scene_->lights_with_sky_peaks != nullptr;
         gatherer_ = std::make_unique<FinalGatherer>(scene_, maps_, gather);
@@ -148,6 +152,8 @@ std::string PhotonMapIntegrator::render_cache_key(const std::string& photon_map_
     hasher.update_value(int32_t(gather.max_specular_depth));
     hasher.update_value(int32_t(gather.max_glossy_bounces));
     hasher.update_value(uint32_t(gather.k_global));
+    // Gather rays read the atmosphere's volume map (keys of scenes without one stay as they were).
+    if (scene_->scene->atmosphere) hasher.update_value(uint32_t(gather.k_volume));
     hash_float(gather.max_radius);
     hasher.update_value(uint8_t(gather.gather_diffuse_sky));
     // Glossy gather hits sample lights (final_gather.cpp): how they pick them changes the records.
@@ -201,15 +207,40 @@ RadianceParts PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, flo
                                                   RayFootprint footprint, SampleContext& context) const {
     const RenderScene& rs = *scene_;
     const std::optional<Hit> hit = trace_ray(rs, ray, context.counters);
+    std::optional<SurfaceInteraction> hit_point;
+    // The camera's ray cone, widened along ideal specular bounces, picks the texture level.
+    if (hit) hit_point = make_interaction(*rs.scene, *hit, ray.direction, footprint.at(path_length + hit->t));
+    RadianceParts radiance = surface_radiance(ray, hit_point ? &*hit_point : nullptr, depth, path_length, footprint, context);
+    const std::optional<HomogeneousMedium>& atmosphere = rs.scene->atmosphere;
+    if (!atmosphere) return radiance;
+    // The atmosphere on the way: what lies beyond is seen through it; it sends the light it
+    // scatters once from the lights (single_scattering) and the light it scattered before
+    // (the volume map without its first events).
+    const MediumSpan span = atmosphere_span(*rs.scene, ray, hit_point ? &*hit_point : nullptr);
+    if (span.empty()) return radiance;
+    radiance = atmosphere->transmittance(span.t1 - span.t0) * radiance;
+    if (!atmosphere->scatters()) return radiance;
+    radiance.add_direct(single_scattering(rs, *atmosphere, ray, span, context));
+    if (maps_->volume)
+        // One point: the light scattered more than once varies slowly along the ray, and a
+        // pixel's samples spread their points over it.
+        radiance.add_indirect(volume_in_scattering(*maps_->volume, *atmosphere, &rs.scene->bounds, ray, span, settings_.k_volume,
+                                                   global_options_.max_radius, photon_flags::kDirect, 1, context));
+    return radiance;
+}
+
+RadianceParts PhotonMapIntegrator::surface_radiance(const Ray& ray, const SurfaceInteraction* hit_point, int depth,
+                                                    float path_length, RayFootprint footprint,
+                                                    SampleContext& context) const {
+    const RenderScene& rs = *scene_;
     // A camera ray or a delta bounce that leaves the scene sees the sky whole.
     RadianceParts radiance;
-    if (!hit) {
+    if (!hit_point) {
         radiance.add_emission(rs.lights->escaped_radiance(ray.direction, 0.0f));
         return radiance;
     }
-    const float length = path_length + hit->t;
-    // The camera's ray cone, widened along ideal specular bounces, picks the texture level.
-    const SurfaceInteraction si = make_interaction(*rs.scene, *hit, ray.direction, footprint.at(length));
+    const SurfaceInteraction& si = *hit_point;
+    const float length = path_length + si.distance;
     const Vec3 wo = -ray.direction;
     radiance.add_emission(rs.lights->emitted_radiance(si, wo));
     const Bsdf bsdf = make_bsdf(rs, si, wo);

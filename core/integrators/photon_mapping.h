@@ -24,6 +24,7 @@ namespace photond {
 struct PhotonMapIntegratorSettings {
     uint32_t k_global = 50;
     uint32_t k_caustic = 100;
+    uint32_t k_volume = 200;  // photons per volume-map estimate of the atmosphere's in-scattered light
     float max_radius_global = 0.0f;   // world units; 0 = kDefaultGlobalRadiusShare of the scene
     float max_radius_caustic = 0.0f;  // world units; 0 = kDefaultCausticRadiusShare of the scene
     int max_specular_depth = 16;
@@ -37,6 +38,9 @@ struct PhotonMapIntegratorSettings {
 /// Bump when the irradiance cache's prepass or gathering changes what it stores for the same
 /// inputs: every cached render cache then misses.
 inline constexpr uint32_t kRenderCacheAlgorithmVersion = 2;  // 2: the light tree (LightSelection)
+
+/// Nearest volume photons per estimate of the in-scattered light along a gather ray, at most.
+inline constexpr uint32_t kGatherVolumePhotons = 32;
 
 /// Nearest photons per estimate in the progressive preview's integrator (make_preview), at most.
 inline constexpr uint32_t kPreviewPhotons = 16;
@@ -90,6 +94,9 @@ public:
 private:
     RadianceParts radiance_along(const Ray& ray, int depth, float path_length, RayFootprint footprint,
                                  SampleContext& context) const;
+    /// What the ray's hit sends back (null: it left the scene), before the atmosphere on its way.
+    RadianceParts surface_radiance(const Ray& ray, const SurfaceInteraction* hit_point, int depth, float path_length,
+                                   RayFootprint footprint, SampleContext& context) const;
     Color indirect_irradiance(const DiffusePoint& point, SampleContext& context) const;
     bool caustic_may_show(const Vec3& p, const Vec3& normal, const Bsdf& bsdf, const Vec3& wo, float other) const;
 

@@ -1,5 +1,7 @@
 #include "core/photon/photon_map.h"
 
+#include <algorithm>
+
 namespace photond {
 
 namespace {
@@ -105,7 +107,7 @@ Color PhotonMap::estimate_irradiance(const Vec3& p, const Vec3& normal, uint32_t
 }
 
 Color PhotonMap::estimate_in_scattering(const Vec3& x, const Vec3& wo, float g, uint32_t k, float max_radius,
-                                        uint8_t exclude_flags) const {
+                                        uint8_t exclude_flags, const Bounds3* medium_bounds) const {
     if (tree_.empty()) return Color(0.0f);
     KnnResult& found = thread_scratch();
     max_radius = max_radius > 0.0f ? max_radius : std::numeric_limits<float>::infinity();
@@ -118,7 +120,21 @@ Color PhotonMap::estimate_in_scattering(const Vec3& x, const Vec3& wo, float g, 
         if (photon.user_flags() & exclude_flags) continue;
         sum += static_cast<double>(henyey_greenstein(g, wo, -photon.direction())) * DVec3(photon.flux());
     }
-    const double volume = 4.0 / 3.0 * kPiDouble * radius2 * std::sqrt(radius2);
+    const double r = std::sqrt(radius2);
+    double volume = 4.0 / 3.0 * kPiDouble * radius2 * r;
+    if (medium_bounds && !medium_bounds->empty()) {
+        // Each face the sphere crosses cuts off a cap of height h: pi h^2 (3 r - h) / 3 (caps of
+        // two faces overlap only near the box's edges, which the floor below covers).
+        double outside = 0.0;
+        for (int axis = 0; axis < 3; ++axis) {
+            for (const double gap : {static_cast<double>(x[axis] - medium_bounds->lower[axis]),
+                                     static_cast<double>(medium_bounds->upper[axis] - x[axis])}) {
+                const double h = std::clamp(r - gap, 0.0, 2.0 * r);
+                outside += kPiDouble * h * h * (3.0 * r - h) / 3.0;
+            }
+        }
+        volume = std::max(volume - outside, 0.125 * volume);
+    }
     return Color(sum / volume);
 }
 

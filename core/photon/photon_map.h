@@ -96,9 +96,11 @@ public:
     /// flux (stored with the event's albedo), over the volume (4/3) pi r^3 of the sphere they
     /// fill. Photons with any of exclude_flags are skipped (photon_flags::kDirect: the single
     /// scattering a ray march takes by light samples). Zero with fewer than
-    /// kMinPhotonsPerEstimate photons.
+    /// kMinPhotonsPerEstimate photons. With `medium_bounds` (the box the medium fills), the
+    /// sphere's caps beyond its faces are left out of the volume: no photon can lie there, and a
+    /// whole sphere would darken the medium along the box's walls.
     Color estimate_in_scattering(const Vec3& x, const Vec3& wo, float g, uint32_t k, float max_radius,
-                                 uint8_t exclude_flags = 0) const;
+                                 uint8_t exclude_flags = 0, const Bounds3* medium_bounds = nullptr) const;
 
     /// Precomputed irradiance (Christensen 1999, "Faster photon map global illumination"): in a
     /// map whose photons hold irradiance (flux) and surface normal (normal, or direction for

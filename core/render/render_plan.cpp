@@ -69,6 +69,20 @@ RenderPlan plan_photon_passes(const Scene& scene, const LightSet& lights, const 
     } else {
         plan.global_map = decide("global_map", true, "diffuse surfaces reflect light: indirect illumination");
     }
+    // The volume map: listed only for a scene with an atmosphere.
+    if (scene.atmosphere) {
+        if (!scene.atmosphere->scatters()) {
+            plan.volume_map = decide("volume_map", false, "the atmosphere only absorbs: its transmittance is exact");
+        } else if (request.volume_photons == 0) {
+            plan.volume_map = decide("volume_map", false,
+                                     "the job asks for 0 volume photons: the atmosphere's light scattered more than "
+                                     "once, and all its light that gather rays cross, are left out");
+        } else {
+            plan.volume_map = decide("volume_map", true,
+                                     "the atmosphere scatters light: its multiple scattering, and what gather rays "
+                                     "cross");
+        }
+    }
     return plan;
 }
 

@@ -20,6 +20,7 @@ struct PassDecision {
 struct RenderPlan {
     bool caustic_map = false;
     bool global_map = false;
+    bool volume_map = false;
     std::vector<PassDecision> decisions;
 
     const PassDecision* find(std::string_view pass) const;
@@ -39,6 +40,7 @@ SceneLightPaths analyse_light_paths(const Scene& scene, const LightSet& lights);
 struct PhotonPassRequest {
     uint32_t global_photons = 0;
     uint32_t caustic_photons = 0;
+    uint32_t volume_photons = 0;
 };
 
 /// The plan of the photon-map integrator for a scene and the photon counts a job asks for.

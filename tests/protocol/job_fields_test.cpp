@@ -105,6 +105,8 @@ const std::map<std::string, json>& changed_values() {
         {"photons.caustic", 0},
         {"photons.k_global", 80},
         {"photons.k_caustic", 9},
+        {"photons.volume", 7777},
+        {"photons.k_volume", 64},
         {"photons.seed", 77},
         {"gather.rays", 100},
         {"irradiance_cache.enabled", false},
@@ -131,9 +133,9 @@ const std::map<std::string, json>& changed_values() {
 }
 
 /// What else a field's changed value needs to be valid: the final preset's photon-map integrator
-/// refuses an atmosphere and media in materials.
+/// refuses media in materials (it renders an atmosphere).
 json companions_of(std::string_view path) {
-    if (path == "atmosphere" || path == "material_media") return {{"integrator", "path"}};
+    if (path == "material_media") return {{"integrator", "path"}};
     return json::object();
 }
 
@@ -215,11 +217,10 @@ TEST(JobFields, KeysComeFromTheTable) {
     for (const JobFieldGroup& group : job_field_groups()) EXPECT_FALSE(job_field_keys(group.name).empty()) << group.name;
     const std::vector<std::string_view> photons = job_field_keys("photons");
     EXPECT_EQ(std::vector<std::string>(photons.begin(), photons.end()),
-              (std::vector<std::string>{"global", "caustic", "k_global", "k_caustic", "seed"}));
+              (std::vector<std::string>{"global", "caustic", "k_global", "k_caustic", "volume", "k_volume", "seed"}));
 }
 
-/// The atmosphere's schema says what its reader accepts (the integrator aside, a rule across
-/// fields that the schema does not state).
+/// The atmosphere's schema says what its reader accepts.
 TEST(JobFields, AtmosphereSchemaAgreesWithTheReader) {
     const json schema = job_json_schema();
     const std::vector<json> atmospheres{

@@ -89,6 +89,8 @@ TEST(JobPresets, FinalIsTheDefaultPresetWithItsValues) {
     EXPECT_EQ(job.photons.caustic, 50000u);
     EXPECT_EQ(job.photons.k_global, 50u);
     EXPECT_EQ(job.photons.k_caustic, 100u);
+    EXPECT_EQ(job.photons.volume, 400000u);
+    EXPECT_EQ(job.photons.k_volume, 200u);
     EXPECT_EQ(job.photons.seed, 1u);
     EXPECT_EQ(job.gather.rays, 256u);
     EXPECT_TRUE(job.irradiance_cache.enabled);
@@ -110,6 +112,8 @@ TEST(JobPresets, PreviewIsCheaper) {
     EXPECT_EQ(job.image.spp, 4);
     EXPECT_EQ(job.photons.global, 50000u);
     EXPECT_EQ(job.photons.caustic, 25000u);
+    EXPECT_EQ(job.photons.volume, 100000u);
+    EXPECT_EQ(job.photons.k_volume, 100u);
     EXPECT_EQ(job.gather.rays, 128u);
     EXPECT_DOUBLE_EQ(job.irradiance_cache.a, 0.35);
 }
@@ -159,7 +163,13 @@ Job full_job() {
                           .spp = 7,
                           .region = std::array<int, 4>{10, 20, 630, 350}};
     job.integrator = "path";
-    job.photons = PhotonSpec{123, 456, 9, 999, 0xfedcba9876543210ull};
+    job.photons = PhotonSpec{.global = 123,
+                             .caustic = 456,
+                             .k_global = 9,
+                             .k_caustic = 999,
+                             .volume = 50'000'000,
+                             .k_volume = 17,
+                             .seed = 0xfedcba9876543210ull};
     job.gather.rays = 333;
     job.irradiance_cache = IrradianceCacheSpec{false, 0.1234567890123, false, 0.1, 1024.0, "rc1-" + std::string(64, 'e')};
     job.output = OutputSpec{"float", {"depth", "direct", "normal"}, -2.5};
@@ -466,7 +476,7 @@ TEST(JobValidation, ImageRegionLiesInsideTheImageWithPositiveSize) {
 // ------------------------------------------------------------------ photons, gather, cache
 
 TEST(JobValidation, PhotonCountLimits) {
-    for (std::string_view field : {"global", "caustic"}) {
+    for (std::string_view field : {"global", "caustic", "volume"}) {
         std::string path = "photons." + std::string(field);
         EXPECT_TRUE(rejects(job_with({path + "=50000001"}), path, "[0, 50000000]"));
         EXPECT_TRUE(rejects(job_with({path + "=-1"}), path, "[0, 50000000]"));
@@ -476,7 +486,7 @@ TEST(JobValidation, PhotonCountLimits) {
 }
 
 TEST(JobValidation, PhotonNeighbourCountLimits) {
-    for (std::string_view field : {"k_global", "k_caustic"}) {
+    for (std::string_view field : {"k_global", "k_caustic", "k_volume"}) {
         std::string path = "photons." + std::string(field);
         EXPECT_TRUE(rejects(job_with({path + "=7"}), path, "[8, 1000]"));
         EXPECT_TRUE(rejects(job_with({path + "=1001"}), path, "[8, 1000]"));
@@ -829,7 +839,6 @@ TEST(JobSchema, NumericBoundsAgreeWithTheValidator) {
             json document = base_job();
             if (field == "environment.rotation_deg") document["environment"]["image"] = "sky.exr";
             if (field.starts_with("atmosphere.")) {
-                document["integrator"] = "path";          // photon-map refuses an atmosphere
                 document["atmosphere"]["sigma_s"] = 0.1;  // one coefficient is required
             }
             if (field.starts_with("material_media.")) {
@@ -1081,31 +1090,40 @@ TEST(JobAtmosphere, RefusesWhatCannotBeRightByName) {
     }
 }
 
-TEST(JobAtmosphere, PhotonMapRefusesItPathAndDirectRenderIt) {
-    const std::string refusal =
-        "atmosphere: integrator \"photon-map\" does not render participating media yet (its volume photon map is "
-        "not built); use \"path\" (the reference) or \"direct\" (single scattering)";
-    // The default preset "final" (and "preview") integrate with photon-map.
-    EXPECT_TRUE(rejects(with_atmosphere({{"sigma_s", 0.1}}, ""), "atmosphere", refusal));
+TEST(JobAtmosphere, EveryIntegratorRendersIt) {
+    // The default preset "final" (and "preview") integrate with photon-map, which renders the
+    // atmosphere with its volume photon map.
+    const Job final_job = parsed(with_atmosphere({{"sigma_s", 0.1}}, ""));
+    EXPECT_EQ(final_job.integrator, "photon-map");
+    ASSERT_TRUE(final_job.atmosphere);
+    EXPECT_EQ(final_job.atmosphere->sigma_s, (std::array<double, 3>{0.1, 0.1, 0.1}));
+    EXPECT_EQ(final_job.photons.volume, 400000u);
+    EXPECT_EQ(final_job.photons.k_volume, 200u);
     json preview = with_atmosphere({{"sigma_s", 0.1}}, "");
     preview["preset"] = "preview";
-    EXPECT_TRUE(rejects(preview, "atmosphere", refusal));
-    EXPECT_TRUE(rejects(with_atmosphere({{"sigma_s", 0.1}}, "photon-map"), "atmosphere", refusal));
-    // Even a medium of zero coefficients: the document asked for one.
-    EXPECT_TRUE(rejects(with_atmosphere({{"sigma_s", 0}}, "photon-map"), "atmosphere", refusal));
-    // Each field's own error comes first: the cross-field rule judges a job whose fields are valid.
+    EXPECT_TRUE(accepts(preview));
+    // Even a medium of zero coefficients: nothing to refuse.
+    EXPECT_TRUE(accepts(with_atmosphere({{"sigma_s", 0}}, "photon-map")));
+    // The atmosphere's own errors still name its fields.
     EXPECT_TRUE(rejects(with_atmosphere({{"sigma_s", -1}}, ""), "atmosphere.sigma_s", "must be in"));
 
-    for (std::string_view integrator : {"path", "direct"}) {
+    for (std::string_view integrator : {"photon-map", "path", "direct"}) {
         const Job job = parsed(with_atmosphere({{"sigma_s", 0.1}}, integrator));
         EXPECT_EQ(job.integrator, integrator);
         ASSERT_TRUE(job.atmosphere) << integrator;
         EXPECT_EQ(job.atmosphere->sigma_s, (std::array<double, 3>{0.1, 0.1, 0.1}));
     }
-    // "reference" integrates with path: nothing else to name.
+    // "reference" integrates with path.
     json reference = with_atmosphere({{"sigma_a", 0.05}}, "");
     reference["preset"] = "reference";
     EXPECT_TRUE(accepts(reference));
+    // The volume map's fields travel with the atmosphere and survive the round trip.
+    json tuned = with_atmosphere({{"sigma_s", 0.1}}, "photon-map");
+    tuned["photons"] = {{"volume", 12345}, {"k_volume", 64}};
+    const Job job = parsed(tuned);
+    EXPECT_EQ(job.photons.volume, 12345u);
+    EXPECT_EQ(job.photons.k_volume, 64u);
+    EXPECT_EQ(parsed(to_json(job)), job);
 }
 
 TEST(JobSchema, DescribesTheAtmosphere) {
@@ -1294,8 +1312,8 @@ TEST(JobMaterialMedia, RefusesWhatCannotBeRightByName) {
 TEST(JobMaterialMedia, PhotonMapAndDirectRefuseItPathRendersIt) {
     const json glass = {{"glass", {{"sigma_s", 0.1}}}};
     const std::string photon_map_refusal =
-        "material_media: integrator \"photon-map\" does not render participating media yet (its volume photon map is "
-        "not built); use \"path\" (the reference)";
+        "material_media: integrator \"photon-map\" does not render media inside solids yet (its volume photon map holds "
+        "the atmosphere's light only); use \"path\" (the reference)";
     const std::string direct_refusal =
         "material_media: integrator \"direct\" renders no light scattered inside solids (their surfaces block its "
         "light samples); use \"path\" (the reference)";
@@ -1318,12 +1336,12 @@ TEST(JobMaterialMedia, PhotonMapAndDirectRefuseItPathRendersIt) {
     // Each field's own error comes first: the cross-field rule judges a job whose fields are valid.
     EXPECT_TRUE(rejects(with_material_media({{"glass", {{"sigma_s", -1}}}}, ""), "material_media.glass.sigma_s",
                         "must be in"));
-    // The atmosphere's rule comes first; "direct" renders an atmosphere but not these media.
+    // With an atmosphere too, which both render: the refusal is the media's.
     json both = with_material_media(glass, "direct");
     both["atmosphere"] = {{"sigma_s", 0.1}};
     EXPECT_TRUE(rejects(both, "material_media", direct_refusal));
     both["integrator"] = "photon-map";
-    EXPECT_TRUE(rejects(both, "atmosphere", "photon-map"));
+    EXPECT_TRUE(rejects(both, "material_media", photon_map_refusal));
 
     const Job job = parsed(with_material_media(glass, "path"));
     EXPECT_EQ(job.integrator, "path");

@@ -377,19 +377,16 @@ TEST_F(DaemonErrors, LightingThatCannotWorkIsRefusedAtSubmission) {
     }
 }
 
-TEST_F(DaemonErrors, MediaRenderWithPathAndAreRefusedByNameWhereTheyCannot) {
+TEST_F(DaemonErrors, MediaRenderAndAreRefusedByNameWhereTheyCannot) {
     Daemon daemon(dir_.path() / "cache");
     ASSERT_TRUE(daemon.started()) << daemon.log();
     const HttpClient client = daemon.client();
     const json fog = {{"sigma_a", 0.02}, {"sigma_s", {0.2, 0.3, 0.4}}, {"g", 0.4}};
-    // photon-map has no volume photon map yet: a 422 that names the field and what to use.
-    expect_problem(client,
-                   client.post("/v1/jobs", with(with(kSmallJob, "/integrator", "photon-map"), "/atmosphere", fog).dump()),
-                   422, "atmosphere", "\"path\"");
     expect_problem(client, client.post("/v1/jobs", with(kSmallJob, "/atmosphere", {{"sigma_s", -1}}).dump()), 422,
                    "atmosphere.sigma_s", "[0, 1e+06]");
-    // path and direct render it, and the plan says where it is and how dense.
-    for (const std::string integrator : {"path", "direct"}) {
+    // Every integrator renders it, and the plan says where it is and how dense (and photon-map
+    // that it traces a volume map).
+    for (const std::string integrator : {"path", "direct", "photon-map"}) {
         const HttpResponse accepted =
             client.post("/v1/jobs", with(with(kSmallJob, "/integrator", integrator), "/atmosphere", fog).dump());
         ASSERT_EQ(accepted.status, 202) << accepted.body;
@@ -397,7 +394,14 @@ TEST_F(DaemonErrors, MediaRenderWithPathAndAreRefusedByNameWhereTheyCannot) {
         ASSERT_EQ(done.at("state"), "done") << done.dump();
         EXPECT_NE(done.dump().find("\"atmosphere\""), std::string::npos) << done.dump();
         EXPECT_NE(done.dump().find("optical depth"), std::string::npos) << done.dump();
+        if (integrator == "photon-map")
+            EXPECT_NE(done.dump().find("\"volume_map\""), std::string::npos) << done.dump();
     }
+    // photon-map does not render a medium inside solids: a 422 that names the field.
+    expect_problem(client,
+                   client.post("/v1/jobs", with(with(kSmallJob, "/integrator", "photon-map"), "/material_media",
+                                                {{"glass", {{"sigma_s", 3.0}}}}).dump()),
+                   422, "material_media", "\"path\"");
     // A medium inside the box's glass sphere (material "glass"): path renders it; a material the
     // scene lacks is refused at submission, naming the entry and the materials there are.
     const json path_job = with(kSmallJob, "/integrator", "path");

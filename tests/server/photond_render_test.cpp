@@ -540,3 +540,24 @@ TEST_F(PhotondRender, QuadLightOfTheJobIsVisibleGeometryAlsoOnNormalMappedScenes
 }
 
 }  // namespace
+
+TEST_F(PhotondRender, FoggyBoxWithAVolumePhotonMapAgreesWithPath) {
+    // The atmosphere through the photon-map integrator (a volume photon map for its multiple
+    // scattering and the gather rays, light samples for its single scattering) against path
+    // tracing, whose fog is free flights and light samples at every scattering event.
+    const std::string common = "render builtin:cornell-box-diffuse --width 32 --height 32 --set output.pixel_type=float "
+                               "--set 'atmosphere={\"sigma_a\": 0.05, \"sigma_s\": 0.5, \"g\": 0.3}' ";
+    const auto path = run(common + "--integrator path --spp 1024 -o " + (dir_ / "path.exr").string());
+    ASSERT_EQ(path.exit_code, 0) << path.output;
+    const auto map = run(common + "-o " + (dir_ / "map.exr").string() + " --stats-json " + (dir_ / "s.json").string());
+    ASSERT_EQ(map.exit_code, 0) << map.output;
+    const auto stats = nlohmann::json::parse(read_file(dir_ / "s.json"));
+    EXPECT_EQ(stats.at("photons").at("stored_volume"), 400000) << stats.dump();
+    EXPECT_NE(map.output.find("volume_map"), std::string::npos) << map.output;
+    const auto compared = run("compare --json " + (dir_ / "map.exr").string() + " " + (dir_ / "path.exr").string());
+    ASSERT_EQ(compared.exit_code, 0) << compared.output;
+    const auto c = nlohmann::json::parse(compared.output);
+    const double bias = c.at("mean").get<double>() / c.at("reference_mean").get<double>() - 1.0;
+    std::printf("photon-map against path in the foggy box: mean %+.2f %%\n", 100.0 * bias);
+    EXPECT_LT(std::abs(bias), 0.04);
+}

@@ -1,0 +1,22 @@
+// The atmosphere's in-scattered light from the volume photon map along a ray segment (Jensen &
+// Christensen 1998): the photon-map integrator's camera rays take the multiple scattering from
+// it (their single scattering from light samples, single_scattering), its gather rays all of it.
+#pragma once
+
+#include "core/integrators/integrator.h"
+#include "core/photon/photon_map.h"
+
+namespace photond {
+
+/// The light `volume`'s photons say `medium` scatters towards the ray's origin over `span` of
+/// the ray (unit direction): `points` distances stratified in the transmittance truncated to the
+/// span (sample_distance_in_segment, one channel for all, two draws from `context`), each the
+/// map's in-scattered source there (PhotonMap::estimate_in_scattering with k photons, radius
+/// capped at max_radius, photons with exclude_flags left out, the sphere clipped to
+/// medium_bounds) times the transmittance to it.
+/// Not attenuated by what lies before the span: the caller's throughput holds that.
+Color volume_in_scattering(const PhotonMap& volume, const HomogeneousMedium& medium, const Bounds3* medium_bounds,
+                           const Ray& ray, const MediumSpan& span, uint32_t k, float max_radius, uint8_t exclude_flags,
+                           int points, SampleContext& context);
+
+}  // namespace photond
