@@ -90,21 +90,13 @@ Color sample_direct_light_in_medium(const RenderScene& rs, const HomogeneousMedi
 
 Color single_scattering(const RenderScene& rs, const HomogeneousMedium& medium, const Ray& ray, const MediumSpan& span,
                         SampleContext& context) {
-    const float length = span.t1 - span.t0;
-    // One channel for all the points (by the first draw), the points stratified in the
-    // truncated transmittance's inverse CDF: a narrow beam (a sun through a window) is crossed
-    // by some point of most rays instead of by the one point of a few.
-    const float u_channel = context.next_1d();
-    const float u_jitter = context.next_1d();
+    // Points stratified along the ray: a narrow beam (a sun through a window) is crossed by some
+    // point of most rays instead of by the one point of a few.
     Color sum(0.0f);
-    for (int k = 0; k < kSingleScatteringPoints; ++k) {
-        const float u = (static_cast<float>(k) + u_jitter) / static_cast<float>(kSingleScatteringPoints);
-        const SegmentDistance d = sample_distance_in_segment(medium, length, u_channel, u);
-        if (!(d.pdf > 0.0f)) continue;
-        const Vec3 x = ray.origin + (span.t0 + d.t) * ray.direction;
-        sum += medium.transmittance(d.t) / d.pdf * sample_direct_light_in_medium(rs, medium, x, -ray.direction, context, false);
-    }
-    return medium.sigma_s * sum / static_cast<float>(kSingleScatteringPoints);
+    march_through_medium(medium, ray, span, kSingleScatteringPoints, context, [&](const Vec3& x, const Color& weight) {
+        sum += weight * sample_direct_light_in_medium(rs, medium, x, -ray.direction, context, false);
+    });
+    return medium.sigma_s * sum;
 }
 
 }  // namespace photond

@@ -135,6 +135,25 @@ Color sample_direct_light(const RenderScene& rs, const LightSet& lights, const S
 /// against phase-function sampling. The caller's throughput carries the transmittance up to x.
 Color sample_direct_light_in_medium(const RenderScene& rs, const HomogeneousMedium& medium, const Vec3& x,
                                     const Vec3& wo, SampleContext& context, bool use_mis);
+/// Calls f(x, weight) at `points` distances along `span` of the ray (unit direction), stratified
+/// in the transmittance truncated to the span (sample_distance_in_segment, one channel for all,
+/// two draws from `context`), weight = T(t) / (pdf(t) points): sums of weight times a quantity
+/// at x estimate the quantity's integral along the span, attenuated from the span's start.
+template <typename F>
+void march_through_medium(const HomogeneousMedium& medium, const Ray& ray, const MediumSpan& span, int points,
+                          SampleContext& context, F&& f) {
+    const float length = span.t1 - span.t0;
+    const float u_channel = context.next_1d();
+    const float u_jitter = context.next_1d();
+    for (int i = 0; i < points; ++i) {
+        const float u = (static_cast<float>(i) + u_jitter) / static_cast<float>(points);
+        const SegmentDistance d = sample_distance_in_segment(medium, length, u_channel, u);
+        if (!(d.pdf > 0.0f)) continue;
+        f(ray.origin + (span.t0 + d.t) * ray.direction,
+          medium.transmittance(d.t) / (d.pdf * static_cast<float>(points)));
+    }
+}
+
 /// Points along a ray segment at which single_scattering samples the light.
 inline constexpr int kSingleScatteringPoints = 4;
 /// The light `medium` scatters once towards the ray's origin over `span` of the ray (unit

@@ -159,6 +159,22 @@ TEST(Atmosphere, NonAbsorbingFogUnderAUniformSkyKeepsItsRadiance) {
     }
 }
 
+/// A smooth glass sphere of radius 0.5 at the origin whose solid scatters (optical depths 1, 2.5
+/// and 6 across, g 0.5) and absorbs nothing, in a scene of its own.
+Scene scattering_glass_sphere(float ior) {
+    SceneBuilder builder("scattering-solid");
+    Material glass;
+    glass.base_color = Color(1.0f);
+    glass.metallic = 0.0f;
+    glass.roughness = 0.0f;
+    glass.transmission = 1.0f;
+    glass.ior = ior;
+    glass.scattering = Color(1.0f, 2.5f, 6.0f);
+    glass.phase_g = 0.5f;
+    EXPECT_TRUE(add_mesh(builder, make_icosphere(Vec3(0.0f), 0.5f, 4), builder.add_material(glass)).is_ok());
+    return builder.build().value();
+}
+
 TEST(Atmosphere, AScatteringSolidUnderAUniformSkyKeepsItsRadiance) {
     // The furnace inside glass: a smooth transmissive sphere whose solid scatters and absorbs
     // nothing (Material::scattering, a job's material_media), under a sky of radiance 1, passes
@@ -166,17 +182,7 @@ TEST(Atmosphere, AScatteringSolidUnderAUniformSkyKeepsItsRadiance) {
     // reflection and total internal reflection) or not (ior 1). Its inside is reached by light
     // only through the surface (light samples from inside are blocked by it).
     for (const float ior : {1.0f, 1.5f}) {
-        SceneBuilder builder("scattering-solid");
-        Material glass;
-        glass.base_color = Color(1.0f);
-        glass.metallic = 0.0f;
-        glass.roughness = 0.0f;
-        glass.transmission = 1.0f;
-        glass.ior = ior;
-        glass.scattering = Color(1.0f, 2.5f, 6.0f);
-        glass.phase_g = 0.5f;
-        ASSERT_TRUE(add_mesh(builder, make_icosphere(Vec3(0.0f), 0.5f, 4), builder.add_material(glass)).is_ok());
-        Scene scene = builder.build().value();
+        Scene scene = scattering_glass_sphere(ior);
         scene.environment = Environment{};
         const auto rs = make_render_scene(std::move(scene));
         ASSERT_TRUE(rs->scattering_interiors);
@@ -191,17 +197,7 @@ TEST(Atmosphere, AScatteringSolidUnderAUniformSkyKeepsItsRadiance) {
     // surface invisible) seen from straight above would show the black below if its inside did
     // not scatter: it sends back some of the light from above, the densest channel (blue,
     // optical depth 6 across) the most.
-    SceneBuilder builder("scattering-solid");
-    Material clear_glass;
-    clear_glass.base_color = Color(1.0f);
-    clear_glass.metallic = 0.0f;
-    clear_glass.roughness = 0.0f;
-    clear_glass.transmission = 1.0f;
-    clear_glass.ior = 1.0f;
-    clear_glass.scattering = Color(1.0f, 2.5f, 6.0f);
-    clear_glass.phase_g = 0.5f;
-    ASSERT_TRUE(add_mesh(builder, make_icosphere(Vec3(0.0f), 0.5f, 4), builder.add_material(clear_glass)).is_ok());
-    Scene scene = builder.build().value();
+    Scene scene = scattering_glass_sphere(1.0f);
     Environment half_sky;
     half_sky.name = "half";
     half_sky.width = 4;
