@@ -560,4 +560,15 @@ TEST_F(PhotondRender, FoggyBoxWithAVolumePhotonMapAgreesWithPath) {
     const double bias = c.at("mean").get<double>() / c.at("reference_mean").get<double>() - 1.0;
     std::printf("photon-map against path in the foggy box: mean %+.2f %%\n", 100.0 * bias);
     EXPECT_LT(std::abs(bias), 0.04);
+    // The same bytes for 1, 2 and 7 threads (photons, the volume map, the cache, the tiles).
+    const std::string small = common + "--width 24 --height 16 --set photons.volume=20000 --set photons.global=20000 ";
+    std::string first;
+    for (const int threads : {1, 2, 7}) {
+        const fs::path out = dir_ / ("t" + std::to_string(threads) + ".exr");
+        const auto r = run(small + "--threads " + std::to_string(threads) + " -o " + out.string());
+        ASSERT_EQ(r.exit_code, 0) << r.output;
+        if (threads == 1) first = read_file(out);
+        else EXPECT_EQ(read_file(out), first) << threads << " threads";
+    }
+    EXPECT_FALSE(first.empty());
 }
