@@ -97,6 +97,7 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
                     }
                 }
             }
+            if (first && emission) emission->in_scattered = in_scattered;
             return in_scattered + fog * from_surface(r, hit_point ? &*hit_point : nullptr, depth, first, glossy_bounces, from);
         }
         /// What the ray's hit sends back (null: it left the scene), before the atmosphere.

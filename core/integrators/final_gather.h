@@ -80,6 +80,9 @@ public:
         Color radiance{0.0f};  // emitted towards the ray's origin; zero when nothing emits
         uint32_t triangle = 0;
         Vec3 point{0.0f};
+        /// The atmosphere's light scattered towards the ray's origin along it (part of what
+        /// gather_ray_radiance returns; zero without an atmosphere).
+        Color in_scattered{0.0f};
     };
     Color gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& counters, float* distance,
                               FirstHitEmission* emission = nullptr) const;

@@ -284,7 +284,7 @@ RadianceParts PhotonMapIntegrator::surface_radiance(const Ray& ray, const Surfac
                         const Ray shadow{rs.tracer->offset_origin(si.p, si.geometric_normal, wi), wi};
                         if (!rs.tracer->occluded(shadow)) {
                             const float weight = power_heuristic(pdf, rays * bsdf.pdf(wo, wi, glossy_lobes));
-                            radiance.add_direct(f * sky->radiance(wi) *
+                            radiance.add_direct(f * sky->radiance(wi) * atmosphere_transmittance(*rs.scene, shadow) *
                                                 (std::abs(glm::dot(wi, si.shading_normal)) * weight / pdf));
                         }
                     }
@@ -301,10 +301,12 @@ RadianceParts PhotonMapIntegrator::surface_radiance(const Ray& ray, const Surfac
                     FinalGatherer::FirstHitEmission emitted;
                     Color gathered = gatherer_->gather_ray_radiance(spawn_ray(rs, si, s->wi), context.rng,
                                                                     context.counters, &distance, &emitted);
-                    // A ray that left the scene at once saw the diffuse sky alone: weighted against
-                    // the sky's light sample above.
+                    // A ray that left the scene at once saw the diffuse sky (weighted against the
+                    // sky's light sample above) and the fog's light on the way (not weighted: the
+                    // light sample finds none of it).
                     if (sky && !std::isfinite(distance) && s->kind != LobeKind::Delta)
-                        gathered *= power_heuristic(rays * s->pdf, sky->pdf(s->wi));
+                        gathered = emitted.in_scattered +
+                                   (gathered - emitted.in_scattered) * power_heuristic(rays * s->pdf, sky->pdf(s->wi));
                     sum += s->weight * gathered;
                     (std::isfinite(distance) ? sum_indirect : sum_direct) += s->weight * gathered;
                     if (!is_black(emitted.radiance) && s->kind != LobeKind::Delta) {

@@ -72,6 +72,7 @@ SegmentDistance sample_distance_in_segment(const HomogeneousMedium& medium, floa
 }
 
 float henyey_greenstein(float g, const Vec3& wo, const Vec3& wi) {
+    if (std::abs(g) < kIsotropicG) return 1.0f / (4.0f * kPi);  // as sample_henyey_greenstein draws it
     const float cos_theta = -glm::dot(wi, wo);
     const float denominator = 1.0f + g * g - 2.0f * g * cos_theta;
     return (1.0f - g * g) / (4.0f * kPi * denominator * std::sqrt(std::max(denominator, 1e-12f)));

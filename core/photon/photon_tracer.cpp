@@ -126,7 +126,7 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
     const EmissionFocus* focus = !whole_paths && rs.caustic_casters ? &rs.caustic_focus : nullptr;
     const std::optional<EmissionSample> emission = lights.sample_emission(u_select, u_position, u_direction, focus);
     if (!emission || is_black(emission->flux_weight)) return;
-    if (want_caustic && want_global && sky_gathered && lights.kind(emission->light) == LightKind::Environment) {
+    if (want_caustic && whole_paths && sky_gathered && lights.kind(emission->light) == LightKind::Environment) {
         const EnvironmentLight* peaks = rs.lights_with_sky_peaks->environment();
         if (!peaks || is_black(peaks->radiance(-emission->direction))) want_caustic = false;
     }

@@ -113,7 +113,9 @@ struct Material {
     }
     bool has_volume() const { return max_component(attenuation) > 0.0f || interior_scatters(); }
     /// Light scatters inside its solid: a path samples free flights there (path.cpp) instead of
-    /// the Beer-Lambert factor of volume_transmittance.
+    /// the Beer-Lambert factor of volume_transmittance. Only `path` renders such a solid (a job's
+    /// material_media; the protocol refuses it for the other integrators, which take only its
+    /// absorption).
     bool interior_scatters() const { return transmission > 0.0f && max_component(scattering) > 0.0f; }
     /// The medium inside its solid: absorption `attenuation`, scattering, asymmetry.
     HomogeneousMedium interior_medium() const { return {attenuation, scattering, phase_g}; }
