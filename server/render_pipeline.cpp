@@ -2,6 +2,7 @@
 
 #include <tbb/info.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <set>
@@ -116,31 +117,20 @@ PassDecision atmosphere_decision(const Scene& scene) {
                 ", outside transmissive solids; optical depth " + format_number(depth) + " across them"};
 }
 
-/// The job's material_media applied to the scene's materials of those names (every one of a
-/// name: glTF names need not be unique); `applied` (when given) receives one line per entry for
-/// the plan. The error names the entry: no material of that name, or one that is not
-/// transmissive (its surface closes no medium).
-std::optional<protocol::FieldError> apply_material_media(const protocol::Job& job, Scene& scene,
-                                                         std::string* applied = nullptr) {
+/// What the job's material_media cannot apply to `scene`, naming the entry: no material of
+/// that name, or one that is not transmissive (its surface closes no medium).
+std::optional<protocol::FieldError> material_media_problem(const protocol::Job& job, const Scene& scene) {
     for (const auto& [name, spec] : job.material_media) {
         const std::string path = "material_media." + name;
-        size_t found = 0;
-        for (Material& m : scene.materials) {
+        bool found = false;
+        for (const Material& m : scene.materials) {
             if (m.name != name) continue;
             if (!(m.transmission > 0.0f))
                 return protocol::FieldError{path, "material '" + name + "' is not transmissive (no "
                                                   "KHR_materials_transmission): its surface closes no medium"};
-            m.scattering = to_vec3(spec.sigma_s);
-            m.phase_g = static_cast<float>(spec.g);
-            if (spec.sigma_a) m.attenuation = to_vec3(*spec.sigma_a);
-            ++found;
-            if (applied && found == 1)
-                *applied += std::string(applied->empty() ? "" : "; ") + "'" + name + "': sigma_a " +
-                            describe_colour({m.attenuation.x, m.attenuation.y, m.attenuation.z}) + " (" +
-                            (spec.sigma_a ? "the job's" : "the file's") + "), sigma_s " + describe_colour(spec.sigma_s) +
-                            ", g " + format_number(spec.g);
+            found = true;
         }
-        if (found == 0) {
+        if (!found) {
             std::set<std::string> names;
             std::string transmissive;
             for (const Material& m : scene.materials)
@@ -151,6 +141,28 @@ std::optional<protocol::FieldError> apply_material_media(const protocol::Job& jo
         }
     }
     return std::nullopt;
+}
+
+/// The job's material_media (material_media_problem found none) given to the scene's materials
+/// of those names (every one of a name: glTF names need not be unique). Returns the plan's
+/// account of it, one entry per name; empty without entries.
+std::string apply_material_media(const protocol::Job& job, Scene& scene) {
+    std::string applied;
+    for (const auto& [name, spec] : job.material_media) {
+        for (Material& m : scene.materials) {
+            if (m.name != name) continue;
+            m.scattering = to_vec3(spec.sigma_s);
+            m.phase_g = static_cast<float>(spec.g);
+            if (spec.sigma_a) m.attenuation = to_vec3(*spec.sigma_a);
+        }
+        const auto m = std::find_if(scene.materials.begin(), scene.materials.end(),
+                                    [&](const Material& material) { return material.name == name; });
+        applied += std::string(applied.empty() ? "" : "; ") + "'" + name + "': sigma_a " +
+                   describe_colour({m->attenuation.x, m->attenuation.y, m->attenuation.z}) + " (" +
+                   (spec.sigma_a ? "the job's" : "the file's") + "), sigma_s " + describe_colour(spec.sigma_s) +
+                   ", g " + format_number(spec.g);
+    }
+    return applied;
 }
 
 /// Plans the photon pass of a photon-map job and gets its maps: from the store when one is
@@ -452,8 +464,7 @@ std::optional<protocol::FieldError> check_job_media(const protocol::Job& job, co
     if (job.material_media.empty()) return std::nullopt;
     auto scene = load_job_scene(job.scene, options);
     if (!scene) return std::nullopt;  // the render says what is wrong with the scene itself
-    Scene copy = **scene;
-    return apply_material_media(job, copy);
+    return material_media_problem(job, **scene);
 }
 
 std::optional<protocol::FieldError> check_job_lighting(const protocol::Job& job, const PipelineOptions& options) {
@@ -523,13 +534,14 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     auto lighting = job_lighting(job, **scene, options, &environment_decision);
     if (!lighting) return lighting.error();
     std::shared_ptr<const Scene> lit_scene = *scene;
+    if (const auto error = material_media_problem(job, **scene)) return Error{protocol::describe(*error)};
     std::string media_applied;
     if (!lighting->empty() || job.atmosphere || !job.material_media.empty()) {
         auto lit = with_added_lighting(**scene, *lighting);
         if (!lit) return lit.error();
         // The atmosphere fills the bounds grown by the job's lights too.
         if (job.atmosphere) lit->atmosphere = atmosphere_medium(*job.atmosphere);
-        if (const auto error = apply_material_media(job, *lit, &media_applied)) return Error{protocol::describe(*error)};
+        media_applied = apply_material_media(job, *lit);
         lit_scene = std::make_shared<const Scene>(std::move(lit).value());
     }
     stats.lighting.job_lights = job.lights.size();

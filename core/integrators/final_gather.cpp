@@ -97,8 +97,12 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
                     }
                 }
             }
-            if (first && emission) emission->in_scattered = in_scattered;
-            return in_scattered + fog * from_surface(r, hit_point ? &*hit_point : nullptr, depth, first, glossy_bounces, from);
+            const Color beyond = from_surface(r, hit_point ? &*hit_point : nullptr, depth, first, glossy_bounces, from);
+            if (first && emission) {
+                emission->radiance *= fog;  // the emitter is seen through the atmosphere too
+                emission->in_scattered = in_scattered;
+            }
+            return in_scattered + fog * beyond;
         }
         /// What the ray's hit sends back (null: it left the scene), before the atmosphere.
         Color from_surface(const Ray& r, const SurfaceInteraction* hit_point, int depth, bool first,
@@ -115,13 +119,7 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
             const SurfaceInteraction& si = *hit_point;
             const Vec3 wo = -r.direction;
             if (first && emission) {
-                // Through the atmosphere too (its transmittance before the hit).
-                const Color fog = rs.scene->atmosphere
-                                      ? rs.scene->atmosphere->transmittance(
-                                            [&] { const MediumSpan s = atmosphere_span(*rs.scene, r, &si);
-                                                  return s.empty() ? 0.0f : s.t1 - s.t0; }())
-                                      : Color(1.0f);
-                emission->radiance = fog * volume_transmittance(*rs.scene, si) * rs.lights->emitted_radiance(si, wo);
+                emission->radiance = volume_transmittance(*rs.scene, si) * rs.lights->emitted_radiance(si, wo);
                 emission->triangle = si.triangle;
                 emission->point = si.p;
             }

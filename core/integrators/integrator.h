@@ -128,7 +128,14 @@ inline Ray primary_ray(const CameraRay& ray) {
 Color sample_direct_light(const RenderScene& rs, const LightSet& lights, const SurfaceInteraction& si,
                           const Bsdf& bsdf, const Vec3& wo, SampleContext& context, bool use_mis,
                           LobeMask mask = kAllLobes, LobeMask mis_lobes = 0, float mis_samples = 1.0f);
-/// Next-event estimation at a point x inside `medium` (the atmosphere) seen from wo: one light
+/// The same with the scene's lights.
+inline Color sample_direct_light(const RenderScene& rs, const SurfaceInteraction& si, const Bsdf& bsdf,
+                                 const Vec3& wo, SampleContext& context, bool use_mis,
+                                 LobeMask mask = kAllLobes) {
+    return sample_direct_light(rs, *rs.lights, si, bsdf, wo, context, use_mis, mask);
+}
+
+/// Next-event estimation at a point x inside `medium` (the atmosphere, or a solid's) seen from wo: one light
 /// sample times the phase function and the atmosphere's transmittance to the light (the
 /// radiance scattered towards wo per unit of scattering coefficient: the caller's weight holds
 /// sigma_s). With `use_mis`, area lights are weighted by the power heuristic
@@ -163,11 +170,5 @@ inline constexpr int kSingleScatteringPoints = 4;
 /// before it: the caller's throughput holds that.
 Color single_scattering(const RenderScene& rs, const HomogeneousMedium& medium, const Ray& ray, const MediumSpan& span,
                         SampleContext& context);
-/// The same with the scene's lights.
-inline Color sample_direct_light(const RenderScene& rs, const SurfaceInteraction& si, const Bsdf& bsdf,
-                                 const Vec3& wo, SampleContext& context, bool use_mis,
-                                 LobeMask mask = kAllLobes) {
-    return sample_direct_light(rs, *rs.lights, si, bsdf, wo, context, use_mis, mask);
-}
 
 }  // namespace photond

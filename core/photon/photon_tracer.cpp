@@ -146,6 +146,15 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
     const int hero = atmosphere ? std::min(2, static_cast<int>(rng.next_float() * 3.0f)) : 0;
     Color spectral(1.0f);
     const auto stored_flux = [&](const Color& f) { return atmosphere ? f / average(spectral) : f; };
+    // Russian roulette after an event that takes the photon's flux to `next`: survive with the
+    // ratio of what it would store then to `stored_before` (what it stored before the event),
+    // so that surviving photons keep about the same flux.
+    const auto survives = [&](const Color& next, const Color& stored_before) {
+        const float survive = std::min(1.0f, max_component(stored_flux(next)) / max_component(stored_before));
+        if (!(survive > 0.0f) || rng.next_float() >= survive) return false;
+        flux = next * (1.0f / survive);
+        return is_finite(flux);
+    };
 
     for (int bounce = 0; bounce < settings.max_bounces; ++bounce) {
         ++out.rays;
@@ -159,24 +168,20 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
             } else if (!span.empty()) {
                 const FreeFlight flight = sample_free_flight(*atmosphere, span.t1 - span.t0, hero, rng.next_float());
                 const Color before = stored_flux(flux);
-                flux *= flight.weight;
                 spectral *= flight.pdf_ratio;
-                if (flight.scattered) {
+                if (!flight.scattered) {
+                    flux *= flight.weight;
+                } else {
                     // A scattering event: the photon is stored with the flux it scatters
-                    // (estimate_in_scattering), then goes on by the phase function, surviving
-                    // Russian roulette with the ratio of its flux to what it arrived with.
+                    // (estimate_in_scattering), then goes on by the phase function.
                     const Vec3 x = ray.origin + (span.t0 + flight.t) * ray.direction;
-                    const Color scattered = stored_flux(flux);
+                    const Color next = flux * flight.weight;
                     if (want_volume)
-                        out.volume.push_back({make_photon(x, ray.direction, scattered,
+                        out.volume.push_back({make_photon(x, ray.direction, stored_flux(next),
                                                           bounce == 0 ? photon_flags::kDirect : uint8_t(0)),
                                               path_in_batch});
                     diffuse_seen = true;
-                    if (!whole_paths) return;
-                    const float survive = std::min(1.0f, max_component(scattered) / max_component(before));
-                    if (!(survive > 0.0f) || rng.next_float() >= survive) return;
-                    flux *= 1.0f / survive;
-                    if (!is_finite(flux)) return;
+                    if (!whole_paths || !survives(next, before)) return;
                     ray = Ray{x, sample_henyey_greenstein(atmosphere->g, -ray.direction, rng.next_vec2())};
                     continue;
                 }
@@ -213,13 +218,8 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
         } else {
             ++specular_bounces;
         }
-        // Russian roulette on the reflectivity of the chosen component: survive with the ratio of
-        // the new flux to the old, so that surviving photons keep about the same flux.
-        const Color next_flux = flux * s->weight;
-        const float survive = std::min(1.0f, max_component(next_flux) / max_component(flux));
-        if (!(survive > 0.0f) || rng.next_float() >= survive) return;
-        flux = next_flux * (1.0f / survive);
-        if (!is_finite(flux)) return;
+        // Russian roulette on the reflectivity of the chosen component.
+        if (!survives(flux * s->weight, stored_flux(flux))) return;
         ray = spawn_ray(rs, si, s->wi);
     }
 }

@@ -222,9 +222,11 @@ Status Scene::validate() const {
                              "' uses a texture out of range"};
         }
         if (!is_finite(m.base_color) || !is_finite(m.emission) || !std::isfinite(m.ior) ||
-            !std::isfinite(m.roughness) || !std::isfinite(m.metallic) || !is_finite(m.scattering) ||
-            min_component(m.scattering) < 0.0f || !(std::abs(m.phase_g) < 1.0f))
+            !std::isfinite(m.roughness) || !std::isfinite(m.metallic))
             return Error{"scene '" + name + "': material '" + m.name + "' has a non-finite factor"};
+        if (!is_finite(m.scattering) || min_component(m.scattering) < 0.0f || !(std::abs(m.phase_g) < 1.0f))
+            return Error{"scene '" + name + "': material '" + m.name +
+                         "' has a negative or non-finite scattering coefficient, or an asymmetry g outside (-1, 1)"};
     }
     for (const PunctualLight& l : lights) {
         if (!is_finite(l.position) || !is_finite(l.direction) || !is_finite(l.intensity))

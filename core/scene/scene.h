@@ -111,7 +111,7 @@ struct Material {
         return metallic_roughness_texture.present() || clearcoat_texture.present() ||
                clearcoat_roughness_texture.present();
     }
-    bool has_volume() const { return max_component(attenuation) > 0.0f || interior_scatters(); }
+    bool has_volume() const { return max_component(attenuation) > 0.0f; }
     /// Light scatters inside its solid: a path samples free flights there (path.cpp) instead of
     /// the Beer-Lambert factor of volume_transmittance. Only `path` renders such a solid (a job's
     /// material_media; the protocol refuses it for the other integrators, which take only its
