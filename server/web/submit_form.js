@@ -54,7 +54,6 @@ function number(text) {
 export class SubmitForm {
   constructor(onSubmitted) {
     this.onSubmitted = onSubmitted;
-    this.loaded = false;
     $("submit-form").addEventListener("submit", (event) => {
       event.preventDefault();
       this.submit();
@@ -64,40 +63,48 @@ export class SubmitForm {
     });
   }
 
-  /// Fills the choices (once per page load; the uploaded scenes on every visit).
+  async loadSchema() {
+    const openapi = await apiJson("/v1/openapi.json");
+    this.schema = openapi.components.schemas.Job;
+    const presets = this.schema.properties.preset;
+    $("preset-select").replaceChildren(...presets.enum.map((name) => option(name, name)));
+    $("preset-select").value = presets.default;
+    $("integrator-select").append(...this.schema.properties.integrator.enum.map((name) => option(name, name)));
+    const aovs = this.schema.properties.output.properties.aovs.items.enum;
+    $("aov-choices").replaceChildren(
+      ...aovs.map((name) => {
+        const label = document.createElement("label");
+        const box = document.createElement("input");
+        box.type = "checkbox";
+        box.value = name;
+        box.name = "aov";
+        label.append(box, ` ${name}`);
+        return label;
+      }));
+  }
+
+  /// Fills the choices (once per page load; the uploaded scenes on every visit). Visits may
+  /// overlap: the schema's choices are built by one load alone, so a choice made meanwhile stays.
   async load() {
-    if (!this.loaded) {
-      const openapi = await apiJson("/v1/openapi.json");
-      this.schema = openapi.components.schemas.Job;
-      this.loaded = true;
-      const presets = this.schema.properties.preset;
-      $("preset-select").replaceChildren(...presets.enum.map((name) => option(name, name)));
-      $("preset-select").value = presets.default;
-      $("integrator-select").append(...this.schema.properties.integrator.enum.map((name) => option(name, name)));
-      const aovs = this.schema.properties.output.properties.aovs.items.enum;
-      $("aov-choices").replaceChildren(
-        ...aovs.map((name) => {
-          const label = document.createElement("label");
-          const box = document.createElement("input");
-          box.type = "checkbox";
-          box.value = name;
-          box.name = "aov";
-          label.append(box, ` ${name}`);
-          return label;
-        }));
+    this.schemaLoaded ??= this.loadSchema();
+    try {
+      await this.schemaLoaded;
+    } catch (error) {
+      this.schemaLoaded = undefined;  // the next visit asks again
+      throw error;
     }
     const builtin = this.schema.properties.scene.oneOf
       .map((form) => form.properties.builtin)
       .find(Boolean);
     const { scenes } = await apiJson("/v1/scenes");
     const select = $("scene-select");
-    const kept = select.value;
     const builtins = optgroup("Built-in");
     for (const name of builtin.examples || []) option(`builtin:${name}`, name, builtins);
     const uploaded = optgroup("Uploaded");
     for (const scene of scenes) option(`id:${scene.id}`, `${scene.name || "scene"} (${scene.id.slice(0, 19)}…)`, uploaded);
     const other = optgroup("Other");
     option("path:", "a file under --scene-root…", other);
+    const kept = select.value;  // read after the fetch: a choice made while it ran stays
     select.replaceChildren(builtins, ...(scenes.length ? [uploaded] : []), other);
     if ([...select.options].some((o) => o.value === kept)) select.value = kept;
     $("scene-path-label").hidden = select.value !== "path:";

@@ -167,7 +167,10 @@ async function submitForm(page, fields) {
     set("look-from", f.from);
     set("look-at", f.at);
     set("vfov", f.vfov);
-    for (const box of document.querySelectorAll("#aov-choices input")) box.checked = (f.aovs || []).includes(box.value);
+    const boxes = [...document.querySelectorAll("#aov-choices input")];
+    for (const box of boxes) box.checked = (f.aovs || []).includes(box.value);
+    const missing = (f.aovs || []).filter((name) => !boxes.some((box) => box.value === name));
+    if (missing.length) throw new Error(`the form offers no AOV ${missing.join(", ")}`);
   }, fields);
   await page.click("#submit-button");
 }

@@ -316,7 +316,9 @@ double median(const json& values) {
 
 TEST(WebPage, InChromium) {
     if (const std::string missing = missing_browser_tools(); !missing.empty()) GTEST_SKIP() << missing;
-    const json r = run_browser("short");
+    // Not const: a key the script did not write reads as null (operator[] on a const json is
+    // undefined behaviour for a missing key).
+    json r = run_browser("short");
     ASSERT_TRUE(r.is_object());
     EXPECT_TRUE(r["errors"].empty()) << r["errors"].dump(2);
 
@@ -327,7 +329,7 @@ TEST(WebPage, InChromium) {
     EXPECT_EQ(r.value("token_in_session_storage", ""), kToken);
 
     // The job with its own exposure: the canvas, made of its 10 x 8 tiles alone, is preview.png.
-    const json& fixed = r["fixed_exposure"];
+    json& fixed = r["fixed_exposure"];
     EXPECT_EQ(fixed["canvas"], json({320, 240}));
     EXPECT_EQ(fixed["shown"], json({320, 240}));  // small frames are shown as they are
     EXPECT_EQ(fixed["differing_pixels"], 0) << fixed.dump(2);
@@ -343,12 +345,13 @@ TEST(WebPage, InChromium) {
     EXPECT_EQ(fixed["texts"]["downloads"],
               json({"image.exr (beauty, albedo, normal)", "albedo.exr", "normal.exr", "preview.png"}));
     for (const char* download : {"image.exr", "albedo.exr"}) {
-        EXPECT_GT(r["downloads"][download].value("bytes", 0), 1000) << download;
-        EXPECT_TRUE(r["downloads"][download].value("exr_magic", false)) << download;
+        const json file = r.value("downloads", json::object()).value(download, json::object());
+        EXPECT_GT(file.value("bytes", 0), 1000) << download;
+        EXPECT_TRUE(file.value("exr_magic", false)) << download;
     }
 
     // Automatic exposure: the canvas ends as preview.png too.
-    const json& automatic = r["automatic_exposure"];
+    json& automatic = r["automatic_exposure"];
     EXPECT_EQ(automatic["differing_pixels"], 0) << automatic.dump(2);
     EXPECT_TRUE(automatic["tile_errors"].empty()) << automatic["tile_errors"];
 
@@ -365,7 +368,7 @@ TEST(WebPage, InChromium) {
 
     // The goals (README.md, "The web page").
     const double first_paint = median(r["first_paint_ms"]);
-    const json& latency = fixed["latency_ms"];
+    json& latency = fixed["latency_ms"];
     const double peak_mb = r["memory_peak"].value("pss_mb", 1e9);
     std::cout << "first paint (ms, 5 loads of the page): " << r["first_paint_ms"] << ", median " << first_paint
               << "\ntile latency, event to canvas (ms), job of 80 tiles: " << latency
@@ -382,7 +385,7 @@ TEST(WebPage, DISABLED_LargeJobInChromium) {
     const char* size_text = std::getenv("PHOTOND_WEB_LARGE_SIZE");
     const int size = size_text ? std::atoi(size_text) : 4096;
     if (const std::string missing = missing_browser_tools(); !missing.empty()) GTEST_SKIP() << missing;
-    const json r = run_browser("large", {{"large_size", size}});
+    json r = run_browser("large", {{"large_size", size}});
     ASSERT_TRUE(r.is_object());
     EXPECT_TRUE(r["errors"].empty()) << r["errors"].dump(2);
     const json& large = r["large"];
