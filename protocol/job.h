@@ -54,6 +54,9 @@ inline constexpr IntegerRange kGatherRays{1, 16384};
 inline constexpr NumberRange kCacheAccuracy{0.0, 1.0, true, false};
 // Record spacing in pixels (Tabellion & Lamorlette 2004); also min_spacing_px <= max_spacing_px.
 inline constexpr NumberRange kCacheSpacingPx{0.0, 1024.0, true, false};
+// Bands of a radiance record's hemispherical-harmonic basis (core/math/hemispherical_harmonics.h).
+inline constexpr IntegerRange kRadianceOrder{3, 16};
+inline constexpr IntegerRange kRadianceSamples{1, 256};
 inline constexpr IntegerRange kPriority{0, 100};
 // Stops of exposure of the PNG preview (2^30: about 1e9, from moonlight to the sun's disc).
 inline constexpr NumberRange kExposureEv{-30.0, 30.0};
@@ -168,6 +171,14 @@ struct IrradianceCacheSpec {
     bool operator==(const IrradianceCacheSpec&) const = default;
 };
 
+struct RadianceCacheSpec {
+    bool enabled = false;
+    int64_t max_order = 0;
+    int64_t samples = 0;
+
+    bool operator==(const RadianceCacheSpec&) const = default;
+};
+
 struct LightSamplingSpec {
     std::string selection;  // one of kLightSelectionNames
 
@@ -271,6 +282,7 @@ struct Job {
     PhotonSpec photons;
     GatherSpec gather;
     IrradianceCacheSpec irradiance_cache;
+    RadianceCacheSpec radiance_cache;
     LightSamplingSpec light_sampling;
     OutputSpec output;
     EnvironmentSpec environment;

@@ -809,6 +809,18 @@ std::vector<JobField> make_job_fields() {
                       },
                       .schema = render_cache_key_schema()});
 
+    fields.push_back(bool_field(JOB_MEMBER(radiance_cache.enabled),
+                                "glossy lobes read cached incident radiance in hemispherical harmonics "
+                                "(Krivanek et al. 2005) instead of BSDF-sampled rays; photon-map with final "
+                                "gathering",
+                                {"false", "false", "false"}));
+    fields.push_back(integer_field(JOB_MEMBER(radiance_cache.max_order), limits::kRadianceOrder,
+                                   "most bands of a radiance record; glossy lobes that need more are BSDF-sampled",
+                                   {"10", "10", "12"}));
+    fields.push_back(integer_field(JOB_MEMBER(radiance_cache.samples), limits::kRadianceSamples,
+                                   "lobe samples of the cached incident radiance per glossy point",
+                                   {"4", "8", "16"}));
+
     // The tree costs little with few lights and wins by far with many (README.md, "Large
     // scenes"); power stays selectable to measure against.
     fields.push_back(choice_field(JOB_MEMBER(light_sampling.selection), kLightSelectionNames,
@@ -881,11 +893,12 @@ std::vector<JobField> make_job_fields() {
 
 #undef JOB_MEMBER
 
-constexpr std::array<JobFieldGroup, 6> kGroups{{
+constexpr std::array<JobFieldGroup, 7> kGroups{{
     {"image", "the image"},
     {"photons", "photon maps (photon-map integrator)"},
     {"gather", "final gathering"},
     {"irradiance_cache", "the irradiance cache of the final gather"},
+    {"radiance_cache", "the radiance cache of glossy lobes"},
     {"light_sampling", "next-event estimation's choice of light"},
     {"output", "the OpenEXR output and its PNG preview"},
 }};

@@ -27,6 +27,9 @@ RenderSettings to_render_settings(const Job& job) {
     cache.min_spacing_px = static_cast<float>(job.irradiance_cache.min_spacing_px);
     cache.max_spacing_px = static_cast<float>(job.irradiance_cache.max_spacing_px);
     cache.seed = job.seed;
+    photon_map.radiance_cache.enabled = job.radiance_cache.enabled;
+    photon_map.radiance_cache.max_order = static_cast<int>(job.radiance_cache.max_order);
+    photon_map.radiance_cache.samples = static_cast<uint32_t>(job.radiance_cache.samples);
     // A region render builds the whole frame's irradiance cache: its pixels are then those of
     // the frame rendered at once, and regions rendered apart assemble without seams.
 

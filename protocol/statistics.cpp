@@ -73,6 +73,17 @@ nlohmann::json to_json(const RenderStatistics& s) {
             result["irradiance_cache"]["records_reused"] = c.records_reused;
         }
     }
+    if (s.radiance_cache) {
+        const auto& c = *s.radiance_cache;
+        result["radiance_cache"] = {
+            {"records", c.records},
+            {"waves", c.waves},
+            {"lookups", c.lookups},
+            {"misses", c.misses},
+            {"interpolated_share", c.interpolated_share()},
+            {"seconds", c.seconds},
+        };
+    }
     if (s.preview) {
         const auto& p = *s.preview;
         result["preview"] = {{"stride", p.stride}, {"samples", p.samples}, {"tiles", p.tiles}, {"seconds", p.seconds}};

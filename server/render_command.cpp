@@ -212,6 +212,12 @@ void print_statistics(const RenderStatistics& s) {
                      100.0 * s.irradiance_cache->interpolated_share(),
                      static_cast<unsigned long long>(s.irradiance_cache->lookups));
     }
+    if (s.radiance_cache) {
+        std::fprintf(stderr, "  radiance cache: %llu records in %d waves, %.1f %% of %llu glossy points interpolated\n",
+                     static_cast<unsigned long long>(s.radiance_cache->records), s.radiance_cache->waves,
+                     100.0 * s.radiance_cache->interpolated_share(),
+                     static_cast<unsigned long long>(s.radiance_cache->lookups));
+    }
     std::fprintf(stderr, "  rays %llu + shadow rays %llu, %.2f Mrays/s\n",
                  static_cast<unsigned long long>(s.rays), static_cast<unsigned long long>(s.shadow_rays),
                  s.rays_per_second() * 1e-6);

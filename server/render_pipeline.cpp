@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <map>
 #include <set>
 
 #include "core/camera/camera.h"
@@ -115,6 +116,58 @@ PassDecision atmosphere_decision(const Scene& scene) {
                 " per unit, g " + format_number(medium.g) + ") filling the scene's bounds " +
                 color_text(scene.bounds.lower) + " to " + color_text(scene.bounds.upper) +
                 ", outside transmissive solids; optical depth " + format_number(depth) + " across them"};
+}
+
+/// The plan's line for the radiance cache of a photon-map job whose scene has a glossy lobe:
+/// which materials' lobes it holds (and in how many bands) and which take BSDF-sampled rays,
+/// and why. None for other integrators or scenes without a glossy lobe.
+std::optional<PassDecision> radiance_cache_decision(const protocol::RenderSettings& settings, const RenderScene& rs) {
+    if (settings.integrator != "photon-map") return std::nullopt;
+    const RadianceCacheSettings& cache = settings.photon_map.radiance_cache;
+    const Scene& scene = *rs.scene;
+    std::vector<bool> used(scene.materials.size(), false);
+    for (uint32_t t = 0; t < scene.triangles.size(); ++t) used[scene.triangle_materials[t]] = true;
+    // Material names grouped by what becomes of their glossy lobes, in the scene's order.
+    std::map<std::string, std::vector<std::string>> groups;
+    std::vector<std::string> order;
+    bool any_cached = false;
+    for (size_t i = 0; i < scene.materials.size() && i < rs.bsdf_materials.size(); ++i) {
+        const BsdfMaterial& m = rs.bsdf_materials[i];
+        const float alpha = sharpest_reflection_alpha(m);
+        if (!used[i] || (!(alpha > 0.0f) && !transmits_non_delta(m))) continue;
+        std::string group;
+        if (transmits_non_delta(m)) {
+            group = "BSDF-sampled rays (rough transmission: a record sees one side)";
+        } else if (const int bands = radiance_order_for(m, cache); bands > 0) {
+            group = "cached in " + std::to_string(bands) + " bands";
+            any_cached = true;
+        } else if (const int needed = radiance_order_for(alpha); needed > kMaxHarmonicsOrder) {
+            group = "BSDF-sampled rays (sharper than " + std::to_string(kMaxHarmonicsOrder) + " bands resolve)";
+        } else {
+            group = "BSDF-sampled rays (" + std::to_string(needed) + " bands needed, max_order " +
+                    std::to_string(cache.max_order) + ")";
+        }
+        if (!groups.contains(group)) order.push_back(group);
+        groups[group].push_back("'" + scene.materials[i].name + "'");
+    }
+    if (order.empty()) return std::nullopt;
+    if (!cache.enabled)
+        return PassDecision{"radiance_cache", false,
+                            "the job leaves it off (radiance_cache.enabled): glossy lobes take BSDF-sampled rays"};
+    if (!settings.photon_map.final_gather) return PassDecision{"radiance_cache", false, "it needs final gathering"};
+    constexpr size_t kNamesShown = 4;
+    std::string account;
+    for (const std::string& group : order) {
+        const std::vector<std::string>& names = groups[group];
+        std::string list;
+        for (size_t k = 0; k < names.size() && k < kNamesShown; ++k) list += (k ? ", " : "") + names[k];
+        if (names.size() > kNamesShown) list += " and " + std::to_string(names.size() - kNamesShown) + " more";
+        account += (account.empty() ? "" : "; ") + group + ": " + list;
+    }
+    return PassDecision{"radiance_cache", any_cached,
+                        (any_cached ? "glossy lobes read incident radiance in hemispherical harmonics; "
+                                    : "no glossy lobe it can hold; ") +
+                            account};
 }
 
 /// What the job's material_media cannot apply to `scene`, naming the entry: no material of
@@ -580,6 +633,7 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     if (!media_applied.empty())
         stats.plan.insert(stats.plan.begin() + (lit_scene->atmosphere ? 2 : 1),
                           PassDecision{"material_media", true, "the solids of " + media_applied});
+    if (auto decision = radiance_cache_decision(settings, **render_scene)) stats.plan.push_back(std::move(*decision));
 
     Integrator& renderer = **integrator;
     // The preview needs the photon maps (a cache hit has them at once) and nothing the
@@ -618,6 +672,8 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
                                      .cancel = options.callbacks.cancel};
         auto prepared = renderer.prepare(context);
         if (!prepared) return prepared.error();
+        // The radiance cache is built in the same preparation, timed apart: the passes still sum.
+        const double radiance_seconds = prepared->radiance ? prepared->radiance->seconds : 0.0;
         if (prepared->built) {
             RenderStatistics::IrradianceCacheFigures figures;
             figures.records = prepared->records;
@@ -626,12 +682,20 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
             figures.cache = prepared->cache_outcome;
             figures.key = prepared->cache_key;
             figures.start_from = prepared->start_from;
-            figures.seconds = seconds_since(pass_start);
+            figures.seconds = seconds_since(pass_start) - radiance_seconds;
             stats.irradiance_cache = figures;
             stats.passes.push_back({std::string(preparation), figures.seconds});
-            stats.rays += prepared->counters.rays;
-            stats.shadow_rays += prepared->counters.shadow_rays;
         }
+        if (prepared->radiance) {
+            RenderStatistics::RadianceCacheFigures figures;
+            figures.records = prepared->radiance->records;
+            figures.waves = prepared->radiance->waves;
+            figures.seconds = prepared->built ? radiance_seconds : seconds_since(pass_start);
+            stats.radiance_cache = figures;
+            stats.passes.push_back({"radiance_cache", figures.seconds});
+        }
+        stats.rays += prepared->counters.rays;
+        stats.shadow_rays += prepared->counters.shadow_rays;
     }
 
     if (options.caches_only) {
@@ -653,6 +717,10 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     if (stats.irradiance_cache) {
         stats.irradiance_cache->lookups = rendered.counters.irradiance_lookups;
         stats.irradiance_cache->misses = rendered.counters.irradiance_misses;
+    }
+    if (stats.radiance_cache) {
+        stats.radiance_cache->lookups = rendered.counters.radiance_lookups;
+        stats.radiance_cache->misses = rendered.counters.radiance_misses;
     }
     stats.cancelled = rendered.cancelled;
     stats.tiles_restored = rendered.tiles_restored;

@@ -88,6 +88,7 @@ public:
                               FirstHitEmission* emission = nullptr) const;
 
     const GatherSettings& settings() const { return settings_; }
+    const RenderScene& scene() const { return *scene_; }
 
 private:
     std::shared_ptr<const RenderScene> scene_;

@@ -70,6 +70,13 @@ struct PrepareReport {
     uint64_t records_reused = 0;  // records taken from that cache
     int waves = 0;
     RayCounters counters;        // rays the preparation traced
+    /// The radiance cache, when one was built (its seconds are part of the preparation's).
+    struct RadianceCacheReport {
+        uint64_t records = 0;
+        int waves = 0;
+        double seconds = 0.0;
+    };
+    std::optional<RadianceCacheReport> radiance;
 };
 
 /// Computes the radiance arriving at the camera along a ray. Implementations are immutable

@@ -187,35 +187,27 @@ void IrradianceCache::for_each_on_path(const Vec3& p, F&& f) const {
     }
 }
 
-bool IrradianceCache::interpolate(const Vec3& p, const Vec3& n, Color* irradiance, float accuracy_scale) const {
-    if (records_.empty()) return false;
+double IrradianceCache::weight(const IrradianceRecord& r, const Vec3& p, const Vec3& n, float a) {
+    const Vec3 offset = p - r.position;
+    // Cheap rejections first: eps < a needs both |P - P_i| < a R_i and 1 - n.n_i < a^2.
+    const float reach = a * r.radius;
+    const float distance2 = glm::dot(offset, offset);
+    if (!(distance2 < reach * reach)) return 0.0;
+    const float cos_normals = std::min(1.0f, glm::dot(n, r.normal));
+    if (!(1.0f - cos_normals < a * a)) return 0.0;
+    const float epsilon = std::sqrt(distance2) / r.radius + safe_sqrt(1.0f - cos_normals);
+    if (!(epsilon < a)) return 0.0;
+    // In front of P: the record sees a different hemisphere (Ward et al. 1988).
+    if (glm::dot(offset, 0.5f * (n + r.normal)) < -kFrontTolerance * r.radius) return 0.0;
+    const double w = 1.0 / std::max(epsilon, kMinEpsilon) - 1.0 / a;
+    return w > 0.0 ? w : 0.0;
+}
+
+template <typename F>
+void IrradianceCache::for_each_weight(const Vec3& p, const Vec3& n, float accuracy_scale, F&& f) const {
     const float a = settings_.accuracy * accuracy_scale;
-    double weight_sum = 0.0;
-    DVec3 sum(0.0);
     const auto add = [&](uint32_t index) {
-        const IrradianceRecord& r = records_[index];
-        const Vec3 offset = p - r.position;
-        // Cheap rejections first: eps < a needs both |P - P_i| < a R_i and 1 - n.n_i < a^2.
-        const float reach = a * r.radius;
-        const float distance2 = glm::dot(offset, offset);
-        if (!(distance2 < reach * reach)) return;
-        const float cos_normals = std::min(1.0f, glm::dot(n, r.normal));
-        if (!(1.0f - cos_normals < a * a)) return;
-        const float epsilon = std::sqrt(distance2) / r.radius + safe_sqrt(1.0f - cos_normals);
-        if (!(epsilon < a)) return;
-        // In front of P: the record sees a different hemisphere (Ward et al. 1988).
-        if (glm::dot(offset, 0.5f * (n + r.normal)) < -kFrontTolerance * r.radius) return;
-        const double w = 1.0 / std::max(epsilon, kMinEpsilon) - 1.0 / a;
-        if (!(w > 0.0)) return;
-        Color e = r.irradiance;
-        if (settings_.gradients) {
-            const Vec3 axis = glm::cross(r.normal, n);
-            for (int c = 0; c < 3; ++c)
-                e[c] += glm::dot(axis, r.rotation_gradient[c]) + glm::dot(offset, r.translation_gradient[c]);
-        }
-        // Gradient extrapolation may not push a record's estimate below zero.
-        sum += w * DVec3(glm::max(e, Color(0.0f)));
-        weight_sum += w;
+        if (const double w = weight(records_[index], p, n, a); w > 0.0) f(index, w);
     };
     if (accuracy_scale <= 1.0f) {
         // Every record whose domain holds p is filed in the node on p's root-to-leaf path.
@@ -223,8 +215,41 @@ bool IrradianceCache::interpolate(const Vec3& p, const Vec3& n, Color* irradianc
     } else {
         for_each_unique_candidate(p, accuracy_scale, 0.0f, add);
     }
+}
+
+bool IrradianceCache::interpolate(const Vec3& p, const Vec3& n, Color* irradiance, float accuracy_scale) const {
+    if (records_.empty()) return false;
+    double weight_sum = 0.0;
+    DVec3 sum(0.0);
+    for_each_weight(p, n, accuracy_scale, [&](uint32_t index, double w) {
+        const IrradianceRecord& r = records_[index];
+        Color e = r.irradiance;
+        if (settings_.gradients) {
+            const Vec3 axis = glm::cross(r.normal, n);
+            const Vec3 offset = p - r.position;
+            for (int c = 0; c < 3; ++c)
+                e[c] += glm::dot(axis, r.rotation_gradient[c]) + glm::dot(offset, r.translation_gradient[c]);
+        }
+        // Gradient extrapolation may not push a record's estimate below zero.
+        sum += w * DVec3(glm::max(e, Color(0.0f)));
+        weight_sum += w;
+    });
     if (!(weight_sum > 0.0)) return false;
     *irradiance = Color(sum / weight_sum);
+    return true;
+}
+
+bool IrradianceCache::weigh_records(const Vec3& p, const Vec3& n, float accuracy_scale,
+                                    std::vector<RecordWeight>* out) const {
+    out->clear();
+    if (records_.empty()) return false;
+    double weight_sum = 0.0;
+    for_each_weight(p, n, accuracy_scale, [&](uint32_t index, double w) {
+        out->push_back({index, w});
+        weight_sum += w;
+    });
+    if (!(weight_sum > 0.0)) return false;
+    for (RecordWeight& r : *out) r.weight /= weight_sum;
     return true;
 }
 

@@ -82,6 +82,14 @@ public:
     /// `accuracy_scale` > 1 widens every record's domain (extrapolation, for points the
     /// prepass did not reach, e.g. sub-pixel positions at the edge of a record's domain).
     bool interpolate(const Vec3& p, const Vec3& n, Color* irradiance, float accuracy_scale = 1.0f) const;
+    /// The records interpolate would use at p and their weights, normalised to sum to 1; false
+    /// (and `out` empty) when none is usable. For caches whose records carry more than
+    /// irradiance (core/integrators/radiance_cache.h).
+    struct RecordWeight {
+        uint32_t index;
+        double weight;
+    };
+    bool weigh_records(const Vec3& p, const Vec3& n, float accuracy_scale, std::vector<RecordWeight>* out) const;
 
     /// Adds a record. Its radius is first clamped by its neighbours' (R_i <= R_j + |P_i - P_j|,
     /// and the neighbours' by it), never below `min_radius` (Krivanek et al. 2006). Its
@@ -133,6 +141,11 @@ private:
     void for_each_on_path(const Vec3& p, F&& f) const;
 
     int32_t child_for(int32_t node, const Vec3& p);
+    /// Record r's weight at p (normal n) for accuracy a: 1/eps - 1/a where usable, else 0.
+    static double weight(const IrradianceRecord& r, const Vec3& p, const Vec3& n, float a);
+    /// Calls f(record index, weight) for each record usable at p.
+    template <typename F>
+    void for_each_weight(const Vec3& p, const Vec3& n, float accuracy_scale, F&& f) const;
 
     IrradianceCacheSettings settings_;
     std::vector<IrradianceRecord> records_;

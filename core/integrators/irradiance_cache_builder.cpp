@@ -27,10 +27,12 @@ constexpr int kMaxPointsPerPixel = 8;
 constexpr float kCandidateX = 0.5f + 1.0f / 1024.0f;
 constexpr float kCandidateY = 0.5f + 1.0f / 2048.0f;
 
-/// The Lambertian points a camera ray sees through ideal specular surfaces: every delta lobe
-/// for the first kBranchDepth bounces, then the heaviest one (deterministic, no random numbers).
-void collect_diffuse_points(const RenderScene& rs, const Ray& ray, float path_length, RayFootprint footprint, int depth,
-                            int max_depth, RayCounters& counters, std::vector<DiffusePoint>& out) {
+/// The points a camera ray sees through ideal specular surfaces where `kind` wants a record:
+/// every delta lobe for the first kBranchDepth bounces, then the heaviest one (deterministic, no
+/// random numbers).
+void collect_points(const RenderScene& rs, const CacheRecordKind& kind, const Ray& ray, float path_length,
+                    RayFootprint footprint, int depth, int max_depth, RayCounters& counters,
+                    std::vector<CachePoint>& out) {
     if (out.size() >= kMaxPointsPerPixel) return;
     const std::optional<Hit> hit = trace_ray(rs, ray, counters);
     if (!hit) return;
@@ -38,10 +40,13 @@ void collect_diffuse_points(const RenderScene& rs, const Ray& ray, float path_le
     const Vec3 wo = -ray.direction;
     const Bsdf bsdf = make_bsdf(rs, si, wo);
     const float length = path_length + hit->t;
-    if (max_component(bsdf.diffuse_reflectance(wo)) > 0.0f) {
-        const Vec3 n = glm::dot(si.surface_normal, wo) >= 0.0f ? si.surface_normal : -si.surface_normal;
-        const Vec3 ng = glm::dot(si.geometric_normal, wo) >= 0.0f ? si.geometric_normal : -si.geometric_normal;
-        out.push_back({si.p, n, ng, footprint.at(length)});
+    CachePoint point;
+    if (kind.wants(bsdf, wo, &point)) {
+        point.position = si.p;
+        point.normal = glm::dot(si.surface_normal, wo) >= 0.0f ? si.surface_normal : -si.surface_normal;
+        point.geometric_normal = glm::dot(si.geometric_normal, wo) >= 0.0f ? si.geometric_normal : -si.geometric_normal;
+        point.footprint = footprint.at(length);
+        out.push_back(point);
     }
     if (!bsdf.has_delta() || depth >= max_depth) return;
     std::array<BsdfSample, 2> lobes;
@@ -54,9 +59,27 @@ void collect_diffuse_points(const RenderScene& rs, const Ray& ray, float path_le
     }
     for (int i = first; i < last; ++i) {
         if (is_black(lobes[i].weight)) continue;
-        collect_diffuse_points(rs, spawn_ray(rs, si, lobes[i].wi), length, footprint, depth + 1, max_depth, counters, out);
+        collect_points(rs, kind, spawn_ray(rs, si, lobes[i].wi), length, footprint, depth + 1, max_depth, counters, out);
     }
 }
+
+/// Irradiance records at the Lambertian points.
+class IrradianceRecordKind final : public CacheRecordKind {
+public:
+    IrradianceRecordKind(const FinalGatherer& gatherer, const CacheBuildSettings& settings)
+        : gatherer_(gatherer), settings_(settings) {}
+    uint64_t stream_tag() const override { return kRecordStreamTag; }
+    bool wants(const Bsdf& bsdf, const Vec3& wo, CachePoint*) const override {
+        return max_component(bsdf.diffuse_reflectance(wo)) > 0.0f;
+    }
+    IrradianceRecord make_record(const CachePoint& point, Rng& rng, RayCounters& counters, std::any*) const override {
+        return make_irradiance_record(gatherer_, point, settings_, rng, counters);
+    }
+
+private:
+    const FinalGatherer& gatherer_;
+    const CacheBuildSettings& settings_;
+};
 
 }  // namespace
 
@@ -98,14 +121,11 @@ bool start_matches(const IrradianceCache& start, const RenderScene& rs, const Ca
            start_root.center == root.center && start_root.half_size == root.half_size;
 }
 
-std::unique_ptr<IrradianceCache> build_irradiance_cache(const RenderScene& rs, const FinalGatherer& gatherer,
-                                                        const Camera& camera, const CacheBuildSettings& settings,
-                                                        CacheBuildStatistics* statistics, const IrradianceCache* start) {
+void fill_cache_in_waves(const RenderScene& rs, const Camera& camera, const CacheBuildSettings& settings,
+                         CacheRecordKind& kind, IrradianceCache& cache, CacheBuildStatistics* statistics) {
     const auto started = std::chrono::steady_clock::now();
-    auto cache = start ? std::make_unique<IrradianceCache>(*start)
-                       : std::make_unique<IrradianceCache>(rs.scene->bounds, settings.interpolation());
     CacheBuildStatistics stats;
-    stats.records_reused = cache->size();
+    stats.records_reused = cache.size();
     const PixelRect frame{0, 0, camera.width(), camera.height()};
     const PixelRect area = settings.region ? settings.region->intersect(frame) : frame;
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
@@ -166,27 +186,27 @@ std::unique_ptr<IrradianceCache> build_irradiance_cache(const RenderScene& rs, c
                 const Clock::time_point chunk_start = phase ? Clock::now() : Clock::time_point{};
                 Chunk& chunk = chunks[chunk_index];
                 const size_t end = std::min(candidates.size(), (chunk_index + 1) * per_chunk);
-                std::vector<DiffusePoint> points;
+                std::vector<CachePoint> points;
                 for (size_t i = chunk_index * per_chunk; i < end; ++i) {
                     const PixelCandidate& c = candidates[i];
                     const CameraRay ray = camera.generate_ray(c.x + kCandidateX, c.y + kCandidateY);
                     points.clear();
-                    collect_diffuse_points(rs, primary_ray(ray), 0.0f, camera_footprint(ray), 0,
-                                           settings.max_specular_depth, chunk.counters, points);
+                    collect_points(rs, kind, primary_ray(ray), 0.0f, camera_footprint(ray), 0,
+                                   settings.max_specular_depth, chunk.counters, points);
                     chunk.points += points.size();
                     for (size_t k = 0; k < points.size(); ++k) {
                         Color unused;
-                        if (cache->interpolate(points[k].position, points[k].normal, &unused)) continue;
+                        if (cache.interpolate(points[k].position, points[k].normal, &unused)) continue;
                         const uint64_t pixel = static_cast<uint64_t>(c.y) * camera.width() + c.x;
-                        Rng rng = Rng::for_stream(settings.seed, kRecordStreamTag, pixel, k);
+                        Rng rng = Rng::for_stream(settings.seed, kind.stream_tag(), pixel, k);
                         WaveRecord& added = chunk.records.emplace_back();
-                        added.record = make_irradiance_record(gatherer, points[k], settings, rng, chunk.counters);
+                        added.record = kind.make_record(points[k], rng, chunk.counters, &added.payload);
                         float max_radius = 0.0f;
                         record_radius_limits(settings, points[k].footprint, &added.min_radius, &max_radius);
                         // The cache is frozen for the wave: its part of the merge's neighbour
                         // search is done here, in parallel (core/integrators/irradiance_wave_merge.h).
                         if (IrradianceCache::accepts(added.record)) {
-                            cache->neighbour_candidates(added.record, &added.cache_candidates);
+                            cache.neighbour_candidates(added.record, &added.cache_candidates);
                             added.candidates_taken = true;
                         }
                     }
@@ -208,12 +228,24 @@ std::unique_ptr<IrradianceCache> build_irradiance_cache(const RenderScene& rs, c
             settings.work_log->phases.push_back({phase->name + " merge", {}, 0.0});
             merge_phase = &settings.work_log->phases.back();
         }
-        merge_wave(*cache, wave_records, arena, merge_phase);
+        // The records the cache takes, in the order it takes them: their payloads too.
+        for (WaveRecord& added : wave_records)
+            if (IrradianceCache::accepts(added.record)) kind.accepted(std::move(added.payload));
+        merge_wave(cache, wave_records, arena, merge_phase);
         ++stats.waves;
     }
-    stats.records = cache->size();
+    stats.records = cache.size();
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     if (statistics) *statistics = stats;
+}
+
+std::unique_ptr<IrradianceCache> build_irradiance_cache(const RenderScene& rs, const FinalGatherer& gatherer,
+                                                        const Camera& camera, const CacheBuildSettings& settings,
+                                                        CacheBuildStatistics* statistics, const IrradianceCache* start) {
+    auto cache = start ? std::make_unique<IrradianceCache>(*start)
+                       : std::make_unique<IrradianceCache>(rs.scene->bounds, settings.interpolation());
+    IrradianceRecordKind kind(gatherer, settings);
+    fill_cache_in_waves(rs, camera, settings, kind, *cache, statistics);
     return cache;
 }
 

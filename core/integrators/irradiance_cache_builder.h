@@ -8,6 +8,7 @@
 // render pass then mostly reads.
 #pragma once
 
+#include <any>
 #include <atomic>
 #include <memory>
 
@@ -57,6 +58,30 @@ struct DiffusePoint {
     float footprint;         // width of a pixel there (world units)
 };
 
+/// A visible point where a cache wants a record; `order`: the bands of a radiance record's basis
+/// (core/integrators/radiance_cache.h), 0 for irradiance records.
+struct CachePoint : DiffusePoint {
+    int order = 0;
+};
+
+/// The kind of record a wave-built cache holds: which visible points want one, and how it is
+/// gathered. The cache itself (an IrradianceCache) holds each record's position, normal and
+/// radius, by which it decides where records are valid; a kind may keep more per record.
+class CacheRecordKind {
+public:
+    virtual ~CacheRecordKind() = default;
+    /// Separates this kind's random streams from other kinds' at the same pixels.
+    virtual uint64_t stream_tag() const = 0;
+    /// Whether a visible point with `bsdf`, seen from wo, wants a record; may set point->order.
+    virtual bool wants(const Bsdf& bsdf, const Vec3& wo, CachePoint* point) const = 0;
+    /// Gathers the record at `point`; what the kind keeps beside it goes in `payload`. Called on
+    /// any thread (const).
+    virtual IrradianceRecord make_record(const CachePoint& point, Rng& rng, RayCounters& counters,
+                                         std::any* payload) const = 0;
+    /// The payload of each record the cache takes, in the order it takes them (one thread).
+    virtual void accepted(std::any&&) {}
+};
+
 /// Radius limits from the pixel spacing limits at a point: a R_i in [min, max] pixels.
 inline void record_radius_limits(const CacheBuildSettings& s, float footprint, float* min_radius, float* max_radius) {
     *min_radius = s.min_spacing_px * footprint / s.accuracy;
@@ -75,6 +100,10 @@ std::unique_ptr<IrradianceCache> build_irradiance_cache(const RenderScene& scene
                                                         const Camera& camera, const CacheBuildSettings& settings,
                                                         CacheBuildStatistics* statistics,
                                                         const IrradianceCache* start = nullptr);
+
+/// Fills `cache` for `camera` with records of `kind`, in the deterministic waves described above.
+void fill_cache_in_waves(const RenderScene& scene, const Camera& camera, const CacheBuildSettings& settings,
+                         CacheRecordKind& kind, IrradianceCache& cache, CacheBuildStatistics* statistics);
 
 /// Whether `start` can start a cache of `scene` with `settings`: the same accuracy and gradients,
 /// and an octree over the same bounds (records of another scene are not).

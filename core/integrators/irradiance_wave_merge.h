@@ -20,6 +20,7 @@
 
 #include <tbb/task_arena.h>
 
+#include <any>
 #include <vector>
 
 #include "core/integrators/irradiance_cache.h"
@@ -36,6 +37,9 @@ struct WaveRecord {
     /// since). Without `candidates_taken` merge_wave takes them itself.
     std::vector<uint32_t> cache_candidates;
     bool candidates_taken = false;
+    /// What the record's cache keeps beside it, if anything (CacheRecordKind::accepted): the
+    /// merge leaves it alone.
+    std::any payload;
 };
 
 /// Inserts `records` into `cache` in their order, with the same result as cache.insert of each

@@ -43,6 +43,17 @@ PhotonMapIntegrator::PhotonMapIntegrator(std::shared_ptr<const RenderScene> scen
     }
     direct_lights_ = gatherer_ && scene_->lights_with_sky_peaks ? scene_->lights_with_sky_peaks.get()
                                                                   : scene_->lights.get();
+    if (gatherer_ && settings_.radiance_cache.enabled) {
+        for (const BsdfMaterial& material : scene_->bsdf_materials)
+            uses_radiance_cache_ = uses_radiance_cache_ || radiance_order_for(material, settings_.radiance_cache) > 0;
+    }
+}
+
+void PhotonMapIntegrator::build_radiance_cache(const Camera& camera, CacheBuildStatistics* statistics) {
+    if (!uses_radiance_cache_) return;
+    CacheBuildSettings build = settings_.irradiance_cache;
+    build.max_specular_depth = settings_.max_specular_depth;
+    radiance_cache_ = photond::build_radiance_cache(*scene_, *gatherer_, camera, build, settings_.radiance_cache, statistics);
 }
 
 void PhotonMapIntegrator::build_cache(const Camera& camera, CacheBuildStatistics* statistics,
@@ -54,6 +65,17 @@ void PhotonMapIntegrator::build_cache(const Camera& camera, CacheBuildStatistics
 }
 
 Expected<PrepareReport> PhotonMapIntegrator::prepare(const PrepareContext& context) {
+    Expected<PrepareReport> report = prepare_irradiance_cache(context);
+    if (!report || !uses_radiance_cache_ || (context.cancel && context.cancel->load())) return report;
+    // The radiance cache is built for each render (render_cache_key keeps irradiance caches only).
+    CacheBuildStatistics statistics;
+    build_radiance_cache(context.camera, &statistics);
+    report->radiance = PrepareReport::RadianceCacheReport{statistics.records, statistics.waves, statistics.seconds};
+    report->counters += statistics.counters;
+    return report;
+}
+
+Expected<PrepareReport> PhotonMapIntegrator::prepare_irradiance_cache(const PrepareContext& context) {
     PrepareReport report;
     if (!uses_irradiance_cache()) return report;
     const bool kept_between_jobs = context.render_caches && !context.photon_map_key.empty();
@@ -163,6 +185,16 @@ std::string PhotonMapIntegrator::render_cache_key(const std::string& photon_map_
     return "rc1-" + Sha256::hex(hasher.finish());
 }
 
+bool PhotonMapIntegrator::radiance_field(const Vec3& p, const Vec3& normal, RadianceCache::Field* field,
+                                         SampleContext& context) const {
+    ++context.counters.radiance_lookups;
+    if (radiance_cache_->field_at(p, normal, 1.0f, field)) return true;
+    // As for irradiance: samples off the prepass's pixel centres may fall just outside.
+    if (radiance_cache_->field_at(p, normal, kExtrapolationScale, field)) return true;
+    ++context.counters.radiance_misses;
+    return false;
+}
+
 RadianceParts PhotonMapIntegrator::radiance_parts(const CameraRay& ray, SampleContext& context) const {
     return radiance_along(primary_ray(ray), 0, 0.0f, camera_footprint(ray), context);
 }
@@ -250,12 +282,19 @@ RadianceParts PhotonMapIntegrator::surface_radiance(const Ray& ray, const Surfac
         const bool glossy = gatherer_ && bsdf.has_non_lambertian_non_delta();
         const LobeMask glossy_lobes = kNonDeltaLobes | kExcludeLambertian;
         const int glossy_rays = std::max(settings_.glossy_rays, 1);
-        radiance.add_direct(sample_direct_light(rs, *direct_lights_, si, bsdf, wo, context, false, kAllLobes,
-                                                glossy ? glossy_lobes : LobeMask(0), static_cast<float>(glossy_rays)));
         // Photon discs and cache records follow the surface, not its normal map; estimates weight
         // their photons by the mapped normal (RadianceEstimateOptions::shading_normal; README).
         const bool front = glm::dot(si.surface_normal, wo) >= 0.0f;
         const Vec3 normal = front ? si.surface_normal : -si.surface_normal;
+        // Glossy lobes the radiance cache holds read its records; the rest take BSDF-sampled rays.
+        thread_local RadianceCache::Field field;
+        const bool cached = glossy && radiance_cache_ && radiance_order_for(bsdf, settings_.radiance_cache) > 0 &&
+                            radiance_field(si.p, normal, &field, context);
+        // Light sampling alone finds the emitters for cached lobes (their records hold no emission).
+        const bool glossy_rays_sampled = glossy && !cached;
+        radiance.add_direct(sample_direct_light(rs, *direct_lights_, si, bsdf, wo, context, false, kAllLobes,
+                                                glossy_rays_sampled ? glossy_lobes : LobeMask(0),
+                                                static_cast<float>(glossy_rays)));
         if (gatherer_) {
             const Color rho = bsdf.diffuse_reflectance(wo);
             if (max_component(rho) > 0.0f) {
@@ -263,7 +302,22 @@ RadianceParts PhotonMapIntegrator::surface_radiance(const Ray& ray, const Surfac
                 const DiffusePoint point{si.p, normal, ng, footprint.at(length)};
                 radiance.add_indirect(rho * kInvPi * indirect_irradiance(point, context));
             }
-            if (glossy) {
+            if (cached) {
+                // The lobe integrates the records' incident radiance (radiance_cache.h): samples
+                // of a smooth field, no rays.
+                const uint32_t samples = std::max<uint32_t>(settings_.radiance_cache.samples, 1);
+                Color sum(0.0f);
+                for (uint32_t i = 0; i < samples; ++i) {
+                    const float u_lobe = context.next_1d();
+                    const Vec2 u = context.next_2d();
+                    const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Radiance, glossy_lobes);
+                    if (s && !is_black(s->weight)) sum += s->weight * field.incident(s->wi);
+                }
+                // The band-limited field rings below zero beside sharp features; its integral
+                // over the lobe stays positive but for rare points (clamping each direction
+                // instead biased glossy light by +3 %: radiance_cache_test).
+                radiance.add_indirect(glm::max(sum / static_cast<float>(samples), Color(0.0f)));
+            } else if (glossy) {
                 // Glossy and rough lobes: BSDF-sampled rays reading the photon maps where they land
                 // (caustics are the maps'), and the emitters they hit weighted by MIS against
                 // light sampling, which alone cannot see an emitter behind rough glass.

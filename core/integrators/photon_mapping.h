@@ -17,6 +17,7 @@
 #include "core/integrators/final_gather.h"
 #include "core/integrators/integrator.h"
 #include "core/integrators/irradiance_cache_builder.h"
+#include "core/integrators/radiance_cache.h"
 #include "core/photon/photon_tracer.h"
 
 namespace photond {
@@ -33,6 +34,8 @@ struct PhotonMapIntegratorSettings {
     bool use_irradiance_cache = true;
     CacheBuildSettings irradiance_cache;
     int glossy_rays = 1;  // BSDF-sampled rays per visible point for non-Lambertian lobes
+    /// Glossy lobes from radiance records instead of glossy rays (needs final gathering).
+    RadianceCacheSettings radiance_cache;
 };
 
 /// Bump when the irradiance cache's prepass or gathering changes what it stores for the same
@@ -58,8 +61,14 @@ public:
 
     /// Whether this integrator fills an irradiance cache (final gathering with the cache on).
     bool uses_irradiance_cache() const { return gatherer_ && settings_.use_irradiance_cache; }
-    /// "irradiance_cache" when it fills one, else none.
-    std::string_view preparation_pass() const override { return uses_irradiance_cache() ? "irradiance_cache" : ""; }
+    /// Whether it fills a radiance cache: final gathering with the cache on, and a material
+    /// whose glossy lobe the cache can hold (radiance_cache_materials).
+    bool uses_radiance_cache() const { return uses_radiance_cache_; }
+    /// "irradiance_cache" when it fills one, else "radiance_cache" when it fills that, else none.
+    /// The radiance cache's own seconds are in PrepareReport::radiance.
+    std::string_view preparation_pass() const override {
+        return uses_irradiance_cache() ? "irradiance_cache" : uses_radiance_cache() ? "radiance_cache" : "";
+    }
     /// The irradiance cache of this view (a no-op without one): with a store and a photon-map key,
     /// taken from the store by render_cache_key or built once and kept there; else built for this
     /// render. `start_from` names an earlier view's cache in the store to start from (an error
@@ -89,6 +98,9 @@ public:
     RadianceParts radiance_parts(const CameraRay& ray, SampleContext& context) const override;
 
     const IrradianceCache* cache() const { return cache_.get(); }
+    const RadianceCache* radiance_cache() const { return radiance_cache_.get(); }
+    /// Fills the radiance cache for this camera (a no-op unless uses_radiance_cache()).
+    void build_radiance_cache(const Camera& camera, CacheBuildStatistics* statistics);
     const std::shared_ptr<const IrradianceCache>& shared_cache() const { return cache_; }
 
 private:
@@ -97,7 +109,11 @@ private:
     /// What the ray's hit sends back (null: it left the scene), before the atmosphere on its way.
     RadianceParts surface_radiance(const Ray& ray, const SurfaceInteraction* hit_point, int depth, float path_length,
                                    RayFootprint footprint, SampleContext& context) const;
+    Expected<PrepareReport> prepare_irradiance_cache(const PrepareContext& context);
     Color indirect_irradiance(const DiffusePoint& point, SampleContext& context) const;
+    /// The radiance cache's field at a glossy point, extrapolating a little where no record is
+    /// usable; false (BSDF-sampled rays instead) where none is even then.
+    bool radiance_field(const Vec3& p, const Vec3& normal, RadianceCache::Field* field, SampleContext& context) const;
     bool caustic_may_show(const Vec3& p, const Vec3& normal, const Bsdf& bsdf, const Vec3& wo, float other) const;
 
     std::shared_ptr<const RenderScene> scene_;
@@ -107,6 +123,8 @@ private:
     RadianceEstimateOptions global_options_;
     std::unique_ptr<FinalGatherer> gatherer_;
     std::shared_ptr<const IrradianceCache> cache_;
+    std::unique_ptr<RadianceCache> radiance_cache_;
+    bool uses_radiance_cache_ = false;
     /// What next-event estimation samples: the scene's lights, or with final gathering under an
     /// environment, the lights with only the sky's peaks (the gather collects the rest).
     const LightSet* direct_lights_ = nullptr;

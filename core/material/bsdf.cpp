@@ -28,6 +28,7 @@
 
 #include <array>
 #include <bit>
+#include <limits>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -228,7 +229,7 @@ bool Bsdf::reads_as_diffuse(LobeMask lobes) const {
     return !glossy && !rough_glass && !rough_coat;
 }
 
-bool Bsdf::transmits_non_delta() const { return m_->glass_weight > 0.0f && !m_->glass_delta; }
+bool Bsdf::transmits_non_delta() const { return photond::transmits_non_delta(*m_); }
 
 Color Bsdf::diffuse_like_reflectance(const Vec3& wo) const {
     const float mu = std::min(std::abs(glm::dot(wo, frame_.n)), 1.0f);
@@ -243,11 +244,19 @@ Color Bsdf::diffuse_like_reflectance(const Vec3& wo) const {
 }
 
 bool Bsdf::has_non_lambertian_non_delta() const {
-    const bool rough_reflection = !m_->smooth && (m_->metallic > 0.0f || (m_->layer_weight > 0.0f && m_->specular_f90 > 0.0f));
-    const bool rough_glass = m_->glass_weight > 0.0f && !m_->glass_delta;
-    const bool rough_coat = m_->coat > 0.0f && !m_->coat_smooth;
-    return rough_reflection || rough_glass || rough_coat;
+    return sharpest_reflection_alpha() > 0.0f || transmits_non_delta();
 }
+
+float sharpest_reflection_alpha(const BsdfMaterial& m) {
+    float alpha = std::numeric_limits<float>::infinity();
+    if (!m.smooth && (m.metallic > 0.0f || (m.layer_weight > 0.0f && m.specular_f90 > 0.0f))) alpha = m.alpha;
+    if (m.coat > 0.0f && !m.coat_smooth) alpha = std::min(alpha, m.coat_alpha);
+    return std::isfinite(alpha) ? alpha : 0.0f;
+}
+
+bool transmits_non_delta(const BsdfMaterial& m) { return m.glass_weight > 0.0f && !m.glass_delta; }
+
+float Bsdf::sharpest_reflection_alpha() const { return photond::sharpest_reflection_alpha(*m_); }
 
 Bsdf::SlotProbabilities Bsdf::slot_probabilities(const Vec3& wo, bool outside,
                                                  LobeMask mask) const {

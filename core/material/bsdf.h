@@ -99,6 +99,12 @@ struct BsdfMaterial {
 /// white, so a texture can only remove lobes). For the render plan and the caustic casters.
 LobeMask possible_lobes(const Scene& scene, const Material& material);
 
+/// The GGX alpha of the material's sharpest non-delta reflection lobe other than the Lambertian
+/// one (rough metal, rough dielectric layer, rough coat); 0 when it has none.
+float sharpest_reflection_alpha(const BsdfMaterial& material);
+/// Whether light passes through the material by a non-delta lobe (rough transmission).
+bool transmits_non_delta(const BsdfMaterial& material);
+
 class Bsdf {
 public:
     /// `shading` is the interpolated-normal frame and `geometric_normal` the triangle's normal, both
@@ -180,6 +186,10 @@ public:
     /// Whether a non-delta lobe other than the Lambertian one exists (rough metal, rough
     /// dielectric layer, rough transmission): then L_o is not rho / pi * E.
     bool has_non_lambertian_non_delta() const;
+    /// The GGX alpha of the sharpest non-delta reflection lobe other than the Lambertian one
+    /// (rough metal, rough dielectric layer, rough coat); 0 when there is none. Rough
+    /// transmission is not among them (transmits_non_delta).
+    float sharpest_reflection_alpha() const;
     /// Which LobeKinds this BSDF has at all (a LobeMask).
     LobeMask lobes() const { return lobes_; }
     /// Reflectance of the Lambertian lobe alone (rho_d), so that L_o = rho_d / pi * E.

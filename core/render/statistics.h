@@ -73,6 +73,19 @@ struct RenderStatistics {
     };
     std::optional<IrradianceCacheFigures> irradiance_cache;
 
+    /// The radiance cache, when glossy lobes read one (core/integrators/radiance_cache.h).
+    struct RadianceCacheFigures {
+        uint64_t records = 0;
+        int waves = 0;
+        uint64_t lookups = 0;  // glossy points of the render pass that asked it
+        uint64_t misses = 0;   // ... that no record covered (BSDF-sampled rays instead)
+        double seconds = 0.0;
+        double interpolated_share() const {
+            return lookups > 0 ? 1.0 - static_cast<double>(misses) / static_cast<double>(lookups) : 0.0;
+        }
+    };
+    std::optional<RadianceCacheFigures> radiance_cache;
+
     /// The progressive preview (core/render/preview_renderer.h), when one was rendered.
     struct PreviewFigures {
         int stride = 0;         // one camera sample per stride x stride pixels

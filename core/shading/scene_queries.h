@@ -19,6 +19,8 @@ struct RayCounters {
     uint64_t shadow_rays = 0;  // occlusion queries
     uint64_t irradiance_lookups = 0;  // indirect irradiance asked of the irradiance cache
     uint64_t irradiance_misses = 0;   // ... that no record covered (gathered on the spot)
+    uint64_t radiance_lookups = 0;    // glossy points that asked the radiance cache
+    uint64_t radiance_misses = 0;     // ... that no record covered (BSDF-sampled rays instead)
     uint64_t caustic_points = 0;      // visible points where the caustic map could be read
     uint64_t caustic_skipped = 0;     // ... where it was not, its light too faint to show
 
@@ -27,6 +29,8 @@ struct RayCounters {
         shadow_rays += o.shadow_rays;
         irradiance_lookups += o.irradiance_lookups;
         irradiance_misses += o.irradiance_misses;
+        radiance_lookups += o.radiance_lookups;
+        radiance_misses += o.radiance_misses;
         caustic_points += o.caustic_points;
         caustic_skipped += o.caustic_skipped;
         return *this;

@@ -113,6 +113,9 @@ const std::map<std::string, json>& changed_values() {
         {"irradiance_cache.a", 0.25},
         {"irradiance_cache.gradients", false},
         {"irradiance_cache.min_spacing_px", 2.5},
+        {"radiance_cache.enabled", true},
+        {"radiance_cache.max_order", 6},
+        {"radiance_cache.samples", 3},
         {"irradiance_cache.max_spacing_px", 30.0},
         {"irradiance_cache.start_from", "rc1-" + std::string(64, 'a')},
         {"light_sampling.selection", "power"},
@@ -212,7 +215,7 @@ TEST(JobFields, KeysComeFromTheTable) {
     std::set<std::string> top;
     for (std::string_view key : job_field_keys()) top.insert(std::string(key));
     EXPECT_EQ(top, (std::set<std::string>{"preset", "scene", "camera", "image", "integrator", "photons", "gather",
-                                          "irradiance_cache", "light_sampling", "output", "environment", "lights",
+                                          "irradiance_cache", "radiance_cache", "light_sampling", "output", "environment", "lights",
                                           "atmosphere", "material_media", "priority", "seed", "progressive"}));
     for (const JobFieldGroup& group : job_field_groups()) EXPECT_FALSE(job_field_keys(group.name).empty()) << group.name;
     const std::vector<std::string_view> photons = job_field_keys("photons");
