@@ -44,11 +44,13 @@ build: configure
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j$(JOBS)
 
-# The irradiance cache's concurrency stress test under ThreadSanitizer (run by CI).
+# The irradiance cache's concurrency stress test and the radiance cache's threaded build and
+# render under ThreadSanitizer (run by CI).
 tsan: deps
 	cmake -S . -B $(BUILD)-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPHOTOND_SANITIZE=thread
-	cmake --build $(BUILD)-tsan -j$(JOBS) --target irradiance_cache_test
+	cmake --build $(BUILD)-tsan -j$(JOBS) --target irradiance_cache_test radiance_cache_test
 	TSAN_OPTIONS=halt_on_error=1 $(BUILD)-tsan/tests/irradiance_cache_test --gtest_filter='IrradianceCache.Concurrent*:IrradianceCache.Octree*'
+	TSAN_OPTIONS=halt_on_error=1 $(BUILD)-tsan/tests/radiance_cache_test --gtest_filter='RadianceCache.Images*'
 
 # The stress suite and the fast core tests under AddressSanitizer and UndefinedBehaviorSanitizer
 # (run by CI). Embree and oneTBB are not instrumented, so leak checking is off. Every test runs;
@@ -58,7 +60,8 @@ ASAN_TESTS := degenerate_geometry_test degenerate_light_test scale_invariance_te
 	tile_renderer_test photon_test kd_tree_test photon_map_test photon_map_io_test photon_tracer_test \
 	final_gather_test exr_io_test png_preview_test environment_light_test material_textures_test alpha_test \
 	clearcoat_test gltf_loader_fuzz_test exr_assemble_test irradiance_cache_io_test caustic_skip_test \
-	light_tree_test irradiance_wave_merge_test preview_renderer_test homogeneous_medium_test atmosphere_test volume_photon_test
+	light_tree_test irradiance_wave_merge_test preview_renderer_test homogeneous_medium_test atmosphere_test volume_photon_test \
+	radiance_cache_test
 
 .PHONY: asan
 asan: deps

@@ -1,4 +1,5 @@
-// Filling the irradiance cache before the render pass, deterministically, in waves over a
+// Filling the irradiance cache (and, with another CacheRecordKind, the radiance cache's records:
+// core/integrators/radiance_cache.h) before the render pass, deterministically, in waves over a
 // coarse-to-fine pixel grid (steps 32, 16, ..., 1 pixels). In each wave every candidate pixel's
 // camera ray finds its visible diffuse points (through ideal specular surfaces) and, where the
 // cache (frozen during the wave) cannot interpolate, gathers a new record; all threads only read
