@@ -44,13 +44,13 @@ build: configure
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j$(JOBS)
 
-# The irradiance cache's concurrency stress test and the radiance cache's threaded build and
-# render under ThreadSanitizer (run by CI).
+# The irradiance cache's concurrency stress test under ThreadSanitizer (run by CI). Tests that run
+# on oneTBB's threads are not among them: Debian's libtbb is not instrumented, so ThreadSanitizer
+# cannot see its synchronisation and reports races inside TBB's own headers.
 tsan: deps
 	cmake -S . -B $(BUILD)-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPHOTOND_SANITIZE=thread
-	cmake --build $(BUILD)-tsan -j$(JOBS) --target irradiance_cache_test radiance_cache_test
+	cmake --build $(BUILD)-tsan -j$(JOBS) --target irradiance_cache_test
 	TSAN_OPTIONS=halt_on_error=1 $(BUILD)-tsan/tests/irradiance_cache_test --gtest_filter='IrradianceCache.Concurrent*:IrradianceCache.Octree*'
-	TSAN_OPTIONS=halt_on_error=1 $(BUILD)-tsan/tests/radiance_cache_test --gtest_filter='RadianceCache.Images*'
 
 # The stress suite and the fast core tests under AddressSanitizer and UndefinedBehaviorSanitizer
 # (run by CI). Embree and oneTBB are not instrumented, so leak checking is off. Every test runs;
