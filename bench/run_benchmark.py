@@ -78,6 +78,17 @@ SCENES = [
               [4, 16, 64, 256], [4, 16, 64],
               note="a closed room lit only by a sky image and its sun through a window (built-in): "
                    "where photon maps must earn their place"),
+    SceneSpec("foggy-room", "bench/references/foggy-room-256", 256, 256,
+              [16, 64, 256, 1024], [16, 64, 256], block=4,
+              note="god rays (built-in): a closed room in its own fog (the scene's atmosphere, "
+                   "optical depth 0.72 across it), lit only by a spot light through a window in a "
+                   "partition; compared over 4 x 4 pixel blocks, as its path reference converges "
+                   "in block means, not per pixel (the fog's light outside the shafts comes from "
+                   "few paths: fireflies), so RMSE and p99 are of block means"),
+    SceneSpec("glossy-objects", "bench/references/glossy-objects-256", 256, 256,
+              [4, 16, 64, 256], [4, 16, 64],
+              note="glossy metals (roughness 0.1 to 0.5), plastics and a clear-coated box under a "
+                   "ceiling light (built-in): glossy interreflection, no ideal mirror or glass"),
     SceneSpec("cornell-box-512", "bench/references/cornell-box-512", 512, 512,
               [4, 16, 64], [4, 16], builtin="cornell-box",
               note="cornell-box at 512 x 512: the presets' goals at four times the pixels"),

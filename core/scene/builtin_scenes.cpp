@@ -72,9 +72,38 @@ Expected<Scene> finish(SceneBuilder& builder, const Status& status, std::string_
     return builder.build();
 }
 
+/// The materials of an open room's surfaces (add_open_room).
+struct OpenRoomMaterials {
+    uint32_t floor, ceiling, back, left, right, light;
+};
+
+/// A room of floor, ceiling, back and side walls, `half` wide on each side of x = 0 and z = 0
+/// and `height` high, every wall facing the interior and the front (z = +half) open, as
+/// "cornell-box"; a square light of side `light_side` just under the ceiling's centre, facing down.
+Status add_open_room(SceneBuilder& builder, float half, float height, float light_side, const OpenRoomMaterials& m) {
+    constexpr float kLightGap = 0.01f;
+    const Vec3 interior(0.0f, 0.5f * height, 0.0f);
+    const Vec3 ex(2.0f * half, 0.0f, 0.0f), ey(0.0f, height, 0.0f), ez(0.0f, 0.0f, 2.0f * half);
+    const Vec3 lower(-half, 0.0f, -half);
+    Status st;
+    if (st) st = add_mesh(builder, make_quad(lower, ex, ez, interior - lower), m.floor);
+    if (st) st = add_mesh(builder, make_quad(lower + ey, ex, ez, interior - lower - ey), m.ceiling);
+    if (st) st = add_mesh(builder, make_quad(lower, ex, ey, interior - lower), m.back);
+    if (st) st = add_mesh(builder, make_quad(lower, ey, ez, interior - lower), m.left);
+    if (st) st = add_mesh(builder, make_quad(lower + ex, ey, ez, interior - lower - ex), m.right);
+    const Vec3 light_corner(-0.5f * light_side, height - kLightGap, -0.5f * light_side);
+    if (st) {
+        st = add_mesh(builder,
+                      make_quad(light_corner, Vec3(light_side, 0.0f, 0.0f), Vec3(0.0f, 0.0f, light_side),
+                                Vec3(0.0f, -1.0f, 0.0f)),
+                      m.light);
+    }
+    return st;
+}
+
 /// Jensen's photon-mapping Cornell box; see the header for the layout.
 Expected<Scene> make_cornell_box() {
-    constexpr float kHalf = 2.75f, kHeight = 5.5f, kLightSide = 1.3f, kLightGap = 0.01f;
+    constexpr float kHalf = 2.75f, kHeight = 5.5f, kLightSide = 1.3f;
     SceneBuilder builder("cornell-box");
     const uint32_t white = builder.add_material(lambertian("white", Color(0.75f)));
     const uint32_t red = builder.add_material(lambertian("red", Color(0.75f, 0.25f, 0.25f)));
@@ -84,27 +113,7 @@ Expected<Scene> make_cornell_box() {
     const uint32_t chrome = builder.add_material(mirror("mirror"));
     const uint32_t crystal = builder.add_material(glass("glass"));
 
-    const Vec3 interior(0.0f, 0.5f * kHeight, 0.0f);
-    const Vec3 ex(2.0f * kHalf, 0.0f, 0.0f), ey(0.0f, kHeight, 0.0f), ez(0.0f, 0.0f, 2.0f * kHalf);
-    const Vec3 lower(-kHalf, 0.0f, -kHalf);
-    const Vec3 top = lower + ey;
-    const Vec3 right = lower + ex;
-    const Vec3 back = lower;
-    Status st;
-    // Every wall faces the interior; the front (z = +kHalf) stays open.
-    if (st) st = add_mesh(builder, make_quad(lower, ex, ez, interior - lower), white);  // floor
-    if (st) st = add_mesh(builder, make_quad(top, ex, ez, interior - top), white);      // ceiling
-    if (st) st = add_mesh(builder, make_quad(back, ex, ey, interior - back), white);    // back wall
-    if (st) st = add_mesh(builder, make_quad(lower, ey, ez, interior - lower), red);    // left, -x
-    if (st) st = add_mesh(builder, make_quad(right, ey, ez, interior - right), blue);   // right, +x
-    // The light: a thin square just below the ceiling, front face down.
-    const Vec3 light_corner(-0.5f * kLightSide, kHeight - kLightGap, -0.5f * kLightSide);
-    if (st) {
-        st = add_mesh(builder,
-                      make_quad(light_corner, Vec3(kLightSide, 0.0f, 0.0f),
-                                Vec3(0.0f, 0.0f, kLightSide), Vec3(0.0f, -1.0f, 0.0f)),
-                      light);
-    }
+    Status st = add_open_room(builder, kHalf, kHeight, kLightSide, {white, white, white, red, blue, light});
     if (st) st = add_mesh(builder, sphere_resting_on(0.0f, -1.4f, -1.2f, 1.0f), chrome);
     if (st) st = add_mesh(builder, sphere_resting_on(0.0f, 1.3f, 0.9f, 1.0f), crystal);
 
@@ -333,24 +342,7 @@ Expected<Scene> make_spheres_room() {
         builder.add_material(lambertian("slate", Color(0.3f, 0.32f, 0.45f)))};
 
     constexpr float kHalf = kSpheresRoomHalfWidth, kHeight = kSpheresRoomHeight;
-    constexpr float kLight = kSpheresRoomLightSide, kLightGap = 0.01f;
-    const Vec3 interior(0.0f, 0.5f * kHeight, 0.0f);
-    const Vec3 ex(2.0f * kHalf, 0.0f, 0.0f), ey(0.0f, kHeight, 0.0f), ez(0.0f, 0.0f, 2.0f * kHalf);
-    const Vec3 lower(-kHalf, 0.0f, -kHalf);
-    Status st;
-    // As "cornell-box": every wall faces the interior, the front (z = +kHalf) stays open.
-    if (st) st = add_mesh(builder, make_quad(lower, ex, ez, interior - lower), white);
-    if (st) st = add_mesh(builder, make_quad(lower + ey, ex, ez, interior - lower - ey), white);
-    if (st) st = add_mesh(builder, make_quad(lower, ex, ey, interior - lower), white);
-    if (st) st = add_mesh(builder, make_quad(lower, ey, ez, interior - lower), red);
-    if (st) st = add_mesh(builder, make_quad(lower + ex, ey, ez, interior - lower - ex), green);
-    const Vec3 light_corner(-0.5f * kLight, kHeight - kLightGap, -0.5f * kLight);
-    if (st) {
-        st = add_mesh(builder,
-                      make_quad(light_corner, Vec3(kLight, 0.0f, 0.0f), Vec3(0.0f, 0.0f, kLight),
-                                Vec3(0.0f, -1.0f, 0.0f)),
-                      light);
-    }
+    Status st = add_open_room(builder, kHalf, kHeight, kSpheresRoomLightSide, {white, white, white, red, green, light});
 
     // The grid: spheres, and every third cell a turned box carrying a small sphere. Objects of
     // one colour are merged into one mesh (fewer geometries, the same triangles).
@@ -632,11 +624,187 @@ Expected<Scene> make_large_city() {
     return finish(builder, st, "large-city");
 }
 
+/// "foggy-room": god rays through a window in fog; see the header for the layout.
+Expected<Scene> make_foggy_room() {
+    constexpr float kHalf = kFoggyRoomHalfWidth, kHeight = kFoggyRoomHeight;
+    SceneBuilder builder("foggy-room");
+    const uint32_t white = builder.add_material(lambertian("white", Color(0.5f)));
+    const uint32_t floor = builder.add_material(lambertian("floor", Color(0.35f, 0.3f, 0.25f)));
+    const uint32_t red = builder.add_material(lambertian("red", Color(0.5f, 0.18f, 0.14f)));
+    const uint32_t blue = builder.add_material(lambertian("blue", Color(0.18f, 0.26f, 0.45f)));
+    const uint32_t plaster = builder.add_material(lambertian("plaster", Color(0.5f, 0.49f, 0.46f)));
+    const uint32_t stone = builder.add_material(lambertian("stone", Color(0.6f, 0.56f, 0.5f)));
+    const uint32_t wood = builder.add_material(lambertian("wood", Color(0.6f, 0.4f, 0.25f)));
+    const uint32_t ivory = builder.add_material(lambertian("ivory", Color(0.8f, 0.78f, 0.7f)));
+
+    const Vec3 interior(0.0f, 0.5f * kHeight, 0.0f);
+    const Vec3 lower(-kHalf, 0.0f, -kHalf);
+    const Vec3 ex(2.0f * kHalf, 0.0f, 0.0f), ey(0.0f, kHeight, 0.0f), ez(0.0f, 0.0f, 2.0f * kHalf);
+    Status st;
+    // Closed: every wall faces the interior (floor, ceiling, z = -half, z = +half, x = -half,
+    // x = +half).
+    if (st) st = add_mesh(builder, make_quad(lower, ex, ez, interior - lower), floor);
+    if (st) st = add_mesh(builder, make_quad(lower + ey, ex, ez, interior - lower - ey), white);
+    if (st) st = add_mesh(builder, make_quad(lower, ex, ey, interior - lower), white);
+    if (st) st = add_mesh(builder, make_quad(lower + ez, ex, ey, interior - lower - ez), white);
+    if (st) st = add_mesh(builder, make_quad(lower, ey, ez, interior - lower), red);
+    if (st) st = add_mesh(builder, make_quad(lower + ex, ey, ez, interior - lower - ex), blue);
+    // The partition: slabs around the window and the window's cross of mullions, all boxes.
+    const float z0 = kFoggyRoomPartitionZ - kFoggyRoomPartitionThickness, z1 = kFoggyRoomPartitionZ;
+    const float wx0 = kFoggyRoomWindow[0], wx1 = kFoggyRoomWindow[1];
+    const float wy0 = kFoggyRoomWindow[2], wy1 = kFoggyRoomWindow[3];
+    const float mx = 0.5f * (wx0 + wx1), my = 0.5f * (wy0 + wy1), m = 0.5f * kFoggyRoomMullion;
+    const auto slab = [&](float xa, float xb, float ya, float yb) {
+        return add_mesh(builder, make_box(Vec3(xa, ya, z0), Vec3(xb, yb, z1)), plaster);
+    };
+    if (st) st = slab(-kHalf, wx0, 0.0f, kHeight);
+    if (st) st = slab(wx1, kHalf, 0.0f, kHeight);
+    if (st) st = slab(wx0, wx1, 0.0f, wy0);
+    if (st) st = slab(wx0, wx1, wy1, kHeight);
+    if (st) st = slab(mx - m, mx + m, wy0, wy1);
+    if (st) st = slab(wx0, mx - m, my - m, my + m);
+    if (st) st = slab(mx + m, wx1, my - m, my + m);
+    // In the beam: a pillar from floor to ceiling, a box and a sphere on the floor.
+    if (st) st = add_mesh(builder, standing_box(-1.2f, -0.5f, 0.3f, kHeight, 0.3f), stone);
+    if (st) st = add_mesh(builder, standing_box(0.0f, 0.6f, 0.6f, 0.6f, 0.5f), wood);
+    if (st) st = add_mesh(builder, sphere_resting_on(0.0f, -1.3f, 1.2f, 0.35f), ivory);
+
+    PunctualLight spot;
+    spot.type = PunctualLightType::Spot;
+    spot.name = "spot";
+    spot.position = kFoggyRoomSpotPosition;
+    spot.direction = glm::normalize(kFoggyRoomSpotTarget - kFoggyRoomSpotPosition);
+    spot.intensity = Color(kFoggyRoomSpotIntensity) * Color(1.0f, 0.95f, 0.85f);
+    spot.cos_inner = std::cos(kFoggyRoomSpotInnerDeg * kPi / 180.0f);
+    spot.cos_outer = std::cos(kFoggyRoomSpotOuterDeg * kPi / 180.0f);
+    builder.add_light(spot);
+
+    CameraDesc camera;
+    camera.name = "camera";
+    // In the front corner, looking across the room at the window: the shafts come towards it.
+    camera.position = Vec3(2.3f, 1.7f, 2.75f);
+    camera.look_at = Vec3(-0.8f, 1.0f, -1.3f);
+    camera.vfov_deg = 60.0f;
+    builder.add_camera(camera);
+    Expected<Scene> scene = finish(builder, st, "foggy-room");
+    if (scene) {
+        HomogeneousMedium fog;
+        fog.sigma_a = Color(kFoggyRoomSigmaA);
+        fog.sigma_s = Color(kFoggyRoomSigmaS);
+        fog.g = kFoggyRoomPhaseG;
+        scene->atmosphere = fog;
+    }
+    return scene;
+}
+
+/// A metal of GGX perceptual roughness `roughness` (glTF: metallic 1, the base colour is F0).
+Material metal(std::string name, const Color& f0, float roughness) {
+    Material m;
+    m.name = std::move(name);
+    m.base_color = f0;
+    m.metallic = 1.0f;
+    m.roughness = roughness;
+    return m;
+}
+
+/// A plastic: a Lambertian base under a GGX dielectric layer (ior 1.5) of `roughness`.
+Material plastic(std::string name, const Color& albedo, float roughness) {
+    Material m;
+    m.name = std::move(name);
+    m.base_color = albedo;
+    m.metallic = 0.0f;
+    m.roughness = roughness;
+    return m;
+}
+
+/// A torus about the vertical through `center`: a tube of radius `minor` around the circle of
+/// radius `major` in the plane y = center.y, nu x nv cells with shared vertices (closed and
+/// watertight), faces outward, smooth normals.
+MeshData make_torus(const Vec3& center, float major, float minor, int nu, int nv) {
+    MeshData torus;
+    for (int i = 0; i < nu; ++i) {
+        const float u = 2.0f * kPi * static_cast<float>(i) / static_cast<float>(nu);
+        for (int j = 0; j < nv; ++j) {
+            const float v = 2.0f * kPi * static_cast<float>(j) / static_cast<float>(nv);
+            const Vec3 normal(std::cos(v) * std::cos(u), std::sin(v), std::cos(v) * std::sin(u));
+            const Vec3 ring(major * std::cos(u), 0.0f, major * std::sin(u));
+            torus.positions.push_back(center + ring + minor * normal);
+            torus.normals.push_back(normal);
+            torus.uvs.push_back(Vec2(static_cast<float>(i) / nu, static_cast<float>(j) / nv));
+        }
+    }
+    const auto at = [nu, nv](int i, int j) {
+        return static_cast<uint32_t>((i % nu) * nv + (j % nv));
+    };
+    for (int i = 0; i < nu; ++i) {
+        for (int j = 0; j < nv; ++j) {
+            // cross(dP/dv, dP/du) points out of the tube.
+            torus.triangles.push_back(glm::uvec3(at(i, j), at(i, j + 1), at(i + 1, j + 1)));
+            torus.triangles.push_back(glm::uvec3(at(i, j), at(i + 1, j + 1), at(i + 1, j)));
+        }
+    }
+    return torus;
+}
+
+/// "glossy-objects": glossy metals and plastics under a ceiling light; see the header.
+Expected<Scene> make_glossy_objects() {
+    constexpr float kHalf = kGlossyObjectsHalfWidth, kHeight = kGlossyObjectsHeight;
+    constexpr float kLight = kGlossyObjectsLightSide;
+    SceneBuilder builder("glossy-objects");
+    const uint32_t white = builder.add_material(lambertian("white", Color(0.75f)));
+    const uint32_t floor = builder.add_material(lambertian("floor", Color(0.7f, 0.68f, 0.64f)));
+    const uint32_t orange = builder.add_material(lambertian("orange", Color(0.75f, 0.4f, 0.15f)));
+    const uint32_t teal = builder.add_material(lambertian("teal", Color(0.15f, 0.5f, 0.55f)));
+    const uint32_t light =
+        builder.add_material(emitter("light", Color(0.75f), Color(kGlossyObjectsLightRadiance)));
+    const uint32_t gold = builder.add_material(metal("gold", Color(1.0f, 0.78f, 0.34f), 0.1f));
+    const uint32_t copper = builder.add_material(metal("copper", Color(0.95f, 0.64f, 0.54f), 0.2f));
+    const uint32_t steel = builder.add_material(metal("steel", Color(0.63f, 0.62f, 0.6f), 0.35f));
+    const uint32_t aluminium =
+        builder.add_material(metal("aluminium", Color(0.91f, 0.92f, 0.92f), 0.5f));
+    const uint32_t brushed_gold =
+        builder.add_material(metal("brushed-gold", Color(1.0f, 0.78f, 0.34f), 0.3f));
+    const uint32_t red_plastic =
+        builder.add_material(plastic("red-plastic", Color(0.7f, 0.08f, 0.06f), 0.2f));
+    const uint32_t green_plastic =
+        builder.add_material(plastic("green-plastic", Color(0.1f, 0.5f, 0.15f), 0.35f));
+    Material coated = plastic("blue-coated", Color(0.1f, 0.2f, 0.6f), 0.6f);
+    coated.clearcoat = 1.0f;
+    coated.clearcoat_roughness = 0.1f;
+    const uint32_t blue_coated = builder.add_material(coated);
+
+    Status st = add_open_room(builder, kHalf, kHeight, kLight, {floor, white, white, orange, teal, light});
+    // The metals in a row at the back, roughest on the right; the plastics, the torus and the
+    // coated box in front of them.
+    const std::array<uint32_t, 4> metals = {gold, copper, steel, aluminium};
+    for (size_t i = 0; i < metals.size() && st; ++i) {
+        const float x = -2.1f + 1.4f * static_cast<float>(i);
+        st = add_mesh(builder, sphere_resting_on(0.0f, x, -1.3f, 0.6f), metals[i]);
+    }
+    constexpr float kTorusMinor = 0.16f;
+    if (st) st = add_mesh(builder, sphere_resting_on(0.0f, -1.9f, 0.8f, 0.5f), red_plastic);
+    const MeshData torus = make_torus(Vec3(-0.55f, kTorusMinor, 1.1f), 0.5f, kTorusMinor, 96, 32);
+    if (st) st = add_mesh(builder, torus, brushed_gold);
+    if (st) st = add_mesh(builder, standing_box(0.75f, 0.9f, 0.7f, 0.7f, 0.6f), blue_coated);
+    if (st) st = add_mesh(builder, sphere_resting_on(0.0f, 2.0f, 0.9f, 0.45f), green_plastic);
+
+    CameraDesc camera;
+    camera.name = "camera";
+    // In front of the open side, looking down by 11 degrees: the view stays between the front
+    // edges of the ceiling and the floor (no black border).
+    camera.position = Vec3(0.0f, 2.9f, kHalf + 5.0f);
+    camera.look_at = Vec3(0.0f, 2.9f - 8.0f * std::tan(11.0f * kPi / 180.0f), 0.0f);
+    camera.vfov_deg = 36.0f;
+    builder.add_camera(camera);
+    return finish(builder, st, "glossy-objects");
+}
+
 }  // namespace
 
 std::vector<std::string> builtin_scene_names() {
-    return {"cornell-box", "cornell-box-diffuse", "caustic", "caustic-area",
-            "furnace",     "spheres-room",        "sunlit-room", "large-city"};
+    return {"cornell-box", "cornell-box-diffuse", "caustic",     "caustic-area",
+            "furnace",     "spheres-room",        "sunlit-room", "large-city",
+            "foggy-room",  "glossy-objects"};
 }
 
 Expected<Scene> make_builtin_scene(std::string_view name) {
@@ -648,6 +816,8 @@ Expected<Scene> make_builtin_scene(std::string_view name) {
     if (name == "spheres-room") return make_spheres_room();
     if (name == "sunlit-room") return make_sunlit_room();
     if (name == "large-city") return make_large_city();
+    if (name == "foggy-room") return make_foggy_room();
+    if (name == "glossy-objects") return make_glossy_objects();
     std::string known;
     for (const std::string& n : builtin_scene_names()) known += (known.empty() ? "" : ", ") + n;
     return Error{"unknown built-in scene '" + std::string(name) + "'; known scenes: " + known};

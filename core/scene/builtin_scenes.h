@@ -70,6 +70,34 @@
 //                         ten times the radiance) and kLargeCityPointLights coloured point lights
 //                         in the streets of intensities over two decades: lights of varied power,
 //                         where distance decides which matters. No sky. All Lambertian.
+//  "foggy-room"           God rays: a closed room x and z in [-3, 3], y in [0, 3.2], walls facing
+//                         in, filled with fog (the scene's own atmosphere, Scene::atmosphere:
+//                         sigma_s kFoggyRoomSigmaS, sigma_a kFoggyRoomSigmaA, g kFoggyRoomPhaseG;
+//                         optical depth 0.72 across the room; a job's `atmosphere` replaces it). A
+//                         partition kFoggyRoomPartitionThickness thick at z = kFoggyRoomPartitionZ
+//                         cuts off a light chamber at the back; a spot light high in the chamber
+//                         (kFoggyRoomSpotPosition, intensity kFoggyRoomSpotIntensity) shines down
+//                         through a window in the partition (kFoggyRoomWindow) whose cross of
+//                         mullions splits its beam into four shafts, which cross the room towards
+//                         the camera and land on the floor. A pillar, a box and a sphere stand in
+//                         the beam and cast shadows through it. The partition hides the light
+//                         from the camera; the room is lit only by the shafts (irradiance about
+//                         3 pi where they land) and what they bring in. Lambertian, darker than
+//                         the other rooms so that the shafts stand out: grey walls, ceiling and
+//                         partition, a red -x wall, a blue +x wall, a brown floor, a stone pillar,
+//                         a wooden box, an ivory sphere.
+//  "glossy-objects"       Glossy interreflection: a room x and z in [-3, 3], y in [0, 4], open at
+//                         z = +3 towards the camera, lit by a kGlossyObjectsLightSide square
+//                         ceiling light of radiance kGlossyObjectsLightRadiance (direct irradiance
+//                         about pi at the floor's centre). On a Lambertian floor, between an orange
+//                         -x wall and a teal +x wall: a row of metal spheres of roughness 0.1
+//                         (gold), 0.2 (copper), 0.35 (steel) and 0.5 (aluminium; glTF's perceptual
+//                         roughness, GGX alpha its square), and in front of them a red plastic
+//                         sphere (0.2), a brushed-gold torus lying on the floor (0.3), a blue box
+//                         under a clear coat (coat 0.1 over a 0.6 base) and a green plastic sphere
+//                         (0.35): lobes on both sides of the BSDF's line between glossy and
+//                         diffuse (kGlossyRoughness, 0.4). No ideal mirror and no glass: every
+//                         reflection is glossy, and the objects reflect each other and the walls.
 #pragma once
 
 #include <array>
@@ -132,6 +160,33 @@ inline constexpr int kLargeCityDomeSubdivisions = 4;
 inline constexpr float kLargeCityLampHeight = 6.0f;
 inline constexpr int kLargeCityPointLights = 96;
 inline constexpr uint64_t kLargeCitySeed = 2018;
+
+/// "foggy-room": room, partition with its window [x0, x1, y0, y1], spot light and fog.
+inline constexpr float kFoggyRoomHalfWidth = 3.0f;
+inline constexpr float kFoggyRoomHeight = 3.2f;
+/// The partition's face towards the room; the light chamber lies behind it (smaller z).
+inline constexpr float kFoggyRoomPartitionZ = -1.5f;
+inline constexpr float kFoggyRoomPartitionThickness = 0.1f;
+inline constexpr std::array<float, 4> kFoggyRoomWindow{-1.6f, -0.2f, 1.0f, 2.1f};
+/// The mullions' width (a vertical and a horizontal bar across the window's middle).
+inline constexpr float kFoggyRoomMullion = 0.1f;
+inline constexpr Vec3 kFoggyRoomSpotPosition{-0.9f, 3.05f, -2.9f};
+/// Where the spot's axis points: through the window's centre.
+inline constexpr Vec3 kFoggyRoomSpotTarget{-0.9f, 1.55f, -1.55f};
+/// W/sr on the axis (warm white): irradiance about 3 pi where the shafts land through the fog,
+/// since the rest of the room is lit only by the light they bring.
+inline constexpr float kFoggyRoomSpotIntensity = 400.0f;
+inline constexpr float kFoggyRoomSpotInnerDeg = 26.0f;
+inline constexpr float kFoggyRoomSpotOuterDeg = 36.0f;
+inline constexpr float kFoggyRoomSigmaS = 0.1f;
+inline constexpr float kFoggyRoomSigmaA = 0.02f;
+inline constexpr float kFoggyRoomPhaseG = 0.4f;
+
+/// "glossy-objects": room and light.
+inline constexpr float kGlossyObjectsHalfWidth = 3.0f;
+inline constexpr float kGlossyObjectsHeight = 4.0f;
+inline constexpr float kGlossyObjectsLightSide = 1.6f;
+inline constexpr float kGlossyObjectsLightRadiance = 21.0f;
 
 /// The names make_builtin_scene accepts, in a fixed order.
 std::vector<std::string> builtin_scene_names();

@@ -6,11 +6,16 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <string>
 #include <vector>
 
+#include "core/accel/ray_tracer.h"
 #include "core/integrators/path.h"
+#include "core/material/bsdf.h"
+#include "core/math/rng.h"
+#include "core/math/sampling.h"
 #include "core/render/tile_renderer.h"
 #include "core/scene/scene_hash.h"
 #include "core/scene/shapes.h"
@@ -227,7 +232,8 @@ TEST(BuiltinScenes, NamesAreListedAndUnique) {
     const std::set<std::string> unique(names.begin(), names.end());
     EXPECT_EQ(unique.size(), names.size());
     for (const char* expected : {"cornell-box", "cornell-box-diffuse", "caustic", "caustic-area",
-                                 "furnace", "spheres-room", "sunlit-room", "large-city"}) {
+                                 "furnace", "spheres-room", "sunlit-room", "large-city",
+                                 "foggy-room", "glossy-objects"}) {
         EXPECT_TRUE(unique.contains(expected)) << expected;
     }
 }
@@ -619,18 +625,22 @@ TEST(BuiltinScenes, LargeCityHasTwoMillionTrianglesAndHundredsOfLightsOfVariedPo
     EXPECT_FALSE(scene.environment.has_value());
 }
 
-TEST(BuiltinScenes, SpheresRoomRendersFiniteAndFillsTheFrame) {
+/// A small path render of a built-in scene from its camera: every pixel finite and
+/// non-negative, the mean in a sane range, and the top and bottom rows not black (the camera
+/// frames the room, not the void beyond it).
+void expect_renders_and_fills_the_frame(const std::string& name, int size = 24, double min_mean = 0.02,
+                                        double min_edge_share = 0.05) {
     auto device = EmbreeDevice::create();
     ASSERT_TRUE(device.has_value()) << device.error().message;
-    auto scene = std::make_shared<const Scene>(build_or_die("spheres-room"));
+    auto scene = std::make_shared<const Scene>(build_or_die(name));
     auto render_scene = RenderScene::create(*device, scene);
     ASSERT_TRUE(render_scene.has_value()) << render_scene.error().message;
-    constexpr int kSize = 32;
+    const int kSize = size;
     auto camera = Camera::create(scene->cameras.at(0), kSize, kSize);
     ASSERT_TRUE(camera.has_value());
     PathIntegrator integrator(*render_scene);
     TileSettings settings;
-    settings.tile_size = 16;
+    settings.tile_size = kSize / 2;
     settings.samples_per_pixel = 8;
     settings.seed = 7;
     const TileRenderResult r = render_tiles(integrator, *camera, settings);
@@ -640,19 +650,207 @@ TEST(BuiltinScenes, SpheresRoomRendersFiniteAndFillsTheFrame) {
     for (int y = 0; y < kSize; ++y) {
         for (int x = 0; x < kSize; ++x) {
             const Color c = r.layers.beauty.pixels()[static_cast<size_t>(y) * kSize + x];
-            ASSERT_TRUE(std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z));
-            ASSERT_GE(min_component(c), 0.0f);
+            ASSERT_TRUE(std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z)) << name;
+            ASSERT_GE(min_component(c), 0.0f) << name;
             row_sum[y] += average(c);
         }
         total += row_sum[y];
     }
     const double mean = total / (kSize * kSize);
-    EXPECT_GT(mean, 0.05);
-    EXPECT_LT(mean, 5.0);
-    // The camera frames the room: the top and bottom rows see walls and floor, not the void
-    // outside the open front.
-    EXPECT_GT(row_sum.front() / kSize, 0.1 * mean);
-    EXPECT_GT(row_sum.back() / kSize, 0.1 * mean);
+    EXPECT_GT(mean, min_mean) << name;
+    EXPECT_LT(mean, 5.0) << name;
+    EXPECT_GT(row_sum.front() / kSize, min_edge_share * mean) << name;
+    EXPECT_GT(row_sum.back() / kSize, min_edge_share * mean) << name;
+}
+
+TEST(BuiltinScenes, SpheresRoomRendersFiniteAndFillsTheFrame) {
+    expect_renders_and_fills_the_frame("spheres-room", 32, 0.05, 0.1);
+}
+
+/// Lowest y of the triangles of one material.
+float lowest_y(const Scene& scene, uint32_t material) {
+    float lowest = std::numeric_limits<float>::infinity();
+    for (const glm::uvec3& t : triangles_of(scene, material)) {
+        for (uint32_t v : {t.x, t.y, t.z}) lowest = std::min(lowest, scene.positions[v].y);
+    }
+    return lowest;
+}
+
+TEST(BuiltinScenes, FoggyRoomIsClosedFoggyAndLitByASpotThroughTheWindow) {
+    const Scene scene = build_or_die("foggy-room");
+    // The fog is the scene's own (a job's atmosphere replaces it): it scatters forward, and its
+    // optical depth across the room is between 0.3 and 1, so that the shafts show and the room
+    // beyond them is not black.
+    ASSERT_TRUE(scene.atmosphere.has_value());
+    const HomogeneousMedium& fog = *scene.atmosphere;
+    EXPECT_TRUE(fog.scatters());
+    EXPECT_GE(fog.g, 0.3f);
+    EXPECT_LE(fog.g, 0.5f);
+    const float depth = max_component(fog.sigma_t()) * 2.0f * kFoggyRoomHalfWidth;
+    EXPECT_GT(depth, 0.3f);
+    EXPECT_LT(depth, 1.0f);
+    EXPECT_FALSE(scene.environment.has_value());
+    // One spot light; everything else Lambertian, nothing emits.
+    ASSERT_EQ(scene.lights.size(), 1u);
+    const PunctualLight& spot = scene.lights[0];
+    EXPECT_EQ(spot.type, PunctualLightType::Spot);
+    EXPECT_NEAR(glm::length(spot.direction), 1.0f, 1e-5f);
+    EXPECT_LT(spot.direction.y, -0.5f);  // down across the room
+    EXPECT_LT(spot.cos_outer, spot.cos_inner);
+    for (const Material& m : scene.materials) {
+        EXPECT_FALSE(m.is_emissive()) << m.name;
+        EXPECT_EQ(m.specular, 0.0f) << m.name;
+        EXPECT_EQ(m.metallic, 0.0f) << m.name;
+        EXPECT_EQ(m.transmission, 0.0f) << m.name;
+        EXPECT_EQ(m.roughness, 1.0f) << m.name;
+    }
+    for (const char* name :
+         {"white", "floor", "red", "blue", "plaster", "stone", "wood", "ivory"}) {
+        EXPECT_FALSE(triangles_of(scene, material_index(scene, name)).empty()) << name;
+    }
+    // The room's box is the scene's bounds, which the fog fills.
+    EXPECT_NEAR(scene.bounds.lower.x, -kFoggyRoomHalfWidth, 1e-5f);
+    EXPECT_NEAR(scene.bounds.upper.z, kFoggyRoomHalfWidth, 1e-5f);
+    EXPECT_NEAR(scene.bounds.lower.y, 0.0f, 1e-5f);
+    EXPECT_NEAR(scene.bounds.upper.y, kFoggyRoomHeight, 1e-5f);
+
+    auto device = EmbreeDevice::create();
+    ASSERT_TRUE(device.has_value()) << device.error().message;
+    auto tracer = RayTracer::build(*device, scene);
+    ASSERT_TRUE(tracer.has_value()) << tracer.error().message;
+    // Closed: rays from the camera in every direction hit a wall facing them (no light leaves
+    // the room, no ray sees the void).
+    const Vec3 eye = scene.cameras[0].position;
+    Rng rng(11, 0);
+    for (int i = 0; i < 2000; ++i) {
+        const Vec3 d = sample_uniform_sphere(rng.next_vec2());
+        const std::optional<Hit> hit = (*tracer)->intersect(Ray{eye, d});
+        ASSERT_TRUE(hit.has_value()) << "direction " << d.x << " " << d.y << " " << d.z;
+        EXPECT_LT(glm::dot(scene.triangle_normal(hit->triangle), d), 0.0f);
+    }
+    // The light is in the chamber behind the partition, hidden from the camera.
+    EXPECT_LT(spot.position.z, kFoggyRoomPartitionZ - kFoggyRoomPartitionThickness);
+    EXPECT_TRUE((*tracer)->occluded(Ray{eye, spot.position - eye, 1e-4f, 0.999f}));
+    // Its axis points at the window (at the cross of the mullions), each pane inside the inner
+    // cone, and through each pane a shaft crosses the room in front of the partition.
+    const float t_window = (kFoggyRoomPartitionZ - spot.position.z) / spot.direction.z;
+    const Vec3 through = spot.position + t_window * spot.direction;
+    EXPECT_GT(through.x, kFoggyRoomWindow[0]);
+    EXPECT_LT(through.x, kFoggyRoomWindow[1]);
+    EXPECT_GT(through.y, kFoggyRoomWindow[2]);
+    EXPECT_LT(through.y, kFoggyRoomWindow[3]);
+    const float mx = 0.5f * (kFoggyRoomWindow[0] + kFoggyRoomWindow[1]);
+    const float my = 0.5f * (kFoggyRoomWindow[2] + kFoggyRoomWindow[3]);
+    double e = 0.0;
+    for (float x : {0.5f * (kFoggyRoomWindow[0] + mx), 0.5f * (mx + kFoggyRoomWindow[1])}) {
+        for (float y : {0.5f * (kFoggyRoomWindow[2] + my), 0.5f * (my + kFoggyRoomWindow[3])}) {
+            const Vec3 to_pane = glm::normalize(Vec3(x, y, kFoggyRoomPartitionZ) - spot.position);
+            EXPECT_GT(glm::dot(to_pane, spot.direction), spot.cos_inner) << x << " " << y;
+            const std::optional<Hit> hit = (*tracer)->intersect(Ray{spot.position, to_pane});
+            ASSERT_TRUE(hit.has_value());
+            EXPECT_GT((spot.position + hit->t * to_pane).z, kFoggyRoomPartitionZ) << x << " " << y;
+            // The spot's irradiance through the fog where the shaft meets the floor's plane.
+            const float d = -spot.position.y / to_pane.y;
+            e += 0.25 * luminance(spot.intensity) * -to_pane.y / (d * d) *
+                 luminance(fog.transmittance(d));
+        }
+    }
+    // Well exposed: about 3 pi where the shafts land, since the rest of the room is lit only by
+    // the light they bring (the image's mean is then about that of sunlit-room).
+    EXPECT_GT(e, 2.5 * kPi);
+    EXPECT_LT(e, 3.5 * kPi);
+    std::printf(
+        "[ info ] foggy-room: optical depth %.2f across the room, irradiance / pi %.3f "
+        "where the shafts land\n",
+        depth, e / kPi);
+}
+
+TEST(BuiltinScenes, GlossyObjectsAreGlossyMetalsAndPlasticsUnderACeilingLight) {
+    const Scene scene = build_or_die("glossy-objects");
+    EXPECT_TRUE(scene.lights.empty());
+    EXPECT_FALSE(scene.environment.has_value());
+    EXPECT_FALSE(scene.atmosphere.has_value());
+    // Metals at four roughnesses, two plastics, a coated box and a torus: all glossy, no ideal
+    // mirror and no glass.
+    struct Object {
+        const char* name;
+        float metallic, roughness, clearcoat;
+    };
+    const Object objects[] = {
+        {"gold", 1.0f, 0.1f, 0.0f},           {"copper", 1.0f, 0.2f, 0.0f},
+        {"steel", 1.0f, 0.35f, 0.0f},         {"aluminium", 1.0f, 0.5f, 0.0f},
+        {"brushed-gold", 1.0f, 0.3f, 0.0f},   {"red-plastic", 0.0f, 0.2f, 0.0f},
+        {"green-plastic", 0.0f, 0.35f, 0.0f}, {"blue-coated", 0.0f, 0.6f, 1.0f}};
+    for (const Object& o : objects) {
+        const uint32_t index = material_index(scene, o.name);
+        const Material& m = scene.materials[index];
+        EXPECT_EQ(m.metallic, o.metallic) << o.name;
+        EXPECT_EQ(m.roughness, o.roughness) << o.name;
+        EXPECT_EQ(m.clearcoat, o.clearcoat) << o.name;
+        EXPECT_GT(m.specular, 0.0f) << o.name;
+        // Resting on the floor.
+        EXPECT_NEAR(lowest_y(scene, index), 0.0f, 1e-4f) << o.name;
+    }
+    EXPECT_GT(scene.materials[material_index(scene, "blue-coated")].clearcoat_roughness,
+              kDeltaRoughness);
+    EXPECT_LT(scene.materials[material_index(scene, "blue-coated")].clearcoat_roughness,
+              kGlossyRoughness);
+    bool glossy = false, rough = false;
+    for (const Material& m : scene.materials) {
+        EXPECT_EQ(m.transmission, 0.0f) << m.name;
+        EXPECT_GT(m.roughness, kDeltaRoughness) << m.name;
+        if (m.specular > 0.0f) {
+            glossy |= m.roughness < kGlossyRoughness;
+            rough |= m.roughness >= kGlossyRoughness && m.metallic == 1.0f;
+        }
+    }
+    // Both sides of the photon passes' line: lobes that count as glossy and a metal that counts
+    // as diffuse.
+    EXPECT_TRUE(glossy);
+    EXPECT_TRUE(rough);
+    // Coloured Lambertian walls.
+    for (const char* wall : {"white", "floor", "orange", "teal"}) {
+        const Material& m = scene.materials[material_index(scene, wall)];
+        EXPECT_EQ(m.specular, 0.0f) << wall;
+        EXPECT_EQ(m.metallic, 0.0f) << wall;
+        EXPECT_EQ(m.roughness, 1.0f) << wall;
+        EXPECT_FALSE(m.is_emissive()) << wall;
+    }
+    // Closed, outward-facing spheres and torus.
+    for (const char* sphere :
+         {"gold", "copper", "steel", "aluminium", "red-plastic", "green-plastic"}) {
+        expect_closed_outward_sphere(scene, sphere);
+    }
+    const std::vector<glm::uvec3> torus =
+        triangles_of(scene, material_index(scene, "brushed-gold"));
+    EXPECT_TRUE(is_watertight(torus));
+    EXPECT_GT(min_normal_agreement(scene.positions, scene.normals, torus), 0.9f);
+    // 2 pi^2 R r^2 for the major radius 0.5 and the minor 0.16 (the tessellation is a little
+    // smaller).
+    EXPECT_NEAR(signed_volume(scene.positions, torus), 2.0 * kPi * kPi * 0.5 * 0.16 * 0.16, 0.01);
+    // One light: the ceiling square, facing down, just below the ceiling.
+    double light_area = 0.0;
+    for (uint32_t i = 0; i < scene.triangles.size(); ++i) {
+        if (!scene.materials[scene.triangle_materials[i]].is_emissive()) continue;
+        light_area += scene.triangle_area(i);
+        EXPECT_LT(scene.triangle_normal(i).y, -0.9999f);
+        for (uint32_t v : {scene.triangles[i].x, scene.triangles[i].y, scene.triangles[i].z}) {
+            EXPECT_NEAR(scene.positions[v].y, kGlossyObjectsHeight, 0.02f);
+        }
+    }
+    EXPECT_NEAR(light_area, kGlossyObjectsLightSide * kGlossyObjectsLightSide, 1e-5);
+    // Well exposed: direct irradiance about pi at the floor's centre (ignoring the objects).
+    const float e = luminance(direct_irradiance(scene, Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f)));
+    EXPECT_GT(e, 0.85f * kPi);
+    EXPECT_LT(e, 1.15f * kPi);
+    EXPECT_NEAR(scene.bounds.upper.y, kGlossyObjectsHeight, 1e-5f);
+    EXPECT_NEAR(scene.bounds.lower.x, -kGlossyObjectsHalfWidth, 1e-5f);
+}
+
+
+TEST(BuiltinScenes, FoggyRoomAndGlossyObjectsRenderFiniteAndFillTheFrame) {
+    expect_renders_and_fills_the_frame("foggy-room");
+    expect_renders_and_fills_the_frame("glossy-objects");
 }
 
 }  // namespace

@@ -427,6 +427,34 @@ TEST_F(PhotondRender, DeeplyNestedJobsAndGltfFilesAreRefusedByName) {
     EXPECT_FALSE(fs::exists(dir_ / "g.exr"));
 }
 
+TEST_F(PhotondRender, RadianceCacheIsAPassThePlanAndTheStatisticsAccountFor) {
+    // builtin:glossy-objects: the aluminium sphere (roughness 0.5) is cached, the sharper metals
+    // keep their rays; the plan names both, the pass is timed, and the passes still add up.
+    const std::string common = "render builtin:glossy-objects --preset preview --width 96 --height 64 --threads 2 ";
+    const auto on = run(common + "--set radiance_cache.enabled=true --stats-json " + (dir_ / "on.json").string() +
+                        " -o " + (dir_ / "on.exr").string());
+    ASSERT_EQ(on.exit_code, 0) << on.output;
+    EXPECT_NE(on.output.find("plan: radiance_cache run"), std::string::npos) << on.output;
+    EXPECT_NE(on.output.find("cached in 8 bands: 'aluminium'"), std::string::npos) << on.output;
+    EXPECT_NE(on.output.find("sharper than 16 bands resolve): 'gold'"), std::string::npos) << on.output;
+    const json stats = json::parse(read_file(dir_ / "on.json"));
+    EXPECT_GT(stats.at("radiance_cache").at("records").get<uint64_t>(), 10u);
+    EXPECT_GT(stats.at("radiance_cache").at("interpolated_share").get<double>(), 0.9);
+    double sum = 0.0;
+    bool timed = false;
+    for (const json& pass : stats.at("passes")) {
+        sum += pass.at("seconds").get<double>();
+        timed = timed || pass.at("name") == "radiance_cache";
+    }
+    EXPECT_TRUE(timed) << stats.at("passes").dump();
+    EXPECT_NEAR(sum, stats.at("total_seconds").get<double>(), 0.02 * stats.at("total_seconds").get<double>());
+    // Off (the presets' default): the plan says so and no records are made.
+    const auto off = run(common + "--stats-json " + (dir_ / "off.json").string() + " -o " + (dir_ / "off.exr").string());
+    ASSERT_EQ(off.exit_code, 0) << off.output;
+    EXPECT_NE(off.output.find("plan: radiance_cache skipped  the job leaves it off"), std::string::npos) << off.output;
+    EXPECT_FALSE(json::parse(read_file(dir_ / "off.json")).contains("radiance_cache"));
+}
+
 TEST_F(PhotondRender, ACausticMapThatWouldNotShowIsDroppedAndThePlanSaysSo) {
     // A wide mirror reflecting 0.1 % of the light: its caustic is under a thousandth of the light
     // where it lands (tests/data/gltf/generate.py).
