@@ -287,7 +287,7 @@ struct Job {
     OutputSpec output;
     EnvironmentSpec environment;
     std::vector<LightSpec> lights;
-    std::optional<AtmosphereSpec> atmosphere;  // absent (or null in the document): none
+    std::optional<AtmosphereSpec> atmosphere;  // absent (or null in the document): the scene's own (builtin:foggy-room has one)
     // By material name (a std::map: a deterministic order); absent, null or {}: none.
     std::map<std::string, MaterialMediumSpec> material_media;
     int priority = 0;
