@@ -552,6 +552,20 @@ TEST(BuiltinScenes, CamerasLookAtTheirScenes) {
     EXPECT_NEAR(std::asin(-forward.y), glm::radians(30.0f), 1e-3f);  // looking down at 30 deg
 }
 
+/// The scene's only light is a square of side `side` just below the ceiling at `height`, facing down.
+void expect_one_ceiling_light(const Scene& scene, float height, float side) {
+    double light_area = 0.0;
+    for (uint32_t i = 0; i < scene.triangles.size(); ++i) {
+        if (!scene.materials[scene.triangle_materials[i]].is_emissive()) continue;
+        light_area += scene.triangle_area(i);
+        EXPECT_LT(scene.triangle_normal(i).y, -0.9999f);
+        for (uint32_t v : {scene.triangles[i].x, scene.triangles[i].y, scene.triangles[i].z}) {
+            EXPECT_NEAR(scene.positions[v].y, height, 0.02f);
+        }
+    }
+    EXPECT_NEAR(light_area, side * side, 1e-5);
+}
+
 TEST(BuiltinScenes, SpheresRoomIsLargeLambertianAndLitFromTheCeiling) {
     const Scene scene = build_or_die("spheres-room");
     // The benchmark's large scene: at least 100 000 triangles (20 spheres of 5120, 10 boxes of
@@ -567,17 +581,7 @@ TEST(BuiltinScenes, SpheresRoomIsLargeLambertianAndLitFromTheCeiling) {
         EXPECT_EQ(m.roughness, 1.0f) << m.name;
         EXPECT_LE(max_component(m.base_color), 0.8f) << m.name;
     }
-    // One light: the ceiling square, facing down, just below the ceiling.
-    double light_area = 0.0;
-    for (uint32_t i = 0; i < scene.triangles.size(); ++i) {
-        if (!scene.materials[scene.triangle_materials[i]].is_emissive()) continue;
-        light_area += scene.triangle_area(i);
-        EXPECT_LT(scene.triangle_normal(i).y, -0.9999f);
-        for (uint32_t v : {scene.triangles[i].x, scene.triangles[i].y, scene.triangles[i].z}) {
-            EXPECT_NEAR(scene.positions[v].y, kSpheresRoomHeight, 0.02f);
-        }
-    }
-    EXPECT_NEAR(light_area, kSpheresRoomLightSide * kSpheresRoomLightSide, 1e-5);
+    expect_one_ceiling_light(scene, kSpheresRoomHeight, kSpheresRoomLightSide);
     EXPECT_NEAR(area_light_power(scene),
                 kPi * kSpheresRoomLightRadiance * kSpheresRoomLightSide * kSpheresRoomLightSide,
                 1e-3);
@@ -828,17 +832,7 @@ TEST(BuiltinScenes, GlossyObjectsAreGlossyMetalsAndPlasticsUnderACeilingLight) {
     // 2 pi^2 R r^2 for the major radius 0.5 and the minor 0.16 (the tessellation is a little
     // smaller).
     EXPECT_NEAR(signed_volume(scene.positions, torus), 2.0 * kPi * kPi * 0.5 * 0.16 * 0.16, 0.01);
-    // One light: the ceiling square, facing down, just below the ceiling.
-    double light_area = 0.0;
-    for (uint32_t i = 0; i < scene.triangles.size(); ++i) {
-        if (!scene.materials[scene.triangle_materials[i]].is_emissive()) continue;
-        light_area += scene.triangle_area(i);
-        EXPECT_LT(scene.triangle_normal(i).y, -0.9999f);
-        for (uint32_t v : {scene.triangles[i].x, scene.triangles[i].y, scene.triangles[i].z}) {
-            EXPECT_NEAR(scene.positions[v].y, kGlossyObjectsHeight, 0.02f);
-        }
-    }
-    EXPECT_NEAR(light_area, kGlossyObjectsLightSide * kGlossyObjectsLightSide, 1e-5);
+    expect_one_ceiling_light(scene, kGlossyObjectsHeight, kGlossyObjectsLightSide);
     // Well exposed: direct irradiance about pi at the floor's centre (ignoring the objects).
     const float e = luminance(direct_irradiance(scene, Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f)));
     EXPECT_GT(e, 0.85f * kPi);
