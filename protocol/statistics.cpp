@@ -56,9 +56,8 @@ nlohmann::json to_json(const RenderStatistics& s) {
         if (!s.photon_cache.empty()) result["photons"]["cache"] = s.photon_cache;
         if (!s.photon_map_key.empty()) result["photons"]["key"] = s.photon_map_key;
     }
-    if (s.irradiance_cache) {
-        const auto& c = *s.irradiance_cache;
-        result["irradiance_cache"] = {
+    const auto cache_json = [](const RenderStatistics::CacheFigures& c) {
+        return nlohmann::json{
             {"records", c.records},
             {"waves", c.waves},
             {"lookups", c.lookups},
@@ -66,6 +65,10 @@ nlohmann::json to_json(const RenderStatistics& s) {
             {"interpolated_share", c.interpolated_share()},
             {"seconds", c.seconds},
         };
+    };
+    if (s.irradiance_cache) {
+        const auto& c = *s.irradiance_cache;
+        result["irradiance_cache"] = cache_json(c);
         if (!c.cache.empty()) result["irradiance_cache"]["cache"] = c.cache;
         if (!c.key.empty()) result["irradiance_cache"]["key"] = c.key;
         if (!c.start_from.empty()) {
@@ -73,17 +76,7 @@ nlohmann::json to_json(const RenderStatistics& s) {
             result["irradiance_cache"]["records_reused"] = c.records_reused;
         }
     }
-    if (s.radiance_cache) {
-        const auto& c = *s.radiance_cache;
-        result["radiance_cache"] = {
-            {"records", c.records},
-            {"waves", c.waves},
-            {"lookups", c.lookups},
-            {"misses", c.misses},
-            {"interpolated_share", c.interpolated_share()},
-            {"seconds", c.seconds},
-        };
-    }
+    if (s.radiance_cache) result["radiance_cache"] = cache_json(*s.radiance_cache);
     if (s.preview) {
         const auto& p = *s.preview;
         result["preview"] = {{"stride", p.stride}, {"samples", p.samples}, {"tiles", p.tiles}, {"seconds", p.seconds}};

@@ -125,8 +125,7 @@ std::optional<PassDecision> radiance_cache_decision(const protocol::RenderSettin
     if (settings.integrator != "photon-map") return std::nullopt;
     const RadianceCacheSettings& cache = settings.photon_map.radiance_cache;
     const Scene& scene = *rs.scene;
-    std::vector<bool> used(scene.materials.size(), false);
-    for (uint32_t t = 0; t < scene.triangles.size(); ++t) used[scene.triangle_materials[t]] = true;
+    const std::vector<bool> used = scene.materials_in_use();
     // Material names grouped by what becomes of their glossy lobes, in the scene's order.
     std::map<std::string, std::vector<std::string>> groups;
     std::vector<std::string> order;

@@ -44,8 +44,11 @@ PhotonMapIntegrator::PhotonMapIntegrator(std::shared_ptr<const RenderScene> scen
     direct_lights_ = gatherer_ && scene_->lights_with_sky_peaks ? scene_->lights_with_sky_peaks.get()
                                                                   : scene_->lights.get();
     if (gatherer_ && settings_.radiance_cache.enabled) {
-        for (const BsdfMaterial& material : scene_->bsdf_materials)
-            uses_radiance_cache_ = uses_radiance_cache_ || radiance_order_for(material, settings_.radiance_cache) > 0;
+        // The materials the plan's radiance_cache line lists: those some triangle shows.
+        const std::vector<bool> used = scene_->scene->materials_in_use();
+        for (size_t i = 0; i < used.size() && i < scene_->bsdf_materials.size(); ++i)
+            uses_radiance_cache_ = uses_radiance_cache_ ||
+                                   (used[i] && radiance_order_for(scene_->bsdf_materials[i], settings_.radiance_cache) > 0);
     }
 }
 

@@ -14,10 +14,7 @@ const PassDecision* RenderPlan::find(std::string_view pass) const {
 SceneLightPaths analyse_light_paths(const Scene& scene, const LightSet& lights) {
     SceneLightPaths paths;
     paths.has_light = !lights.empty() && max_component(lights.total_power()) > 0.0f;
-    std::vector<bool> used(scene.materials.size(), false);
-    for (uint32_t t = 0; t < scene.triangles.size(); ++t) {
-        if (scene.triangle_area(t) > 0.0f) used[scene.triangle_materials[t]] = true;
-    }
+    const std::vector<bool> used = scene.materials_in_use();
     for (size_t i = 0; i < scene.materials.size(); ++i) {
         if (!used[i]) continue;
         const Material& m = scene.materials[i];

@@ -56,34 +56,30 @@ struct RenderStatistics {
     std::string photon_cache;
     std::string photon_map_key;
 
-    /// The irradiance cache, when final gathering used one.
-    struct IrradianceCacheFigures {
+    /// A cache of records filled before the render pass and read by it.
+    struct CacheFigures {
         uint64_t records = 0;
         int waves = 0;
         uint64_t lookups = 0;  // render pass
-        uint64_t misses = 0;   // lookups no record covered (gathered on the spot)
+        uint64_t misses = 0;   // lookups no record covered (gathered or sampled on the spot)
         double seconds = 0.0;  // the prepass that placed the records (0 when taken from a store)
+        double interpolated_share() const {
+            return lookups > 0 ? 1.0 - static_cast<double>(misses) / static_cast<double>(lookups) : 0.0;
+        }
+    };
+
+    /// The irradiance cache, when final gathering used one.
+    struct IrradianceCacheFigures : CacheFigures {
         std::string cache;     // "hit" when taken from the render-cache store, "miss" when built
         std::string key;       // its render-cache key (with a store)
         std::string start_from;       // the key of the cache it started from, if any
         uint64_t records_reused = 0;  // records taken from that cache
-        double interpolated_share() const {
-            return lookups > 0 ? 1.0 - static_cast<double>(misses) / static_cast<double>(lookups) : 0.0;
-        }
     };
     std::optional<IrradianceCacheFigures> irradiance_cache;
 
-    /// The radiance cache, when glossy lobes read one (core/integrators/radiance_cache.h).
-    struct RadianceCacheFigures {
-        uint64_t records = 0;
-        int waves = 0;
-        uint64_t lookups = 0;  // glossy points of the render pass that asked it
-        uint64_t misses = 0;   // ... that no record covered (BSDF-sampled rays instead)
-        double seconds = 0.0;
-        double interpolated_share() const {
-            return lookups > 0 ? 1.0 - static_cast<double>(misses) / static_cast<double>(lookups) : 0.0;
-        }
-    };
+    /// The radiance cache, when glossy lobes read one (core/integrators/radiance_cache.h): its
+    /// lookups are glossy points, its misses those that took BSDF-sampled rays instead.
+    using RadianceCacheFigures = CacheFigures;
     std::optional<RadianceCacheFigures> radiance_cache;
 
     /// The progressive preview (core/render/preview_renderer.h), when one was rendered.

@@ -179,6 +179,14 @@ float Scene::triangle_area(uint32_t triangle) const {
                                          positions[t.z] - positions[t.x]));
 }
 
+std::vector<bool> Scene::materials_in_use() const {
+    std::vector<bool> used(materials.size(), false);
+    for (uint32_t t = 0; t < triangles.size(); ++t) {
+        if (triangle_area(t) > 0.0f) used[triangle_materials[t]] = true;
+    }
+    return used;
+}
+
 void Scene::derive_triangle_data() {
     triangle_normals.resize(triangles.size());
     flat_shaded.resize(triangles.size());

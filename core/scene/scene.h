@@ -285,6 +285,8 @@ struct Scene {
     /// One texture reference read at a point, with the footprint of its slot.
     Vec4 sample(const TextureRef& ref, const TexturePoint& tp) const;
     float triangle_area(uint32_t triangle) const;
+    /// Per material: whether a triangle of positive area uses it (what can show or carry light).
+    std::vector<bool> materials_in_use() const;
     Vec3 triangle_normal(uint32_t triangle) const {  // geometric, unit (zero for degenerate)
         return triangle_normals[triangle];
     }
