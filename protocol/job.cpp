@@ -54,15 +54,10 @@ void check_irradiance_cache(const IrradianceCacheSpec& cache) {
     }
 }
 
-/// Media inside solids: photon-map traces no photons through them, and direct's light samples
-/// stop at the solids' surfaces, so no light scattered inside them reaches it; both refuse the job.
+/// Media inside solids: direct's light samples stop at the solids' surfaces, so no light
+/// scattered inside them reaches it; it refuses the job (path and photon-map render them).
 void check_material_media(const Job& job) {
     if (job.material_media.empty()) return;
-    if (job.integrator == "photon-map") {
-        fail("material_media",
-             "integrator \"photon-map\" does not render media inside solids yet (its volume photon map holds "
-             "the atmosphere's light only); use \"path\" (the reference)");
-    }
     if (job.integrator == "direct") {
         fail("material_media",
              "integrator \"direct\" renders no light scattered inside solids (their surfaces block its light "

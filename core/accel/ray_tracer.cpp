@@ -122,6 +122,64 @@ Expected<std::unique_ptr<RayTracer>> RayTracer::build(std::shared_ptr<EmbreeDevi
     return tracer;
 }
 
+namespace {
+
+/// The point of triangle (a, b, c) closest to p (Ericson, "Real-Time Collision Detection",
+/// 2005, section 5.1.5: the Voronoi regions of the vertices, then the edges, then the face).
+Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+    const Vec3 ab = b - a, ac = c - a, ap = p - a;
+    const float d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
+    if (d1 <= 0.0f && d2 <= 0.0f) return a;
+    const Vec3 bp = p - b;
+    const float d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
+    if (d3 >= 0.0f && d4 <= d3) return b;
+    const float vc = d1 * d4 - d3 * d2;
+    if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f) return a + ab * (d1 / (d1 - d3));
+    const Vec3 cp = p - c;
+    const float d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
+    if (d6 >= 0.0f && d5 <= d6) return c;
+    const float vb = d5 * d2 - d1 * d6;
+    if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) return a + ac * (d2 / (d2 - d6));
+    const float va = d3 * d6 - d5 * d4;
+    if (va <= 0.0f && d4 - d3 >= 0.0f && d5 - d6 >= 0.0f) return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    const float denominator = 1.0f / (va + vb + vc);
+    return a + ab * (vb * denominator) + ac * (vc * denominator);
+}
+
+struct ClosestPointQuery {
+    const Scene* scene;
+    const std::vector<uint32_t>* reported;  // per geometry, as RayTracer::reported_; null: identity
+};
+
+bool closest_point_callback(RTCPointQueryFunctionArguments* args) {
+    const auto* query = static_cast<const ClosestPointQuery*>(args->userPtr);
+    const uint32_t triangle = query->reported ? query->reported[args->geomID][args->primID] : args->primID;
+    const glm::uvec3& tri = query->scene->triangles[triangle];
+    const Vec3 p(args->query->x, args->query->y, args->query->z);
+    const std::vector<Vec3>& positions = query->scene->positions;
+    const float distance = glm::length(p - closest_point_on_triangle(p, positions[tri.x], positions[tri.y], positions[tri.z]));
+    if (!(distance < args->query->radius)) return false;
+    args->query->radius = distance;
+    return true;
+}
+
+}  // namespace
+
+float RayTracer::distance_to_surface(const Vec3& p, float max_distance) const {
+    if (subset_ || !(max_distance > 0.0f) || !is_finite(p)) return max_distance;
+    RTCPointQuery query;
+    query.x = p.x;
+    query.y = p.y;
+    query.z = p.z;
+    query.time = 0.0f;
+    query.radius = max_distance;
+    RTCPointQueryContext context;
+    rtcInitPointQueryContext(&context);
+    ClosestPointQuery user{scene_, has_alpha_geometry_ ? reported_ : nullptr};
+    rtcPointQuery(rtc_scene_, &query, &context, &closest_point_callback, &user);
+    return std::min(query.radius, max_distance);
+}
+
 RayTracer::~RayTracer() {
     if (rtc_scene_) rtcReleaseScene(rtc_scene_);
 }

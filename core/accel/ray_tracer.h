@@ -96,6 +96,11 @@ public:
     /// Whether anything lies in [tmin, tmax] (from_viewpoint is not looked at).
     bool occluded(const Ray& ray) const;
 
+    /// The distance from p to the nearest point of any triangle, when it is below
+    /// `max_distance`; else max_distance (Embree's closest-point query). Alpha is not looked at.
+    /// For a tracer of all the scene's triangles (not a subset).
+    float distance_to_surface(const Vec3& p, float max_distance) const;
+
     /// The ray of a camera at `origin`: no offset (a camera position is exact, unlike a computed
     /// hit point), and from_viewpoint set.
     static Ray viewpoint_ray(const Vec3& origin, const Vec3& direction) {

@@ -97,6 +97,15 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
                     }
                 }
             }
+            // Inside a solid that scatters: all the light its inside sends (the volume map's photons
+            // there); from_surface attenuates what lies beyond (volume_transmittance).
+            if (hit_point && g.maps_->volume && rs.scattering_interiors) {
+                if (const std::optional<HomogeneousMedium> interior = scattering_interior(*rs.scene, *hit_point)) {
+                    SampleContext context{rng, counters};
+                    in_scattered += interior_in_scattering(rs, *g.maps_->volume, *interior, r, *hit_point,
+                                                           g.settings_.k_volume, g.settings_.max_radius, 1, context);
+                }
+            }
             const Color beyond = from_surface(r, hit_point ? &*hit_point : nullptr, depth, first, glossy_bounces, from);
             if (first && emission) {
                 emission->radiance *= fog;  // the emitter is seen through the atmosphere too

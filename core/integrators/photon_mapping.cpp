@@ -246,6 +246,13 @@ RadianceParts PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, flo
     // The camera's ray cone, widened along ideal specular bounces, picks the texture level.
     if (hit) hit_point = make_interaction(*rs.scene, *hit, ray.direction, footprint.at(path_length + hit->t));
     RadianceParts radiance = surface_radiance(ray, hit_point ? &*hit_point : nullptr, depth, path_length, footprint, context);
+    // Inside a solid that scatters, all its light comes from the volume map (light samples from
+    // inside are blocked by its surface); surface_radiance attenuated what lies beyond.
+    if (hit_point && maps_->volume && rs.scattering_interiors) {
+        if (const std::optional<HomogeneousMedium> interior = scattering_interior(*rs.scene, *hit_point))
+            radiance.add_indirect(interior_in_scattering(rs, *maps_->volume, *interior, ray, *hit_point,
+                                                         settings_.k_volume, global_options_.max_radius, 1, context));
+    }
     const std::optional<HomogeneousMedium>& atmosphere = rs.scene->atmosphere;
     if (!atmosphere) return radiance;
     // The atmosphere on the way: what lies beyond is seen through it; it sends the light it

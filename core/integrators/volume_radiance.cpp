@@ -13,4 +13,27 @@ Color volume_in_scattering(const PhotonMap& volume, const HomogeneousMedium& med
     return sum;
 }
 
+std::optional<HomogeneousMedium> scattering_interior(const Scene& scene, const SurfaceInteraction& si) {
+    if (!segment_inside_solid(scene, si)) return std::nullopt;
+    const Material& material = scene.materials[si.material];
+    if (!material.interior_scatters()) return std::nullopt;
+    return material.interior_medium();
+}
+
+Color interior_in_scattering(const RenderScene& rs, const PhotonMap& volume, const HomogeneousMedium& medium,
+                             const Ray& ray, const SurfaceInteraction& si, uint32_t k, float max_radius, int points,
+                             SampleContext& context) {
+    Color sum(0.0f);
+    const MediumSpan span{ray.tmin, si.distance};
+    if (span.empty()) return sum;
+    // The surface matters within an estimate's radius; farther is all the same.
+    const float reach = max_radius > 0.0f ? max_radius : rs.scene->bounds.radius();
+    march_through_medium(medium, ray, span, points, context, [&](const Vec3& x, const Color& weight) {
+        const float surface = rs.tracer->distance_to_surface(x, reach);
+        sum += weight * volume.estimate_in_scattering(x, -ray.direction, medium.g, k, max_radius, 0, nullptr, true,
+                                                      surface < reach ? surface : std::numeric_limits<float>::infinity());
+    });
+    return sum;
+}
+
 }  // namespace photond

@@ -1,6 +1,8 @@
-// The atmosphere's in-scattered light from the volume photon map along a ray segment (Jensen &
-// Christensen 1998): the photon-map integrator's camera rays take the multiple scattering from
-// it (their single scattering from light samples, single_scattering), its gather rays all of it.
+// The in-scattered light from the volume photon map along a ray segment (Jensen & Christensen
+// 1998). In the atmosphere the photon-map integrator's camera rays take the multiple scattering
+// from it (their single scattering from light samples, single_scattering), its gather rays all
+// of it. Inside a solid that scatters (Material::interior_scatters) every ray takes all of it:
+// light samples from inside are blocked by the solid's surface.
 #pragma once
 
 #include "core/integrators/integrator.h"
@@ -18,5 +20,16 @@ namespace photond {
 Color volume_in_scattering(const PhotonMap& volume, const HomogeneousMedium& medium, const Bounds3* medium_bounds,
                            const Ray& ray, const MediumSpan& span, uint32_t k, float max_radius, uint8_t exclude_flags,
                            int points, SampleContext& context);
+
+/// The medium of the solid a ray segment ending at `si` ran inside, when that solid scatters.
+std::optional<HomogeneousMedium> scattering_interior(const Scene& scene, const SurfaceInteraction& si);
+
+/// All the light the scattering solid whose inside the ray (unit direction) crossed up to `si`
+/// sends towards its origin: volume_in_scattering over [ray.tmin, si.distance] from the map's
+/// photons inside solids (photon_flags::kInterior), each sphere cut by the solid's surface as a
+/// plane at its nearest point (RayTracer::distance_to_surface). Not attenuated by what lies before.
+Color interior_in_scattering(const RenderScene& rs, const PhotonMap& volume, const HomogeneousMedium& medium,
+                             const Ray& ray, const SurfaceInteraction& si, uint32_t k, float max_radius, int points,
+                             SampleContext& context);
 
 }  // namespace photond

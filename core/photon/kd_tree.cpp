@@ -226,7 +226,17 @@ Expected<PhotonKdTree> PhotonKdTree::from_tree_order(std::vector<Photon> photons
 }
 
 void PhotonKdTree::k_nearest(const Vec3& p, uint32_t k, float max_radius, KnnResult& out) const {
-    k_nearest_impl(p, k, max_radius, out, [&p](const Vec3& q) { return distance2(p, q); });
+    k_nearest_impl(p, k, max_radius, out, [&p](const Vec3& q) { return distance2(p, q); },
+                   [](const Photon&) { return true; });
+}
+
+void PhotonKdTree::k_nearest_flagged(const Vec3& p, uint32_t k, float max_radius, uint8_t required_flags,
+                                     uint8_t excluded_flags, KnnResult& out) const {
+    k_nearest_impl(p, k, max_radius, out, [&p](const Vec3& q) { return distance2(p, q); },
+                   [required_flags, excluded_flags](const Photon& photon) {
+                       const uint8_t flags = photon.user_flags();
+                       return (flags & required_flags) == required_flags && (flags & excluded_flags) == 0;
+                   });
 }
 
 void PhotonKdTree::k_nearest_in_disc(const Vec3& p, const Vec3& normal, float flattening,
@@ -238,12 +248,12 @@ void PhotonKdTree::k_nearest_in_disc(const Vec3& p, const Vec3& normal, float fl
     }
     k_nearest_impl(p, k, max_radius, out, [&](const Vec3& q) {
         return disc_distance2(p, q, normal, stretch2);
-    });
+    }, [](const Photon&) { return true; });
 }
 
-template <class Distance2>
+template <class Distance2, class Accept>
 void PhotonKdTree::k_nearest_impl(const Vec3& p, uint32_t k, float max_radius, KnnResult& out,
-                                  Distance2 distance2_to) const {
+                                  Distance2 distance2_to, Accept accept) const {
     // distance2_to(q) >= distance2(p, q) for every q: a subtree beyond the splitting plane by
     // more than the current radius holds no closer photon in either metric.
     out.clear();
@@ -288,7 +298,7 @@ void PhotonKdTree::k_nearest_impl(const Vec3& p, uint32_t k, float max_radius, K
         while (hi - lo > kLeafSize) {
             const uint32_t mid = lo + (hi - lo) / 2;
             const Photon& node = photons_[mid];
-            consider(mid, distance2_to(node.position));
+            if (accept(node)) consider(mid, distance2_to(node.position));
             const uint32_t axis = node.split_axis();
             const float plane = p[axis] - node.position[axis];
             const float plane2 = plane * plane;
@@ -300,7 +310,8 @@ void PhotonKdTree::k_nearest_impl(const Vec3& p, uint32_t k, float max_radius, K
                 lo = mid + 1;
             }
         }
-        for (uint32_t i = lo; i < hi; ++i) consider(i, distance2_to(photons_[i].position));
+        for (uint32_t i = lo; i < hi; ++i)
+            if (accept(photons_[i])) consider(i, distance2_to(photons_[i].position));
     }
     out.radius2 = full ? heap[0].dist2 : farthest2;
 }

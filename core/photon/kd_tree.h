@@ -91,6 +91,12 @@ public:
     void k_nearest_in_disc(const Vec3& p, const Vec3& normal, float flattening, uint32_t k,
                            float max_radius, KnnResult& out) const;
 
+    /// k_nearest among the photons whose user flags hold all of `required_flags` and none of
+    /// `excluded_flags` (the others are not candidates: the k found are k of those). The same
+    /// guarantees as k_nearest.
+    void k_nearest_flagged(const Vec3& p, uint32_t k, float max_radius, uint8_t required_flags,
+                           uint8_t excluded_flags, KnnResult& out) const;
+
     /// Calls f(uint32_t index, float dist2) for every photon with distance <= radius to p, in a
     /// deterministic order. Nothing for a non-finite p or a negative or NaN radius.
     template <class F>
@@ -121,9 +127,10 @@ public:
 private:
     static void build_subtree(Photon* photons, uint32_t lo, uint32_t hi);
 
-    template <class Distance2>
+    /// `accept(photon)`: whether the photon is a candidate at all.
+    template <class Distance2, class Accept>
     void k_nearest_impl(const Vec3& p, uint32_t k, float max_radius, KnnResult& out,
-                        Distance2 distance2_to) const;
+                        Distance2 distance2_to, Accept accept) const;
 
     // Deeper than any balanced tree over < 2^32 photons (depth <= 32).
     static constexpr int kMaxStackDepth = 64;

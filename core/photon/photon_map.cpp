@@ -106,12 +106,27 @@ Color PhotonMap::estimate_irradiance(const Vec3& p, const Vec3& normal, uint32_t
     return Color(sum / (kPiDouble * radius2));
 }
 
+namespace {
+
+/// The volume of a sphere of radius r beyond a plane at distance h < r from its centre (a cap of
+/// height r - h; the whole sphere less the cap on the centre's side when h < 0).
+double cap_volume(double r, double h) {
+    const double height = std::clamp(r - h, 0.0, 2.0 * r);
+    return kPiDouble * height * height * (3.0 * r - height) / 3.0;
+}
+
+}  // namespace
+
 Color PhotonMap::estimate_in_scattering(const Vec3& x, const Vec3& wo, float g, uint32_t k, float max_radius,
-                                        uint8_t exclude_flags, const Bounds3* medium_bounds) const {
+                                        uint8_t exclude_flags, const Bounds3* medium_bounds, bool interior,
+                                        float surface_distance) const {
     if (tree_.empty()) return Color(0.0f);
     KnnResult& found = thread_scratch();
     max_radius = max_radius > 0.0f ? max_radius : std::numeric_limits<float>::infinity();
-    tree_.k_nearest(x, k, max_radius, found);
+    if (interior)
+        tree_.k_nearest_flagged(x, k, max_radius, photon_flags::kInterior, 0, found);
+    else
+        tree_.k_nearest_flagged(x, k, max_radius, 0, photon_flags::kInterior, found);
     const double radius2 = estimate_radius2(found, k, max_radius);  // see estimate_radiance
     if (found.size() < kMinPhotonsPerEstimate || !(radius2 > 0.0)) return Color(0.0f);
     DVec3 sum(0.0);
@@ -128,13 +143,14 @@ Color PhotonMap::estimate_in_scattering(const Vec3& x, const Vec3& wo, float g, 
         double outside = 0.0;
         for (int axis = 0; axis < 3; ++axis) {
             for (const double gap : {static_cast<double>(x[axis] - medium_bounds->lower[axis]),
-                                     static_cast<double>(medium_bounds->upper[axis] - x[axis])}) {
-                const double h = std::clamp(r - gap, 0.0, 2.0 * r);
-                outside += kPiDouble * h * h * (3.0 * r - h) / 3.0;
-            }
+                                     static_cast<double>(medium_bounds->upper[axis] - x[axis])})
+                outside += cap_volume(r, gap);
         }
         volume = std::max(volume - outside, 0.125 * volume);
     }
+    // The solid's surface taken as the plane at its nearest point: curved surfaces leave a little
+    // more or less than the cap (a convex one more), within the sphere's last few percent.
+    if (surface_distance < r) volume = std::max(volume - cap_volume(r, surface_distance), 0.125 * volume);
     return Color(sum / volume);
 }
 

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -21,6 +22,9 @@ namespace photond {
 namespace photon_flags {
 inline constexpr uint8_t kDirect = 1;   // first hit from the light: L D
 inline constexpr uint8_t kCaustic = 2;  // through one or more specular bounces: L S+ D
+/// A volume photon stored inside a closed transmissive solid (Material::interior_scatters), not
+/// in the atmosphere: estimates in the one never count photons of the other.
+inline constexpr uint8_t kInterior = 4;
 }  // namespace photon_flags
 
 /// Fewer photons than this in an estimate give zero (the lecture's rule: too few to trust).
@@ -99,8 +103,14 @@ public:
     /// kMinPhotonsPerEstimate photons. With `medium_bounds` (the box the medium fills), the
     /// sphere's caps beyond its faces are left out of the volume: no photon can lie there, and a
     /// whole sphere would darken the medium along the box's walls.
+    /// `interior`: x lies inside a scattering solid, whose photons (photon_flags::kInterior) alone
+    /// are searched; else those are never among the k. `surface_distance`: how far x is from the
+    /// surface that bounds its medium (a solid's; infinite: unknown or far), whose far side is
+    /// left out of the volume as a plane there would cut it.
     Color estimate_in_scattering(const Vec3& x, const Vec3& wo, float g, uint32_t k, float max_radius,
-                                 uint8_t exclude_flags = 0, const Bounds3* medium_bounds = nullptr) const;
+                                 uint8_t exclude_flags = 0, const Bounds3* medium_bounds = nullptr,
+                                 bool interior = false,
+                                 float surface_distance = std::numeric_limits<float>::infinity()) const;
 
     /// Precomputed irradiance (Christensen 1999, "Faster photon map global illumination"): in a
     /// map whose photons hold irradiance (flux) and surface normal (normal, or direction for

@@ -142,10 +142,12 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
     // In a scattering atmosphere, free flights by a hero channel drawn once for the photon, and
     // what it stores divided by the channel average of the pdf ratios (sample_free_flight), as
     // path tracing does.
+    // Solids that scatter inside (Material::interior_scatters) are media of their own.
     const std::optional<HomogeneousMedium>& atmosphere = rs.scene->atmosphere;
-    const int hero = atmosphere ? std::min(2, static_cast<int>(rng.next_float() * 3.0f)) : 0;
+    const bool media = atmosphere || rs.scattering_interiors;
+    const int hero = media ? std::min(2, static_cast<int>(rng.next_float() * 3.0f)) : 0;
     Color spectral(1.0f);
-    const auto stored_flux = [&](const Color& f) { return atmosphere ? f / average(spectral) : f; };
+    const auto stored_flux = [&](const Color& f) { return media ? f / average(spectral) : f; };
     // Russian roulette after an event that takes the photon's flux to `next`: survive with the
     // ratio of what it would store then to `stored_before` (what it stored before the event),
     // so that surviving photons keep about the same flux.
@@ -161,12 +163,20 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
         const std::optional<Hit> hit = rs.tracer->intersect(ray);
         std::optional<SurfaceInteraction> hit_point;
         if (hit) hit_point = make_interaction(*rs.scene, *hit, ray.direction);
-        if (atmosphere) {
-            const MediumSpan span = atmosphere_span(*rs.scene, ray, hit_point ? &*hit_point : nullptr);
-            if (!span.empty() && !atmosphere->scatters()) {
-                flux *= atmosphere->transmittance(span.t1 - span.t0);
+        // The medium on the way, as path tracing takes it (path.cpp): the solid's own where the
+        // segment ends inside a transmissive material that scatters, else the atmosphere.
+        std::optional<HomogeneousMedium> interior;
+        if (rs.scattering_interiors && hit_point && segment_inside_solid(*rs.scene, *hit_point) &&
+            rs.scene->materials[hit_point->material].interior_scatters())
+            interior = rs.scene->materials[hit_point->material].interior_medium();
+        const HomogeneousMedium* medium = interior ? &*interior : atmosphere ? &*atmosphere : nullptr;
+        if (medium) {
+            const MediumSpan span = interior ? MediumSpan{ray.tmin, hit->t}
+                                             : atmosphere_span(*rs.scene, ray, hit_point ? &*hit_point : nullptr);
+            if (!span.empty() && !medium->scatters()) {
+                flux *= medium->transmittance(span.t1 - span.t0);
             } else if (!span.empty()) {
-                const FreeFlight flight = sample_free_flight(*atmosphere, span.t1 - span.t0, hero, rng.next_float());
+                const FreeFlight flight = sample_free_flight(*medium, span.t1 - span.t0, hero, rng.next_float());
                 const Color before = stored_flux(flux);
                 spectral *= flight.pdf_ratio;
                 if (!flight.scattered) {
@@ -176,13 +186,13 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
                     // (estimate_in_scattering), then goes on by the phase function.
                     const Vec3 x = ray.origin + (span.t0 + flight.t) * ray.direction;
                     const Color next = flux * flight.weight;
+                    const uint8_t flags = static_cast<uint8_t>((bounce == 0 ? photon_flags::kDirect : 0) |
+                                                               (interior ? photon_flags::kInterior : 0));
                     if (want_volume)
-                        out.volume.push_back({make_photon(x, ray.direction, stored_flux(next),
-                                                          bounce == 0 ? photon_flags::kDirect : uint8_t(0)),
-                                              path_in_batch});
+                        out.volume.push_back({make_photon(x, ray.direction, stored_flux(next), flags), path_in_batch});
                     diffuse_seen = true;
                     if (!whole_paths || !survives(next, before)) return;
-                    ray = Ray{x, sample_henyey_greenstein(atmosphere->g, -ray.direction, rng.next_vec2())};
+                    ray = Ray{x, sample_henyey_greenstein(medium->g, -ray.direction, rng.next_vec2())};
                     continue;
                 }
             }
@@ -190,7 +200,7 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
         if (!hit) return;
         const SurfaceInteraction& si = *hit_point;
         const Vec3 wo = -ray.direction;  // towards where the photon came from
-        if (rs.scene->materials[si.material].has_volume()) {
+        if (!interior && rs.scene->materials[si.material].has_volume()) {  // a free flight took it
             flux *= volume_transmittance(*rs.scene, si);
             if (is_black(flux)) return;
         }
@@ -378,9 +388,9 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
     MapBuilder global, caustic, volume;
     global.target = settings.global_photons;
     caustic.target = settings.caustic_photons;
-    // The volume map: only where the atmosphere scatters light.
+    // The volume map: only where the atmosphere or a solid's inside scatters light.
     const bool scattering_atmosphere = rs.scene->atmosphere && rs.scene->atmosphere->scatters();
-    volume.target = scattering_atmosphere ? settings.volume_photons : 0;
+    volume.target = scattering_atmosphere || rs.scattering_interiors ? settings.volume_photons : 0;
     for (MapBuilder* m : {&global, &caustic, &volume}) {
         m->active = m->target > 0;
         m->cap = static_cast<uint64_t>(m->target) * settings.max_emitted_per_stored;

@@ -66,8 +66,23 @@ RenderPlan plan_photon_passes(const Scene& scene, const LightSet& lights, const 
     } else {
         plan.global_map = decide("global_map", true, "diffuse surfaces reflect light: indirect illumination");
     }
-    // The volume map: listed only for a scene with an atmosphere.
-    if (scene.atmosphere) {
+    // The volume map: listed only for a scene with an atmosphere or solids that scatter inside.
+    bool scattering_solids = false;
+    const std::vector<bool> used = scene.materials_in_use();
+    for (size_t i = 0; i < scene.materials.size(); ++i)
+        scattering_solids = scattering_solids || (used[i] && scene.materials[i].interior_scatters());
+    const bool scattering_atmosphere = scene.atmosphere && scene.atmosphere->scatters();
+    if (scattering_solids && request.volume_photons == 0) {
+        plan.volume_map = decide("volume_map", false,
+                                 "the job asks for 0 volume photons: the light that solids scatter inside is left out");
+    } else if (scattering_solids) {
+        plan.volume_map = decide("volume_map", true,
+                                 scattering_atmosphere
+                                     ? "the atmosphere and solids' insides scatter light: the atmosphere's multiple "
+                                       "scattering, what gather rays cross, and all the light inside the solids"
+                                     : "solids scatter light inside: all the light that camera and gather rays cross "
+                                       "there");
+    } else if (scene.atmosphere) {
         if (!scene.atmosphere->scatters()) {
             plan.volume_map = decide("volume_map", false, "the atmosphere only absorbs: its transmittance is exact");
         } else if (request.volume_photons == 0) {

@@ -44,9 +44,13 @@ inline Vec3 oriented_shading_normal(const Vec3& shading, const Vec3& geometric) 
 /// that reaches a volume material's surface from inside (its back face: the solid's normals
 /// point out) crossed t of its medium, exp(-sigma t). Closed, non-nested solids; a segment that
 /// ends on another surface inside the solid is not attenuated.
+/// A solid that also scatters inside (Material::interior_scatters) takes out what it scatters
+/// too: exp(-(sigma_a + sigma_s) t), the light that crossed it unscattered.
 inline Color volume_transmittance(const Scene& scene, const SurfaceInteraction& si) {
     const Material& m = scene.materials[si.material];
-    if (si.front_face || !m.has_volume()) return Color(1.0f);
+    if (si.front_face) return Color(1.0f);
+    if (m.interior_scatters()) return glm::exp(-(m.attenuation + m.scattering) * si.distance);
+    if (!m.has_volume()) return Color(1.0f);
     return glm::exp(-m.attenuation * si.distance);
 }
 
