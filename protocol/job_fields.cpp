@@ -485,7 +485,7 @@ json material_media_schema() {
              "the participating media inside closed transmissive solids (KHR_materials_transmission) by "
              "their glTF material's name: scattering per world unit (per metre for glTF scenes), phase "
              "asymmetry and optionally the absorption in place of the file's KHR_materials_volume; rendered "
-             "by the integrator path (photon-map and direct refuse it); whether the scene has the material is "
+             "by the integrators path and photon-map (direct refuses it); whether the scene has the material is "
              "checked when it is loaded; absent, null or {}: none"},
             {"oneOf", {{{"type", "null"}, {"description", "no media in materials"}}, media}}};
 }
@@ -777,7 +777,8 @@ std::vector<JobField> make_job_fields() {
                                    "nearest photons per caustic-map radiance estimate", {"100", "100", "100"}));
     fields.push_back(integer_field(JOB_MEMBER(photons.volume), limits::kPhotonCount,
                                    "photons stored in the volume map at scattering events in the atmosphere "
-                                   "(photon-map integrator; only when the job has an atmosphere that scatters)",
+                                   "or inside solids that scatter (photon-map integrator; only when the job's "
+                                   "atmosphere or material_media scatter)",
                                    {"100000", "400000", "2000000"}));
     fields.push_back(integer_field(JOB_MEMBER(photons.k_volume), limits::kPhotonNeighbours,
                                    "nearest photons per volume-map estimate of in-scattered light",

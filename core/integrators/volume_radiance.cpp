@@ -26,12 +26,11 @@ Color interior_in_scattering(const RenderScene& rs, const PhotonMap& volume, con
     Color sum(0.0f);
     const MediumSpan span{ray.tmin, si.distance};
     if (span.empty()) return sum;
-    // The surface matters within an estimate's radius; farther is all the same.
-    const float reach = max_radius > 0.0f ? max_radius : rs.scene->bounds.radius();
     march_through_medium(medium, ray, span, points, context, [&](const Vec3& x, const Color& weight) {
-        const float surface = rs.tracer->distance_to_surface(x, reach);
+        // The surface matters within the estimate's radius only: the query looks no farther.
+        const auto surface = [&](float radius) { return rs.tracer->distance_to_surface(x, radius); };
         sum += weight * volume.estimate_in_scattering(x, -ray.direction, medium.g, k, max_radius, 0, nullptr, true,
-                                                      surface < reach ? surface : std::numeric_limits<float>::infinity());
+                                                      surface);
     });
     return sum;
 }

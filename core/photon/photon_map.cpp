@@ -119,7 +119,7 @@ double cap_volume(double r, double h) {
 
 Color PhotonMap::estimate_in_scattering(const Vec3& x, const Vec3& wo, float g, uint32_t k, float max_radius,
                                         uint8_t exclude_flags, const Bounds3* medium_bounds, bool interior,
-                                        float surface_distance) const {
+                                        const std::function<float(float)>& surface_distance) const {
     if (tree_.empty()) return Color(0.0f);
     KnnResult& found = thread_scratch();
     max_radius = max_radius > 0.0f ? max_radius : std::numeric_limits<float>::infinity();
@@ -150,7 +150,10 @@ Color PhotonMap::estimate_in_scattering(const Vec3& x, const Vec3& wo, float g, 
     }
     // The solid's surface taken as the plane at its nearest point: curved surfaces leave a little
     // more or less than the cap (a convex one more), within the sphere's last few percent.
-    if (surface_distance < r) volume = std::max(volume - cap_volume(r, surface_distance), 0.125 * volume);
+    if (surface_distance) {
+        const double distance = surface_distance(static_cast<float>(r));
+        if (distance < r) volume = std::max(volume - cap_volume(r, distance), 0.125 * volume);
+    }
     return Color(sum / volume);
 }
 

@@ -8,7 +8,7 @@
 #pragma once
 
 #include <cstdint>
-#include <limits>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -104,13 +104,14 @@ public:
     /// sphere's caps beyond its faces are left out of the volume: no photon can lie there, and a
     /// whole sphere would darken the medium along the box's walls.
     /// `interior`: x lies inside a scattering solid, whose photons (photon_flags::kInterior) alone
-    /// are searched; else those are never among the k. `surface_distance`: how far x is from the
-    /// surface that bounds its medium (a solid's; infinite: unknown or far), whose far side is
-    /// left out of the volume as a plane there would cut it.
+    /// are searched; else those are never among the k. `surface_distance(r)`, when given: how far
+    /// x is from the surface that bounds its medium (a solid's) if that is under the estimate's
+    /// radius r, else anything not below r; the sphere's part beyond it is left out of the volume
+    /// as a plane there at that distance would cut it.
     Color estimate_in_scattering(const Vec3& x, const Vec3& wo, float g, uint32_t k, float max_radius,
                                  uint8_t exclude_flags = 0, const Bounds3* medium_bounds = nullptr,
                                  bool interior = false,
-                                 float surface_distance = std::numeric_limits<float>::infinity()) const;
+                                 const std::function<float(float)>& surface_distance = {}) const;
 
     /// Precomputed irradiance (Christensen 1999, "Faster photon map global illumination"): in a
     /// map whose photons hold irradiance (flux) and surface normal (normal, or direction for

@@ -1309,50 +1309,41 @@ TEST(JobMaterialMedia, RefusesWhatCannotBeRightByName) {
     }
 }
 
-TEST(JobMaterialMedia, PhotonMapAndDirectRefuseItPathRendersIt) {
+TEST(JobMaterialMedia, DirectRefusesItPathAndPhotonMapRenderIt) {
     const json glass = {{"glass", {{"sigma_s", 0.1}}}};
-    const std::string photon_map_refusal =
-        "material_media: integrator \"photon-map\" does not render media inside solids yet (its volume photon map holds "
-        "the atmosphere's light only); use \"path\" (the reference)";
     const std::string direct_refusal =
         "material_media: integrator \"direct\" renders no light scattered inside solids (their surfaces block its "
         "light samples); use \"path\" (the reference)";
-    // The default preset "final" (and "preview") integrate with photon-map.
-    EXPECT_TRUE(rejects(with_material_media(glass, ""), "material_media", photon_map_refusal));
-    json preview = with_material_media(glass, "");
-    preview["preset"] = "preview";
-    EXPECT_TRUE(rejects(preview, "material_media", photon_map_refusal));
-    EXPECT_TRUE(rejects(with_material_media(glass, "photon-map"), "material_media", photon_map_refusal));
     EXPECT_TRUE(rejects(with_material_media(glass, "direct"), "material_media", direct_refusal));
-    // The whole message: the photon-map refusal does not offer "direct".
-    Expected<Job> refused = parse_job(with_material_media(glass, "photon-map"));
-    ASSERT_FALSE(refused);
-    EXPECT_EQ(refused.error().message, photon_map_refusal);
-    refused = parse_job(with_material_media(glass, "direct"));
+    // The whole message.
+    Expected<Job> refused = parse_job(with_material_media(glass, "direct"));
     ASSERT_FALSE(refused);
     EXPECT_EQ(refused.error().message, direct_refusal);
     // Even a medium of zero coefficients: the document asked for one.
     EXPECT_TRUE(rejects(with_material_media({{"glass", {{"sigma_s", 0}}}}, "direct"), "material_media", direct_refusal));
     // Each field's own error comes first: the cross-field rule judges a job whose fields are valid.
-    EXPECT_TRUE(rejects(with_material_media({{"glass", {{"sigma_s", -1}}}}, ""), "material_media.glass.sigma_s",
+    EXPECT_TRUE(rejects(with_material_media({{"glass", {{"sigma_s", -1}}}}, "direct"), "material_media.glass.sigma_s",
                         "must be in"));
-    // With an atmosphere too, which both render: the refusal is the media's.
+    // With an atmosphere too, which direct renders: the refusal is the media's.
     json both = with_material_media(glass, "direct");
     both["atmosphere"] = {{"sigma_s", 0.1}};
     EXPECT_TRUE(rejects(both, "material_media", direct_refusal));
-    both["integrator"] = "photon-map";
-    EXPECT_TRUE(rejects(both, "material_media", photon_map_refusal));
 
     const Job job = parsed(with_material_media(glass, "path"));
     EXPECT_EQ(job.integrator, "path");
     ASSERT_EQ(job.material_media.size(), 1u);
     EXPECT_EQ(job.material_media.at("glass").sigma_s, (std::array<double, 3>{0.1, 0.1, 0.1}));
-    both["integrator"] = "path";
-    EXPECT_TRUE(accepts(both));
-    // "reference" integrates with path: nothing else to name.
-    json reference = with_material_media(glass, "");
-    reference["preset"] = "reference";
-    EXPECT_TRUE(accepts(reference));
+    for (const std::string integrator : {"path", "photon-map"}) {
+        both["integrator"] = integrator;
+        EXPECT_TRUE(accepts(both)) << integrator;
+        EXPECT_TRUE(accepts(with_material_media(glass, integrator))) << integrator;
+    }
+    // Every preset: "final" and "preview" integrate with photon-map, "reference" with path.
+    for (const std::string preset : {"preview", "final", "reference"}) {
+        json job_with_preset = with_material_media(glass, "");
+        job_with_preset["preset"] = preset;
+        EXPECT_TRUE(accepts(job_with_preset)) << preset;
+    }
 }
 
 TEST(JobSchema, DescribesTheMaterialMedia) {

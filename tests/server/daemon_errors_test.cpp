@@ -394,23 +394,31 @@ TEST_F(DaemonErrors, MediaRenderAndAreRefusedByNameWhereTheyCannot) {
         ASSERT_EQ(done.at("state"), "done") << done.dump();
         EXPECT_NE(done.dump().find("\"atmosphere\""), std::string::npos) << done.dump();
         EXPECT_NE(done.dump().find("optical depth"), std::string::npos) << done.dump();
-        if (integrator == "photon-map")
+        if (integrator == "photon-map") {
             EXPECT_NE(done.dump().find("\"volume_map\""), std::string::npos) << done.dump();
+        }
     }
-    // photon-map does not render a medium inside solids: a 422 that names the field.
+    // direct does not render a medium inside solids: a 422 that names the field.
     expect_problem(client,
-                   client.post("/v1/jobs", with(with(kSmallJob, "/integrator", "photon-map"), "/material_media",
+                   client.post("/v1/jobs", with(with(kSmallJob, "/integrator", "direct"), "/material_media",
                                                 {{"glass", {{"sigma_s", 3.0}}}}).dump()),
                    422, "material_media", "\"path\"");
-    // A medium inside the box's glass sphere (material "glass"): path renders it; a material the
-    // scene lacks is refused at submission, naming the entry and the materials there are.
+    // A medium inside the box's glass sphere (material "glass"): path and photon-map render it
+    // (photon-map with a volume map of the solid's photons); a material the scene lacks is
+    // refused at submission, naming the entry and the materials there are.
+    for (const std::string integrator : {"path", "photon-map"}) {
+        const HttpResponse accepted = client.post(
+            "/v1/jobs", with(with(kSmallJob, "/integrator", integrator), "/material_media",
+                             {{"glass", {{"sigma_s", 3.0}, {"g", 0.3}}}}).dump());
+        ASSERT_EQ(accepted.status, 202) << accepted.body;
+        const json done = wait_for_status(client, accepted.json_body().at("id"), is_terminal_state);
+        ASSERT_EQ(done.at("state"), "done") << done.dump();
+        EXPECT_NE(done.dump().find("the solids of 'glass'"), std::string::npos) << done.dump();
+        if (integrator == "photon-map") {
+            EXPECT_NE(done.dump().find("solids scatter light inside"), std::string::npos) << done.dump();
+        }
+    }
     const json path_job = with(kSmallJob, "/integrator", "path");
-    const HttpResponse accepted =
-        client.post("/v1/jobs", with(path_job, "/material_media", {{"glass", {{"sigma_s", 3.0}, {"g", 0.3}}}}).dump());
-    ASSERT_EQ(accepted.status, 202) << accepted.body;
-    const json done = wait_for_status(client, accepted.json_body().at("id"), is_terminal_state);
-    ASSERT_EQ(done.at("state"), "done") << done.dump();
-    EXPECT_NE(done.dump().find("the solids of 'glass'"), std::string::npos) << done.dump();
     expect_problem(client, client.post("/v1/jobs", with(path_job, "/material_media", {{"nope", {{"sigma_s", 1}}}}).dump()),
                    422, "material_media.nope", "'glass'");
     expect_problem(client, client.post("/v1/jobs", with(path_job, "/material_media", {{"white", {{"sigma_s", 1}}}}).dump()),
