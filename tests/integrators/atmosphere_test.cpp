@@ -70,7 +70,6 @@ Color single_scattering(const HomogeneousMedium& m, const Vec3& origin, const Ve
                         const Color& intensity) {
     // The ray enters the box at t0 and leaves it at t1 (it is axis-aligned in the test).
     const Bounds3 box{Vec3(-1.0f), Vec3(1.0f)};
-    const Ray ray{origin, direction};
     float t0 = 0.0f, t1 = 1e30f;
     for (int a = 0; a < 3; ++a) {
         if (direction[a] == 0.0f) continue;

@@ -81,7 +81,9 @@ TEST(LightTree, PmfEqualsTheSamplesProbabilityAndSumsToOneForLightsThatShineEver
             for (int s = 0; s < 200; ++s) {
                 float pmf = 0.0f;
                 const std::optional<uint32_t> light = tree.sample(p, rng.next_float(), &pmf);
-                if (light) EXPECT_EQ(pmf, tree.pmf(p, *light)) << "point " << point << ", light " << *light;
+                if (light) {
+                    EXPECT_EQ(pmf, tree.pmf(p, *light)) << "point " << point << ", light " << *light;
+                }
             }
         }
         if (&lights == &points) {
@@ -253,7 +255,9 @@ TEST(LightSelection, ChoiceProbabilitiesSumToAtMostOneAndMisPdfEqualsTheSamplesP
             const Vec3 p(24.0f * rng.next_float() - 12.0f, 4.0f * rng.next_float(), 24.0f * rng.next_float() - 12.0f);
             double sum = 0.0;
             for (uint32_t l = 0; l < lights.size(); ++l) sum += lights.incident_choice_probability(l, p);
-            if (selection == LightSelection::Power) EXPECT_NEAR(sum, 1.0, 1e-4);
+            if (selection == LightSelection::Power) {
+                EXPECT_NEAR(sum, 1.0, 1e-4);
+            }
             EXPECT_LE(sum, 1.0 + 1e-5);  // the tree's dead ends (see LightTree's tests)
             EXPECT_GT(sum, 0.5);
             for (int s = 0; s < 50; ++s) {

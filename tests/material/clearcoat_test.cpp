@@ -89,8 +89,9 @@ TEST(Clearcoat, RoughCoatSamplingAgreesWithEvaluation) {
             EXPECT_NEAR(sampled, quadrature, 0.02 * quadrature + 1e-3);
             EXPECT_NEAR(pdf_integral, 1.0, 0.03);
             // The coat alone reflects about its Fresnel share; nothing reflects more than all.
-            if (colour == 0.0f)
+            if (colour == 0.0f) {
                 EXPECT_NEAR(quadrature, coat_fresnel(1.0f, mu), 0.35 * coat_fresnel(1.0f, mu));
+            }
             EXPECT_LT(quadrature, 1.01);
         }
     }
