@@ -151,6 +151,7 @@ bench: build
 	python3 bench/large_scene.py --photond $(BUILD)/server/photond
 	python3 bench/run_benchmark.py --photond $(BUILD)/server/photond $(BENCH_ARGS)
 	python3 bench/gltf_samples.py --photond $(BUILD)/server/photond
+	python3 bench/radiance_cache_tradeoff.py --photond $(BUILD)/server/photond
 
 # 200 concurrent clients (submitters, event and tile streams, slow readers, slowloris) on a real
 # daemon for LOAD_SECONDS, with the /healthz p99 goal of 50 ms (bench/load_test.py). ctest runs a

@@ -820,7 +820,7 @@ std::vector<JobField> make_job_fields() {
                                    {"10", "10", "12"}));
     fields.push_back(integer_field(JOB_MEMBER(radiance_cache.samples), limits::kRadianceSamples,
                                    "lobe samples of the cached incident radiance per glossy point",
-                                   {"4", "8", "16"}));
+                                   {"8", "16", "32"}));
 
     // The tree costs little with few lights and wins by far with many (README.md, "Large
     // scenes"); power stays selectable to measure against.

@@ -41,7 +41,7 @@ struct RadianceCacheSettings {
     /// The most bands a record may have; lobes that need more are BSDF-sampled instead.
     int max_order = 10;
     /// Lobe samples of the interpolated incident radiance at each shading point.
-    uint32_t samples = 8;
+    uint32_t samples = 16;
 };
 
 /// Bands needed for a glossy lobe of GGX alpha: ceil(kBandsTimesAlpha / alpha), at least kMinBands.
