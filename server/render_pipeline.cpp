@@ -200,7 +200,9 @@ std::optional<protocol::FieldError> material_media_problem(const protocol::Job& 
 /// account of it, one entry per name; empty without entries.
 std::string apply_material_media(const protocol::Job& job, Scene& scene) {
     std::string applied;
-    for (const auto& [name, spec] : job.material_media) {
+    for (const auto& entry : job.material_media) {
+        const std::string& name = entry.first;  // a named variable: lambdas may not capture bindings (C++17)
+        const auto& spec = entry.second;
         for (Material& m : scene.materials) {
             if (m.name != name) continue;
             m.scattering = to_vec3(spec.sigma_s);
