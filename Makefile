@@ -152,6 +152,13 @@ bench: build
 	python3 bench/run_benchmark.py --photond $(BUILD)/server/photond $(BENCH_ARGS)
 	python3 bench/gltf_samples.py --photond $(BUILD)/server/photond
 	python3 bench/radiance_cache_tradeoff.py --photond $(BUILD)/server/photond
+	$(MAKE) bench-web
+
+# The web page's time goals (README.md, "The web page"): first paint under 200 ms and a live tile
+# within 50 ms of its event, asserted. ctest runs the same test and prints the figures only.
+.PHONY: bench-web
+bench-web: build
+	PHOTOND_WEB_TIME_GOALS=1 $(BUILD)/tests/web_page_test --gtest_filter=WebPage.InChromium
 
 # 200 concurrent clients (submitters, event and tile streams, slow readers, slowloris) on a real
 # daemon for LOAD_SECONDS, with the /healthz p99 goal of 50 ms (bench/load_test.py). ctest runs a
