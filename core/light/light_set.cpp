@@ -363,7 +363,7 @@ Color LightSet::emissive_texel(const Entry& e, Vec2 b) const {
 
 Color LightSet::mean_emissive_texel(uint32_t triangle) const {
     const Material& m = scene_->materials[scene_->triangle_materials[triangle]];
-    const Texture& texture = scene_->textures[static_cast<size_t>(m.emissive_texture.texture)];
+    const Texture& texture = *scene_->textures[static_cast<size_t>(m.emissive_texture.texture)];
     const TexturePoint c0 = scene_->texture_point(triangle, 0.0f, 0.0f);
     const TexturePoint c1 = scene_->texture_point(triangle, 1.0f, 0.0f);
     const TexturePoint c2 = scene_->texture_point(triangle, 0.0f, 1.0f);

@@ -152,7 +152,7 @@ BsdfMaterial::BsdfMaterial(const Material& material, float metallic_value, float
 LobeMask possible_lobes(const Scene& scene, const Material& m) {
     float metallic[2] = {m.metallic, m.metallic}, roughness[2] = {m.roughness, m.roughness};
     if (m.metallic_roughness_texture.present()) {
-        const Texture& t = scene.textures[static_cast<size_t>(m.metallic_roughness_texture.texture)];
+        const Texture& t = *scene.textures[static_cast<size_t>(m.metallic_roughness_texture.texture)];
         float g[2] = {1.0f, 0.0f}, b[2] = {1.0f, 0.0f};
         for (const Color& c : t.texels) {
             g[0] = std::min(g[0], c.y), g[1] = std::max(g[1], c.y);

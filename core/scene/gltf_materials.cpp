@@ -4,6 +4,8 @@
 
 #include <limits>
 
+#include <tbb/parallel_for.h>
+
 namespace photond::gltf {
 namespace {
 
@@ -61,23 +63,38 @@ Expected<int> GltfSceneReader::scene_texture(int texture_index, const std::strin
                     " uses sampler " + std::to_string(texture.sampler) + ", which does not exist");
     const auto key = std::make_tuple(source, texture.sampler, srgb);
     if (const auto it = textures_.find(key); it != textures_.end()) return it->second;
-    Expected<Texture> decoded = decode_image(model_.images[static_cast<size_t>(source)], source, srgb);
-    if (!decoded) return fail(context + decoded.error().message);
-    if (texture.sampler >= 0) {
-        // glTF 2.0 section 5.26: wrapS/wrapT 33071 CLAMP_TO_EDGE, 33648 MIRRORED_REPEAT, else
-        // 10497 REPEAT; magFilter 9728 NEAREST.
-        const tinygltf::Sampler& sampler = model_.samplers[static_cast<size_t>(texture.sampler)];
-        const auto wrap = [](int mode) {
-            return mode == 33071 ? TextureWrap::ClampToEdge
-                                 : mode == 33648 ? TextureWrap::MirroredRepeat : TextureWrap::Repeat;
-        };
-        decoded->wrap_s = wrap(sampler.wrapS);
-        decoded->wrap_t = wrap(sampler.wrapT);
-        decoded->nearest = sampler.magFilter == 9728;
-    }
-    const int scene_index = static_cast<int>(builder_.add_texture(std::move(decoded).value()));
+    const int scene_index = static_cast<int>(pending_textures_.size());
+    pending_textures_.push_back({source, texture.sampler, srgb, context});
     textures_.emplace(key, scene_index);
     return scene_index;
+}
+
+Status GltfSceneReader::decode_textures() {
+    std::vector<std::optional<Expected<Texture>>> decoded(pending_textures_.size());
+    tbb::parallel_for(size_t{0}, pending_textures_.size(), [&](size_t i) {
+        const PendingTexture& pending = pending_textures_[i];
+        Expected<Texture> texture =
+            decode_image(model_.images[static_cast<size_t>(pending.image)], pending.image, pending.srgb);
+        if (texture && pending.sampler >= 0) {
+            // glTF 2.0 section 5.26: wrapS/wrapT 33071 CLAMP_TO_EDGE, 33648 MIRRORED_REPEAT, else
+            // 10497 REPEAT; magFilter 9728 NEAREST.
+            const tinygltf::Sampler& sampler = model_.samplers[static_cast<size_t>(pending.sampler)];
+            const auto wrap = [](int mode) {
+                return mode == 33071 ? TextureWrap::ClampToEdge
+                                     : mode == 33648 ? TextureWrap::MirroredRepeat : TextureWrap::Repeat;
+            };
+            texture->wrap_s = wrap(sampler.wrapS);
+            texture->wrap_t = wrap(sampler.wrapT);
+            texture->nearest = sampler.magFilter == 9728;
+        }
+        if (texture) texture->build_mip_levels();
+        decoded[i] = std::move(texture);
+    });
+    for (size_t i = 0; i < decoded.size(); ++i) {
+        if (!*decoded[i]) return fail(pending_textures_[i].context + decoded[i]->error().message);
+        builder_.add_texture(std::move(*decoded[i]).value());
+    }
+    return Status::ok();
 }
 
 Expected<TextureRef> GltfSceneReader::texture_ref(int index, int tex_coord,

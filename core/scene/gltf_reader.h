@@ -210,8 +210,14 @@ private:
                                      Material& m);
     Status read_clearcoat_textures(const tinygltf::Value& clearcoat, int material_index,
                                    const std::string& context, Material& m);
+    /// The scene texture of glTF texture texture_index read as sRGB colour or as data: its index,
+    /// given now; the image is decoded by decode_textures() once the whole file was accepted.
     Expected<int> scene_texture(int texture_index, const std::string& context, const std::string& role,
                                 bool srgb);
+    /// Decodes every texture scene_texture() handed out, in parallel (PNG and JPEG decoding is
+    /// most of the time a textured file takes to read), and adds them to the scene in the order
+    /// their indices were given; the first failure in that order is the error.
+    Status decode_textures();
     /// A textureInfo (index, texCoord, KHR_texture_transform) as a TextureRef; `sets` collects
     /// the material's TEXCOORD sets, whose position there is the ref's slot.
     Expected<TextureRef> texture_ref(int index, int tex_coord, const tinygltf::ExtensionMap& extensions,
@@ -238,6 +244,15 @@ private:
     std::map<int, uint32_t> materials_;  // glTF material (-1: default) -> scene material
     /// (glTF image, sampler, sRGB) -> scene texture
     std::map<std::tuple<int, int, bool>, int> textures_;
+    /// A scene texture handed out and not yet decoded: its image, sampler, curve, and the first
+    /// use's context for the error message.
+    struct PendingTexture {
+        int image = -1;
+        int sampler = -1;
+        bool srgb = false;
+        std::string context;
+    };
+    std::vector<PendingTexture> pending_textures_;  // by scene texture index
     std::map<int, std::vector<int>> texcoord_sets_;  // glTF material -> TEXCOORD sets by slot
     std::map<int, int> normal_slots_;  // glTF material with a normal texture -> its slot
     std::vector<uint8_t> on_path_;       // cycle detection during the node walk

@@ -314,6 +314,7 @@ Expected<Scene> GltfSceneReader::read() {
         if (Status st = visit_node(root, Mat4(1.0f), 0); !st) return st.error();
 
     if (triangle_count_ == 0) return fail("contains no triangles");
+    if (Status st = decode_textures(); !st) return st.error();
     add_cameras();
     add_feature_warnings();
     Expected<Scene> scene = builder_.build();

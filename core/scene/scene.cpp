@@ -115,7 +115,7 @@ void Texture::build_mip_levels() {
 }
 
 Vec4 Scene::sample(const TextureRef& ref, const TexturePoint& tp) const {
-    const Texture& t = textures[static_cast<size_t>(ref.texture)];
+    const Texture& t = *textures[static_cast<size_t>(ref.texture)];
     const float footprint = ref.slot == 0 ? tp.footprint : tp.footprint1;
     float lod = 0.0f;
     if (footprint > 0.0f) {
@@ -277,7 +277,8 @@ uint32_t SceneBuilder::add_material(Material material) {
 }
 
 uint32_t SceneBuilder::add_texture(Texture texture) {
-    scene_.textures.push_back(std::move(texture));
+    if (texture.mip_levels.empty()) texture.build_mip_levels();
+    scene_.textures.push_back(std::make_shared<const Texture>(std::move(texture)));
     return static_cast<uint32_t>(scene_.textures.size() - 1);
 }
 
@@ -396,9 +397,6 @@ Status SceneBuilder::add_mesh(std::span<const Vec3> positions, std::span<const V
 Expected<Scene> SceneBuilder::build() {
     for (const PunctualLight& l : scene_.lights) {
         if (l.type != PunctualLightType::Directional) scene_.bounds.extend(l.position);
-    }
-    for (Texture& t : scene_.textures) {
-        if (t.mip_levels.empty()) t.build_mip_levels();
     }
     scene_.triangle_normals.clear();
     scene_.flat_shaded.clear();

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <limits>
 #include <optional>
 #include <span>
@@ -246,7 +247,10 @@ struct Scene {
     /// Derived from the normals with triangle_normals.
     std::vector<uint8_t> flat_shaded;
     std::vector<Material> materials;
-    std::vector<Texture> textures;
+    /// Immutable once added (SceneBuilder::add_texture builds the mip levels) and shared by every
+    /// copy of the scene: a job that adds lights renders a copy (core/scene/scene_lighting.h),
+    /// which must not copy hundreds of megabytes of texels.
+    std::vector<std::shared_ptr<const Texture>> textures;
     std::vector<PunctualLight> lights;
     /// glTF files: one per entry of the file's cameras[] array, same index (placed by the first
     /// node that instantiates it). Built-in scenes: their own views.
@@ -309,6 +313,7 @@ public:
         std::span<const Vec4> colors;
         std::span<const Vec4> tangents;  // object space; w = bitangent sign
     };
+    /// Builds the texture's mip levels (unless it has them) and adds it; returns its index.
     uint32_t add_texture(Texture texture);
     void add_light(PunctualLight light);
     void add_camera(CameraDesc camera);

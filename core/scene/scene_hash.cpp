@@ -105,7 +105,8 @@ Sha256Digest scene_content_hash(const Scene& scene) {
         hash_vec3(hasher, m.emission);
         hasher.update_value(uint8_t(m.double_sided ? 1 : 0));
     });
-    hash_array(hasher, scene.textures, [&](const Texture& t) {
+    hash_array(hasher, scene.textures, [&](const std::shared_ptr<const Texture>& texture) {
+        const Texture& t = *texture;
         hasher.update_value(int32_t(t.width));
         hasher.update_value(int32_t(t.height));
         hash_array(hasher, t.texels, [&](const Color& c) { hash_vec3(hasher, c); });

@@ -117,7 +117,7 @@ Scene sunlit_room_variant(bool lattice, bool bumps) {
         }
         t.nearest = true;  // crisp bars: bilinear alpha would round their ends
         t.build_mip_levels();
-        scene.textures.push_back(std::move(t));
+        scene.textures.push_back(std::make_shared<const Texture>(std::move(t)));
         Material screen = test_support::lambertian(Color(0.5f));
         screen.name = "lattice";
         screen.alpha_mode = AlphaMode::Mask;
@@ -154,7 +154,7 @@ Scene sunlit_room_variant(bool lattice, bool bumps) {
             }
         }
         t.build_mip_levels();
-        scene.textures.push_back(std::move(t));
+        scene.textures.push_back(std::make_shared<const Texture>(std::move(t)));
         const uint32_t floor = material_named(scene, "floor");
         Material& m = scene.materials.at(floor);
         m.normal_texture.texture = static_cast<int>(scene.textures.size() - 1);

@@ -211,7 +211,7 @@ TEST(SceneHash, LightTransportChangesTheKey) {
                   Texture t;
                   t.width = t.height = 1;
                   t.texels = {Color(0.5f)};
-                  s.textures.push_back(t);
+                  s.textures.push_back(std::make_shared<const Texture>(t));
               }),
               key);
     // Light intensity: an emissive material here, a punctual light in "caustic".

@@ -389,7 +389,7 @@ TEST(GltfLoader, MaterialsWithExtensionsAndDefaults) {
 
 void expect_checker_texture(const Scene& scene) {
     ASSERT_EQ(scene.textures.size(), 1u);
-    const Texture& tex = scene.textures[0];
+    const Texture& tex = *scene.textures[0];
     ASSERT_EQ(tex.width, 2);
     ASSERT_EQ(tex.height, 2);
     ASSERT_EQ(tex.texels.size(), 4u);
@@ -416,7 +416,7 @@ TEST(GltfLoader, BaseColorTexturePngDataUri) {
 TEST(GltfLoader, SixteenBitTextureKeepsPrecision) {
     const Scene scene = load_ok("texture16.gltf");
     ASSERT_EQ(scene.textures.size(), 1u);
-    const Texture& tex = scene.textures[0];
+    const Texture& tex = *scene.textures[0];
     ASSERT_EQ(tex.texels.size(), 4u);
     // 32768/65535 decodes to 0.21404; truncation to 8 bits (128/255) would give 0.21586.
     expect_vec_near(tex.texels[0], Vec3(srgb_eotf(32768.0f / 65535.0f)), 1e-5f);
