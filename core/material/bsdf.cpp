@@ -154,11 +154,12 @@ LobeMask possible_lobes(const Scene& scene, const Material& m) {
     if (m.metallic_roughness_texture.present()) {
         const Texture& t = *scene.textures[static_cast<size_t>(m.metallic_roughness_texture.texture)];
         float g[2] = {1.0f, 0.0f}, b[2] = {1.0f, 0.0f};
-        for (const Color& c : t.texels) {
+        for (size_t i = 0, n = t.texel_count(); i < n; ++i) {
+            const Vec4 c = t.texel(i);
             g[0] = std::min(g[0], c.y), g[1] = std::max(g[1], c.y);
             b[0] = std::min(b[0], c.z), b[1] = std::max(b[1], c.z);
         }
-        if (t.texels.empty()) g[0] = g[1] = b[0] = b[1] = 1.0f;
+        if (t.texel_count() == 0) g[0] = g[1] = b[0] = b[1] = 1.0f;
         for (int i = 0; i < 2; ++i) {
             roughness[i] = m.roughness * g[i];
             metallic[i] = m.metallic * b[i];

@@ -118,29 +118,27 @@ Expected<Texture> decode_image(const tinygltf::Image& image, int image_index, bo
     Texture texture;
     texture.width = decoded.width;
     texture.height = decoded.height;
+    if (decoded.bits == 8) {
+        // Kept as the image holds it; Texture reads it through the sRGB curve or as data.
+        texture.encoding = srgb ? TexelEncoding::Srgb8 : TexelEncoding::Linear8;
+        texture.rgba8.resize(texel_count);
+        const uint8_t* p = decoded.image.data();
+        for (size_t i = 0; i < texel_count; ++i, p += 4)
+            texture.rgba8[i] = uint32_t(p[0]) | (uint32_t(p[1]) << 8) | (uint32_t(p[2]) << 16) | (uint32_t(p[3]) << 24);
+        return texture;
+    }
     texture.texels.resize(texel_count);
     const auto curve = [srgb](float c) { return srgb ? srgb_to_linear(c) : c; };
     std::vector<float> alpha(texel_count);
     bool opaque = true;
-    if (decoded.bits == 8) {
-        float table[256];
-        for (int i = 0; i < 256; ++i) table[i] = curve(float(i) / 255.0f);
-        const uint8_t* p = decoded.image.data();
-        for (size_t i = 0; i < texel_count; ++i, p += 4) {
-            texture.texels[i] = Color(table[p[0]], table[p[1]], table[p[2]]);
-            alpha[i] = p[3] / 255.0f;
-            opaque = opaque && p[3] == 255;
-        }
-    } else {
-        const uint8_t* p = decoded.image.data();
-        for (size_t i = 0; i < texel_count; ++i, p += 8) {
-            uint16_t rgba[4];
-            std::memcpy(rgba, p, sizeof(rgba));  // stb returns native-endian 16-bit samples
-            texture.texels[i] = Color(curve(rgba[0] / 65535.0f), curve(rgba[1] / 65535.0f),
-                                      curve(rgba[2] / 65535.0f));
-            alpha[i] = rgba[3] / 65535.0f;
-            opaque = opaque && rgba[3] == 65535;
-        }
+    const uint8_t* p = decoded.image.data();
+    for (size_t i = 0; i < texel_count; ++i, p += 8) {
+        uint16_t rgba[4];
+        std::memcpy(rgba, p, sizeof(rgba));  // stb returns native-endian 16-bit samples
+        texture.texels[i] = Color(curve(rgba[0] / 65535.0f), curve(rgba[1] / 65535.0f),
+                                  curve(rgba[2] / 65535.0f));
+        alpha[i] = rgba[3] / 65535.0f;
+        opaque = opaque && rgba[3] == 65535;
     }
     if (!opaque) texture.alpha = std::move(alpha);
     return texture;

@@ -70,8 +70,9 @@ struct ImageLoadContext {
 /// tinygltf's image loader: keeps the encoded bytes (user data: an ImageLoadContext).
 bool keep_encoded_image(tinygltf::Image* image, const int image_index, std::string* err,
                         std::string*, int, int, const unsigned char* bytes, int size, void* user);
-/// Decodes a PNG or JPEG into linear RGB (through the sRGB curve for colour textures: base colour
-/// and emission; as stored for data: metallic-roughness and normals) and linear alpha.
+/// Decodes a PNG or JPEG into a texture read as sRGB colour (base colour, emission) or as data
+/// (metallic-roughness, normals): 8-bit images keep their bytes (TexelEncoding), 16-bit ones
+/// become float linear RGB and alpha.
 Expected<Texture> decode_image(const tinygltf::Image& image, int image_index, bool srgb);
 
 // ---------------------------------------------------------------------------------------------

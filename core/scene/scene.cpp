@@ -23,12 +23,49 @@ int wrap_index(long long i, int n, TextureWrap mode) {
     }
 }
 
+/// The linear value of each 8-bit code: through the sRGB curve (IEC 61966-2-1) or as it is.
+struct ByteTables {
+    float srgb[256];
+    float linear[256];
+    ByteTables() {
+        for (int i = 0; i < 256; ++i) {
+            const float c = static_cast<float>(i) / 255.0f;
+            srgb[i] = c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+            linear[i] = c;
+        }
+    }
+};
+const ByteTables& byte_tables() {
+    static const ByteTables tables;
+    return tables;
+}
+
+Vec4 unpack_rgba8(uint32_t v, const float* table) {
+    return Vec4(table[v & 255u], table[(v >> 8) & 255u], table[(v >> 16) & 255u],
+                static_cast<float>(v >> 24) / 255.0f);
+}
+
+/// One level's texels as sample_level reads them: float RGB (and alpha, absent when opaque), or
+/// packed 8-bit RGBA with the table that decodes its colour.
+struct LevelTexels {
+    int width = 0;
+    int height = 0;
+    const Color* texels = nullptr;
+    const float* alpha = nullptr;
+    const uint32_t* rgba8 = nullptr;
+    const float* table = nullptr;
+
+    Vec4 at(size_t i) const {
+        if (rgba8) return unpack_rgba8(rgba8[i], table);
+        return Vec4(texels[i], alpha ? alpha[i] : 1.0f);
+    }
+};
+
 // Bilinear (or nearest) RGBA lookup in one level; texel centres at half-integers.
-Vec4 sample_level(int width, int height, const std::vector<Color>& texels, const std::vector<float>& alpha,
-                  TextureWrap wrap_s, TextureWrap wrap_t, bool nearest, const Vec2& uv) {
+Vec4 sample_level(const LevelTexels& level, TextureWrap wrap_s, TextureWrap wrap_t, bool nearest, const Vec2& uv) {
+    const int width = level.width, height = level.height;
     const auto at = [&](int xi, int yi) {
-        const size_t i = static_cast<size_t>(yi) * static_cast<size_t>(width) + static_cast<size_t>(xi);
-        return Vec4(texels[i], alpha.empty() ? 1.0f : alpha[i]);
+        return level.at(static_cast<size_t>(yi) * static_cast<size_t>(width) + static_cast<size_t>(xi));
     };
     const float x = uv.x * static_cast<float>(width) - 0.5f;
     const float y = uv.y * static_cast<float>(height) - 0.5f;
@@ -53,21 +90,35 @@ Vec4 sample_level(int width, int height, const std::vector<Color>& texels, const
            ty * ((1.0f - tx) * at(x0, y1) + tx * at(x1, y1));
 }
 
+LevelTexels level_zero(const Texture& t) {
+    LevelTexels level{t.width, t.height};
+    if (t.encoding == TexelEncoding::Float) {
+        level.texels = t.texels.data();
+        level.alpha = t.alpha.empty() ? nullptr : t.alpha.data();
+    } else {
+        level.rgba8 = t.rgba8.data();
+        level.table = t.encoding == TexelEncoding::Srgb8 ? byte_tables().srgb : byte_tables().linear;
+    }
+    return level;
+}
+
 }  // namespace
 
+Vec4 Texture::texel(size_t i) const { return level_zero(*this).at(i); }
+
 Vec4 Texture::sample_rgba(const Vec2& uv, float lod) const {
-    if (width <= 0 || height <= 0 || texels.empty()) return Vec4(1.0f);
-    if (!(lod > 0.0f) || mip_levels.empty())
-        return sample_level(width, height, texels, alpha, wrap_s, wrap_t, nearest, uv);
+    if (width <= 0 || height <= 0 || texel_count() == 0) return Vec4(1.0f);
+    if (!(lod > 0.0f) || mip_levels.empty()) return sample_level(level_zero(*this), wrap_s, wrap_t, nearest, uv);
     // Trilinear between the two levels around lod (Williams 1983, "Pyramidal parametrics").
     const float max_lod = static_cast<float>(mip_levels.size());
     const float l = std::min(lod, max_lod);
     const int l0 = std::min(static_cast<int>(l), static_cast<int>(mip_levels.size()));
     const float t = l - static_cast<float>(l0);
     const auto level = [&](int k) {
-        if (k == 0) return sample_level(width, height, texels, alpha, wrap_s, wrap_t, false, uv);
+        if (k == 0) return sample_level(level_zero(*this), wrap_s, wrap_t, false, uv);
         const TextureLevel& m = mip_levels[static_cast<size_t>(k - 1)];
-        return sample_level(m.width, m.height, m.texels, m.alpha, wrap_s, wrap_t, false, uv);
+        const LevelTexels level{m.width, m.height, m.texels.data(), m.alpha.empty() ? nullptr : m.alpha.data()};
+        return sample_level(level, wrap_s, wrap_t, false, uv);
     };
     const Vec4 a = level(l0);
     if (t <= 0.0f || l0 >= static_cast<int>(mip_levels.size())) return a;
@@ -76,15 +127,21 @@ Vec4 Texture::sample_rgba(const Vec2& uv, float lod) const {
 
 void Texture::build_mip_levels() {
     mip_levels.clear();
+    if (texel_count() == 0) return;
     int w = width, h = height;
-    const std::vector<Color>* src = &texels;
-    const std::vector<float>* src_alpha = &alpha;
+    // Levels 1.. are float (a third of level 0's texel count): averaging 8-bit texels and storing
+    // the mean in 8 bits again would round it.
+    LevelTexels src = level_zero(*this);
+    bool has_alpha = src.alpha != nullptr;
+    if (src.rgba8) {
+        has_alpha = std::any_of(rgba8.begin(), rgba8.end(), [](uint32_t v) { return (v >> 24) != 255u; });
+    }
     while (w > 1 || h > 1) {
         TextureLevel next;
         next.width = std::max(1, w / 2);
         next.height = std::max(1, h / 2);
         next.texels.resize(static_cast<size_t>(next.width) * next.height);
-        if (!src_alpha->empty()) next.alpha.resize(next.texels.size());
+        if (has_alpha) next.alpha.resize(next.texels.size());
         // A box filter over the source texels each destination texel covers (two or three per
         // axis where a size is odd).
         for (int y = 0; y < next.height; ++y) {
@@ -95,9 +152,9 @@ void Texture::build_mip_levels() {
                 float sum_alpha = 0.0f;
                 for (int yy = y_begin; yy < y_end; ++yy) {
                     for (int xx = x_begin; xx < x_end; ++xx) {
-                        const size_t i = static_cast<size_t>(yy) * w + xx;
-                        sum += (*src)[i];
-                        if (!src_alpha->empty()) sum_alpha += (*src_alpha)[i];
+                        const Vec4 texel = src.at(static_cast<size_t>(yy) * w + xx);
+                        sum += Color(texel);
+                        if (has_alpha) sum_alpha += texel.w;
                     }
                 }
                 const float inv = 1.0f / static_cast<float>((y_end - y_begin) * (x_end - x_begin));
@@ -109,8 +166,8 @@ void Texture::build_mip_levels() {
         w = next.width;
         h = next.height;
         mip_levels.push_back(std::move(next));
-        src = &mip_levels.back().texels;
-        src_alpha = &mip_levels.back().alpha;
+        const TextureLevel& level = mip_levels.back();
+        src = LevelTexels{level.width, level.height, level.texels.data(), has_alpha ? level.alpha.data() : nullptr};
     }
 }
 

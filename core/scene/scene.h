@@ -28,15 +28,22 @@ struct TextureLevel {
     std::vector<float> alpha;   // same layout; empty when the image is opaque
 };
 
-/// A texture in linear space (sRGB images decoded when loaded), with the wrap modes and the
-/// magnification filter of its glTF sampler. Minification always filters trilinearly over
-/// box-filtered mip levels chosen from the ray footprint (glTF's filters are hints; point
-/// sampling a distant texture aliases).
+/// How level 0 of a texture is stored: float texels (16-bit images, textures made in code), or
+/// the 8-bit RGBA an image holds, read through a table as sRGB-encoded colour (base colour,
+/// emission) or as linear data (metallic-roughness, normals). 8 bits take a quarter of the
+/// memory of float: a 2048 x 2048 image is 16 MB, not 64 MB, and reads from the cache faster.
+enum class TexelEncoding : uint8_t { Float, Srgb8, Linear8 };
+
+/// A texture read in linear space, with the wrap modes and the magnification filter of its glTF
+/// sampler. Minification always filters trilinearly over box-filtered mip levels chosen from
+/// the ray footprint (glTF's filters are hints; point sampling a distant texture aliases).
 struct Texture {
     int width = 0;
     int height = 0;
-    std::vector<Color> texels;  // level 0, row-major, row 0 at v = 0 (glTF: top of the image)
-    std::vector<float> alpha;   // level 0 alpha; empty when every texel is opaque
+    TexelEncoding encoding = TexelEncoding::Float;
+    std::vector<Color> texels;  // Float: level 0, row-major, row 0 at v = 0 (glTF: top of the image)
+    std::vector<float> alpha;   // Float: level 0 alpha; empty when every texel is opaque
+    std::vector<uint32_t> rgba8;  // Srgb8, Linear8: level 0 as texels, R in the lowest byte
     TextureWrap wrap_s = TextureWrap::Repeat;
     TextureWrap wrap_t = TextureWrap::Repeat;
     bool nearest = false;  // magFilter NEAREST: no bilinear interpolation at level 0
@@ -44,6 +51,9 @@ struct Texture {
     /// builder calls it); not hashed.
     std::vector<TextureLevel> mip_levels;
 
+    /// Level 0's texel i in linear RGB and alpha, whatever the encoding.
+    Vec4 texel(size_t i) const;
+    size_t texel_count() const { return encoding == TexelEncoding::Float ? texels.size() : rgba8.size(); }
     /// RGB and alpha at uv, bilinear (or nearest) at level 0: sample(uv, 0).
     Color sample(const Vec2& uv) const { return Color(sample_rgba(uv, 0.0f)); }
     /// RGBA at uv, filtered trilinearly at the mip level `lod` (0 = the image itself; the level

@@ -13,7 +13,7 @@ static_assert(sizeof(Material) == sizeof(std::string) + 304,
 static_assert(sizeof(PunctualLight) == sizeof(std::string) + 56,
               "PunctualLight changed: hash the new field in scene_content_hash");
 // Texture::mip_levels are derived from the texels and need no hashing of their own.
-static_assert(sizeof(Texture) == 16 + 3 * sizeof(std::vector<Color>),
+static_assert(sizeof(Texture) == 24 + 4 * sizeof(std::vector<Color>),
               "Texture changed: hash the new field in scene_content_hash");
 // Scene::triangle_normals and flat_shaded are derived from the positions and normals and need no
 // hashing of their own; cameras and warnings do not affect light transport.
@@ -109,8 +109,11 @@ Sha256Digest scene_content_hash(const Scene& scene) {
         const Texture& t = *texture;
         hasher.update_value(int32_t(t.width));
         hasher.update_value(int32_t(t.height));
+        hasher.update_value(uint8_t(t.encoding));
         hash_array(hasher, t.texels, [&](const Color& c) { hash_vec3(hasher, c); });
         hash_array(hasher, t.alpha, [&](float a) { hash_float(hasher, a); });
+        hasher.update_value(uint64_t(t.rgba8.size()));
+        hasher.update_values(std::span<const uint32_t>(t.rgba8));
         hasher.update_value(uint8_t(t.wrap_s));
         hasher.update_value(uint8_t(t.wrap_t));
         hasher.update_value(uint8_t(t.nearest ? 1 : 0));

@@ -392,13 +392,16 @@ void expect_checker_texture(const Scene& scene) {
     const Texture& tex = *scene.textures[0];
     ASSERT_EQ(tex.width, 2);
     ASSERT_EQ(tex.height, 2);
-    ASSERT_EQ(tex.texels.size(), 4u);
+    // An 8-bit image keeps its bytes, read through the sRGB curve.
+    EXPECT_EQ(tex.encoding, TexelEncoding::Srgb8);
+    ASSERT_EQ(tex.texel_count(), 4u);
     // Row 0 is the first image row: (255,0,0) (0,128,0) / (0,0,64) (188,188,188), sRGB.
-    expect_vec_near(tex.texels[0], {1, 0, 0});
-    expect_vec_near(tex.texels[1], {0, 0.21586050f, 0});
-    expect_vec_near(tex.texels[1], {0, srgb_eotf(128.0f / 255.0f), 0});
-    expect_vec_near(tex.texels[2], {0, 0, srgb_eotf(64.0f / 255.0f)});
-    expect_vec_near(tex.texels[3], Vec3(srgb_eotf(188.0f / 255.0f)));
+    expect_vec_near(Vec3(tex.texel(0)), {1, 0, 0});
+    expect_vec_near(Vec3(tex.texel(1)), {0, 0.21586050f, 0});
+    expect_vec_near(Vec3(tex.texel(1)), {0, srgb_eotf(128.0f / 255.0f), 0});
+    expect_vec_near(Vec3(tex.texel(2)), {0, 0, srgb_eotf(64.0f / 255.0f)});
+    expect_vec_near(Vec3(tex.texel(3)), Vec3(srgb_eotf(188.0f / 255.0f)));
+    EXPECT_FLOAT_EQ(tex.texel(3).w, 1.0f);
     // Texture times baseColorFactor (0.5, 1, 1) at texel centres.
     ASSERT_EQ(scene.materials.size(), 1u);
     EXPECT_EQ(scene.materials[0].base_color_texture.texture, 0);
@@ -417,6 +420,7 @@ TEST(GltfLoader, SixteenBitTextureKeepsPrecision) {
     const Scene scene = load_ok("texture16.gltf");
     ASSERT_EQ(scene.textures.size(), 1u);
     const Texture& tex = *scene.textures[0];
+    EXPECT_EQ(tex.encoding, TexelEncoding::Float);
     ASSERT_EQ(tex.texels.size(), 4u);
     // 32768/65535 decodes to 0.21404; truncation to 8 bits (128/255) would give 0.21586.
     expect_vec_near(tex.texels[0], Vec3(srgb_eotf(32768.0f / 65535.0f)), 1e-5f);

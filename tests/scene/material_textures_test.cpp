@@ -199,6 +199,45 @@ TEST(MipMaps, LevelsAreBoxMeansAndTheFootprintPicksThem) {
     EXPECT_NEAR(t.sample_rgba(Vec2(0.0625f, 0.0625f), 1.0f).x, 0.5f, 1e-6f);
 }
 
+TEST(EightBitTexels, ReadThroughTheirCurveAndMipLikeTheirFloatTwin) {
+    // A 4 x 2 texture of 8-bit RGBA, with one translucent texel, and the same texture in float.
+    const uint8_t bytes[8][4] = {{0, 64, 128, 255},  {255, 1, 2, 255},   {10, 20, 30, 255}, {200, 100, 50, 255},
+                                 {7, 77, 177, 255},  {33, 66, 99, 128},  {250, 5, 0, 255},  {128, 128, 128, 255}};
+    for (const TexelEncoding encoding : {TexelEncoding::Srgb8, TexelEncoding::Linear8}) {
+        Texture packed;
+        packed.width = 4;
+        packed.height = 2;
+        packed.encoding = encoding;
+        Texture twin = packed;
+        twin.encoding = TexelEncoding::Float;
+        const auto curve = [encoding](uint8_t code) {
+            const float c = code / 255.0f;
+            if (encoding == TexelEncoding::Linear8) return c;
+            return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+        };
+        for (const auto& b : bytes) {
+            packed.rgba8.push_back(uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24);
+            twin.texels.push_back(Color(curve(b[0]), curve(b[1]), curve(b[2])));
+            twin.alpha.push_back(b[3] / 255.0f);
+        }
+        ASSERT_EQ(packed.texel_count(), 8u);
+        for (size_t i = 0; i < 8; ++i) {
+            EXPECT_EQ(packed.texel(i), twin.texel(i)) << i;  // the same floats, bit for bit
+        }
+        EXPECT_FLOAT_EQ(packed.texel(5).w, 128.0f / 255.0f);
+        packed.build_mip_levels();
+        twin.build_mip_levels();
+        ASSERT_EQ(packed.level_count(), twin.level_count());
+        for (size_t level = 0; level < packed.mip_levels.size(); ++level) {
+            EXPECT_EQ(packed.mip_levels[level].texels, twin.mip_levels[level].texels) << level;
+            EXPECT_EQ(packed.mip_levels[level].alpha, twin.mip_levels[level].alpha) << level;
+        }
+        for (const Vec2 uv : {Vec2(0.1f, 0.2f), Vec2(0.55f, 0.8f), Vec2(-0.3f, 1.7f)}) {
+            for (const float lod : {0.0f, 0.4f, 1.0f, 2.5f}) EXPECT_EQ(packed.sample_rgba(uv, lod), twin.sample_rgba(uv, lod));
+        }
+    }
+}
+
 TEST(Extensions, ClearcoatAndVolumeAreRead) {
     const Scene scene = load("coat_volume.gltf");  // both extensions required
     ASSERT_EQ(scene.materials.size(), 3u);
