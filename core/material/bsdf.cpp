@@ -230,6 +230,12 @@ bool Bsdf::reads_as_diffuse(LobeMask lobes) const {
     return !glossy && !rough_glass && !rough_coat;
 }
 
+bool Bsdf::reads_as_diffuse_from_both_sides(LobeMask lobes) const {
+    const bool glossy = (lobes & lobes_ & mask_of(LobeKind::Glossy)) != 0;
+    const bool rough_coat = m_->coat > 0.0f && !m_->coat_smooth && in_mask(lobes, m_->coat_kind);
+    return !glossy && !rough_coat;
+}
+
 bool Bsdf::transmits_non_delta() const { return photond::transmits_non_delta(*m_); }
 
 Color Bsdf::diffuse_like_reflectance(const Vec3& wo) const {

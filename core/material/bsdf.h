@@ -205,6 +205,10 @@ public:
     /// glossy lobe, no non-delta transmission and no rough clearcoat among them). Then
     /// final-gather hits read their share as diffuse_like_reflectance(wo) / pi * E.
     bool reads_as_diffuse(LobeMask lobes = kNonDeltaLobes) const;
+    /// Like reads_as_diffuse, except that rough glass of diffuse kind (roughness at least
+    /// kGlossyRoughness) is allowed among the lobes: light reaches wo from both sides of the
+    /// surface, and each side's irradiance may stand for its incident light.
+    bool reads_as_diffuse_from_both_sides(LobeMask lobes = kNonDeltaLobes) const;
     /// Whether light passes through a non-delta lobe (rough transmission).
     bool transmits_non_delta() const;
     /// Reflectance towards wo of the lobes of diffuse kind under uniform incident radiance
