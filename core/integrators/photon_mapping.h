@@ -39,8 +39,9 @@ struct PhotonMapIntegratorSettings {
 };
 
 /// Bump when the irradiance cache's prepass or gathering changes what it stores for the same
-/// inputs: every cached render cache then misses.
-inline constexpr uint32_t kRenderCacheAlgorithmVersion = 2;  // 2: the light tree (LightSelection)
+/// inputs: every cached render cache then misses. 2: the light tree (LightSelection); 3: rough
+/// glass at gather hits read from both sides.
+inline constexpr uint32_t kRenderCacheAlgorithmVersion = 3;
 
 /// Nearest volume photons per estimate of the in-scattered light along a gather ray, at most.
 inline constexpr uint32_t kGatherVolumePhotons = 32;
