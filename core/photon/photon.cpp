@@ -61,7 +61,7 @@ uint32_t round_half_away(float v) {
 
 // Octahedral normal codes (Meyer et al. 2010): the unit octahedron |x| + |y| + |z| = 1 folded
 // onto the square [-1, 1]^2, 16 bits per coordinate.
-constexpr float kNormalScale = 65535.0f;
+constexpr float kNormalScale = Photon::kNormalScale;
 
 float sign_not_zero(float v) { return v >= 0.0f ? 1.0f : -1.0f; }
 
@@ -71,17 +71,6 @@ uint16_t normal_code(float c) {
 
 }  // namespace
 
-Vec3 Photon::normal() const {
-    if (!has_normal()) return Vec3(0.0f);
-    const float x = float(normal_u_) * (2.0f / kNormalScale) - 1.0f;
-    const float y = float(normal_v_) * (2.0f / kNormalScale) - 1.0f;
-    Vec3 n(x, y, 1.0f - std::abs(x) - std::abs(y));
-    if (n.z < 0.0f) {
-        n.x = (1.0f - std::abs(y)) * sign_not_zero(x);
-        n.y = (1.0f - std::abs(x)) * sign_not_zero(y);
-    }
-    return glm::normalize(n);  // |n| >= 1 / sqrt(3): never zero
-}
 
 constinit const PhotonDirectionTables kPhotonDirectionTables = make_direction_tables();
 

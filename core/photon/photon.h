@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <type_traits>
 
@@ -62,8 +63,20 @@ struct Photon {
     }
 
     /// The unit surface normal on the side the photon arrived from, or zero when the photon was
-    /// made without one.
-    Vec3 normal() const;
+    /// made without one. Inline: every photon a search meets may be asked for it.
+    Vec3 normal() const {
+        if (!has_normal()) return Vec3(0.0f);
+        const float x = float(normal_u_) * (2.0f / kNormalScale) - 1.0f;
+        const float y = float(normal_v_) * (2.0f / kNormalScale) - 1.0f;
+        Vec3 n(x, y, 1.0f - std::abs(x) - std::abs(y));
+        if (n.z < 0.0f) {  // the lower half, folded out of the square's corners
+            n.x = (1.0f - std::abs(y)) * (x >= 0.0f ? 1.0f : -1.0f);
+            n.y = (1.0f - std::abs(x)) * (y >= 0.0f ? 1.0f : -1.0f);
+        }
+        return glm::normalize(n);  // |n| >= 1 / sqrt(3): never zero
+    }
+    /// The largest octahedral normal code (16 bits a coordinate).
+    static constexpr float kNormalScale = 65535.0f;
     bool has_normal() const { return normal_u_ != 0 || normal_v_ != 0; }
 
     /// Six bits for the caller (e.g. which map, caustic or not), given to make_photon.
