@@ -43,24 +43,24 @@ Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si
     // A normal map bends the shading normal: the precomputed irradiance (about the unbent
     // normal) would light the surface as if flat, and brighten what it lights in turn.
     const Vec3 bent = bent_shading_normal(si, front);
-    if (maps.irradiance && bsdf.reads_as_diffuse(lobes) && bent == Vec3(0.0f)) {
+    if (maps.irradiance && bent == Vec3(0.0f)) {
         Color e;
-        if (maps.irradiance->nearest_irradiance(si.p, n, settings.max_radius, &e))
-            return bsdf.diffuse_like_reflectance(wo) * kInvPi * e;
-    }
-    if (maps.irradiance && bsdf.transmits_non_delta() && bsdf.reads_as_diffuse_from_both_sides(lobes) &&
-        bent == Vec3(0.0f)) {
-        // Each side's incident light taken as uniform, E_side / pi: exact for uniform light on
-        // either side, as the albedo read above is. A kNN estimate here evaluated the BSDF for
-        // each of k photons, and rough glass's photons lie sparse on small curved solids: most
-        // of a glass-heavy scene's gathering time went to them.
-        const float u_lobe = rng.next_float();
-        const Vec2 u = rng.next_vec2();
-        const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Radiance, lobes);
-        if (!s || !(s->pdf > 0.0f) || is_black(s->weight)) return Color(0.0f);
-        Color e;
-        const Vec3 side = glm::dot(s->wi, n) >= 0.0f ? n : -n;
-        if (maps.irradiance->nearest_irradiance(si.p, side, settings.max_radius, &e)) return s->weight * kInvPi * e;
+        if (bsdf.reads_as_diffuse(lobes)) {
+            if (maps.irradiance->nearest_irradiance(si.p, n, settings.max_radius, &e))
+                return bsdf.diffuse_like_reflectance(wo) * kInvPi * e;
+        } else if (bsdf.reads_as_diffuse_from_both_sides(lobes)) {
+            // Rough glass: each side's incident light taken as uniform, E_side / pi, exact for
+            // uniform light on either side as the albedo read above is. A kNN estimate here
+            // evaluated the BSDF for each of k photons, and rough glass's photons lie sparse on
+            // small curved solids: most of a glass-heavy scene's gathering time went to them.
+            const float u_lobe = rng.next_float();
+            const Vec2 u = rng.next_vec2();
+            const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Radiance, lobes);
+            if (!s || !(s->pdf > 0.0f) || is_black(s->weight)) return Color(0.0f);
+            const Vec3 side = glm::dot(s->wi, n) >= 0.0f ? n : -n;
+            if (maps.irradiance->nearest_irradiance(si.p, side, settings.max_radius, &e))
+                return s->weight * kInvPi * e;
+        }
     }
     RadianceEstimateOptions options;
     // Where only the bent normal keeps the precomputed irradiance from serving, fewer photons:

@@ -224,10 +224,8 @@ Color Bsdf::diffuse_reflectance(const Vec3& wo) const {
 }
 
 bool Bsdf::reads_as_diffuse(LobeMask lobes) const {
-    const bool glossy = (lobes & lobes_ & mask_of(LobeKind::Glossy)) != 0;
     const bool rough_glass = m_->glass_weight > 0.0f && !m_->glass_delta && in_mask(lobes, m_->glass_kind);
-    const bool rough_coat = m_->coat > 0.0f && !m_->coat_smooth && in_mask(lobes, m_->coat_kind);
-    return !glossy && !rough_glass && !rough_coat;
+    return reads_as_diffuse_from_both_sides(lobes) && !rough_glass;
 }
 
 bool Bsdf::reads_as_diffuse_from_both_sides(LobeMask lobes) const {

@@ -60,17 +60,12 @@ uint32_t round_half_away(float v) {
 }
 
 // Octahedral normal codes (Meyer et al. 2010): the unit octahedron |x| + |y| + |z| = 1 folded
-// onto the square [-1, 1]^2, 16 bits per coordinate.
-constexpr float kNormalScale = Photon::kNormalScale;
-
-float sign_not_zero(float v) { return v >= 0.0f ? 1.0f : -1.0f; }
-
+// onto the square [-1, 1]^2, 16 bits per coordinate (Photon::normal decodes them).
 uint16_t normal_code(float c) {
-    return uint16_t(round_half_away(std::clamp(c * 0.5f + 0.5f, 0.0f, 1.0f) * kNormalScale));
+    return uint16_t(round_half_away(std::clamp(c * 0.5f + 0.5f, 0.0f, 1.0f) * Photon::kNormalScale));
 }
 
 }  // namespace
-
 
 constinit const PhotonDirectionTables kPhotonDirectionTables = make_direction_tables();
 
@@ -121,8 +116,8 @@ Photon make_photon(Vec3 position, Vec3 direction, Color flux, uint8_t user_flags
     if (l1 > 0.0f && std::isfinite(l1)) {
         float x = normal.x / l1, y = normal.y / l1;
         if (normal.z < 0.0f) {
-            const float folded_x = (1.0f - std::abs(y)) * sign_not_zero(x);
-            y = (1.0f - std::abs(x)) * sign_not_zero(y);
+            const float folded_x = (1.0f - std::abs(y)) * Photon::sign_not_zero(x);
+            y = (1.0f - std::abs(x)) * Photon::sign_not_zero(y);
             x = folded_x;
         }
         p.normal_u_ = normal_code(x);

@@ -70,13 +70,15 @@ struct Photon {
         const float y = float(normal_v_) * (2.0f / kNormalScale) - 1.0f;
         Vec3 n(x, y, 1.0f - std::abs(x) - std::abs(y));
         if (n.z < 0.0f) {  // the lower half, folded out of the square's corners
-            n.x = (1.0f - std::abs(y)) * (x >= 0.0f ? 1.0f : -1.0f);
-            n.y = (1.0f - std::abs(x)) * (y >= 0.0f ? 1.0f : -1.0f);
+            n.x = (1.0f - std::abs(y)) * sign_not_zero(x);
+            n.y = (1.0f - std::abs(x)) * sign_not_zero(y);
         }
         return glm::normalize(n);  // |n| >= 1 / sqrt(3): never zero
     }
     /// The largest octahedral normal code (16 bits a coordinate).
     static constexpr float kNormalScale = 65535.0f;
+    /// The octahedral fold's sign: +1 for zero.
+    static float sign_not_zero(float v) { return v >= 0.0f ? 1.0f : -1.0f; }
     bool has_normal() const { return normal_u_ != 0 || normal_v_ != 0; }
 
     /// Six bits for the caller (e.g. which map, caustic or not), given to make_photon.

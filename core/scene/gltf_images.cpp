@@ -53,11 +53,6 @@ std::optional<std::pair<uint32_t, uint32_t>> encoded_image_size(std::span<const 
     return std::nullopt;
 }
 
-// sRGB electro-optical transfer function, IEC 61966-2-1.
-float srgb_to_linear(float c) {
-    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
-}
-
 }  // namespace
 
 bool keep_encoded_image(tinygltf::Image* image, const int image_index, std::string* err,

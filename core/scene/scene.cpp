@@ -30,7 +30,7 @@ struct ByteTables {
     ByteTables() {
         for (int i = 0; i < 256; ++i) {
             const float c = static_cast<float>(i) / 255.0f;
-            srgb[i] = c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+            srgb[i] = srgb_to_linear(c);
             linear[i] = c;
         }
     }
@@ -103,6 +103,8 @@ LevelTexels level_zero(const Texture& t) {
 }
 
 }  // namespace
+
+float srgb_to_linear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
 
 Vec4 Texture::texel(size_t i) const { return level_zero(*this).at(i); }
 

@@ -34,6 +34,9 @@ struct TextureLevel {
 /// memory of float: a 2048 x 2048 image is 16 MB, not 64 MB, and reads from the cache faster.
 enum class TexelEncoding : uint8_t { Float, Srgb8, Linear8 };
 
+/// The sRGB electro-optical transfer function (IEC 61966-2-1): an encoded value in [0, 1] to linear.
+float srgb_to_linear(float c);
+
 /// A texture read in linear space, with the wrap modes and the magnification filter of its glTF
 /// sampler. Minification always filters trilinearly over box-filtered mip levels chosen from
 /// the ray footprint (glTF's filters are hints; point sampling a distant texture aliases).

@@ -48,6 +48,26 @@ std::shared_ptr<const RenderScene> glossy_spheres() {
     return make_render_scene(builder.build().value());
 }
 
+/// `photon-map` without the irradiance cache: `global` photons (no caustic map), `rays` gather
+/// rays, `spp` samples per pixel.
+Image render_photon_map(const std::shared_ptr<const RenderScene>& rs, const Camera& camera, uint32_t global,
+                        uint32_t rays, int spp) {
+    PhotonTracingSettings tracing;
+    tracing.global_photons = global;
+    tracing.caustic_photons = 0;
+    auto traced = trace_photons(*rs, tracing);
+    EXPECT_TRUE(traced) << traced.error().message;
+    if (!traced) return Image(camera.width(), camera.height());
+    EXPECT_TRUE(traced->irradiance) << "gather hits on diffuse-reading surfaces read the precomputed irradiance";
+    PhotonMapIntegratorSettings settings;
+    settings.gather.rays = rays;
+    settings.use_irradiance_cache = false;
+    const PhotonMapIntegrator photon_map(rs, std::make_shared<const PhotonMaps>(std::move(traced).value()), settings);
+    TileSettings tiles;
+    tiles.samples_per_pixel = spp;
+    return render_tiles(photon_map, camera, tiles).layers.beauty;
+}
+
 TEST(GlossyGather, GlossyLobesFollowedBySamplingAgreeWithPathPerPixel) {
     const auto rs = glossy_spheres();
     const Camera camera = Camera::create(rs->scene->cameras.at(0), 48, 32).value();
@@ -113,17 +133,7 @@ TEST(GlossyGather, RoughMetalUnderAUniformSkyIsAsSmoothAsPath) {
     TileSettings tiles;
     tiles.samples_per_pixel = 16;
     const Image path16 = render_tiles(PathIntegrator(rs), camera, tiles).layers.beauty;
-
-    PhotonTracingSettings tracing;
-    tracing.global_photons = 20000;
-    tracing.caustic_photons = 0;
-    auto traced = trace_photons(*rs, tracing);
-    ASSERT_TRUE(traced) << traced.error().message;
-    PhotonMapIntegratorSettings settings;
-    settings.gather.rays = 64;
-    settings.use_irradiance_cache = false;
-    const PhotonMapIntegrator photon_map(rs, std::make_shared<const PhotonMaps>(std::move(traced).value()), settings);
-    const Image image = render_tiles(photon_map, camera, tiles).layers.beauty;
+    const Image image = render_photon_map(rs, camera, 20000, 64, tiles.samples_per_pixel);
     const ImageError ours = compare_images(image, reference).value();
     const ImageError theirs = compare_images(path16, reference).value();
     std::printf("rough metal plane under a uniform sky, 16 spp: photon-map relMSE %.6f, path %.6f\n",
@@ -160,20 +170,7 @@ TEST(GlossyGather, FloorUnderARoughGlassRoofAgreesWithPath) {
     TileSettings path_tiles;
     path_tiles.samples_per_pixel = 1024;
     const Image reference = render_tiles(PathIntegrator(rs), camera, path_tiles).layers.beauty;
-
-    PhotonTracingSettings tracing;
-    tracing.global_photons = 100000;
-    tracing.caustic_photons = 0;
-    auto traced = trace_photons(*rs, tracing);
-    ASSERT_TRUE(traced) << traced.error().message;
-    ASSERT_TRUE(traced->irradiance) << "the two-sided read needs precomputed irradiance";
-    PhotonMapIntegratorSettings settings;
-    settings.gather.rays = 128;
-    settings.use_irradiance_cache = false;
-    const PhotonMapIntegrator photon_map(rs, std::make_shared<const PhotonMaps>(std::move(traced).value()), settings);
-    TileSettings tiles;
-    tiles.samples_per_pixel = 16;
-    const Image image = render_tiles(photon_map, camera, tiles).layers.beauty;
+    const Image image = render_photon_map(rs, camera, 100000, 128, 16);
     const ImageError error = compare_images(image, reference).value();
     std::printf("floor under a rough glass roof, 24x24 vs path: mean %.4f against %.4f (%+.2f %%), relMSE %.5f\n",
                 error.mean, error.reference_mean, 100.0 * error.mean_bias, error.relative_mse);
