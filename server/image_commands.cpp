@@ -18,7 +18,7 @@ int run_compare_command(std::span<const std::string> args) {
         "[--block N]\n"
         "                       [--error-png F] [--json]\n"
         "prints relMSE, RMSE, the 99th percentile of per-pixel absolute error, and the mean bias;\n"
-        "--block N compares N x N block averages (the region in block units then);\n"
+        "--block N compares N x N block averages (the region still in pixels, rounded out to blocks);\n"
         "--error-png F writes the per-pixel relative squared error as a PNG (white = 1 or more);\n"
         "--json prints the figures as one JSON object (bias as a fraction, not in percent)\n";
     std::vector<std::string> files;

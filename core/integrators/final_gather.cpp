@@ -34,9 +34,10 @@ constexpr uint32_t kBentNormalPhotons = 32;
 /// albedo at wo, exact under uniform light, instead of evaluating the BSDF per photon); for rough
 /// glass as rough, the same from both sides (one lobe sample picks the side and carries the
 /// lobe's weight); else the global map's estimate.
+/// `exclude_flags`: photons the estimate leaves out (where it falls back to one).
 Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si, const Bsdf& bsdf,
                             const Vec3& wo, const GatherSettings& settings, Rng& rng,
-                            LobeMask lobes = kNonDeltaLobes) {
+                            LobeMask lobes = kNonDeltaLobes, uint8_t exclude_flags = 0) {
     if (!maps.global) return Color(0.0f);
     const bool front = glm::dot(si.surface_normal, wo) >= 0.0f;
     const Vec3 n = front ? si.surface_normal : -si.surface_normal;
@@ -69,6 +70,7 @@ Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si
     options.k = diffuse_but_bent ? std::min(settings.k_global, kBentNormalPhotons) : settings.k_global;
     options.max_radius = settings.max_radius;
     options.lobes = lobes;
+    options.exclude_flags = exclude_flags;
     return maps.global->estimate_radiance(si.p, n, bsdf, wo, estimate_options_at(options, si, bsdf, front));
 }
 
@@ -76,16 +78,24 @@ Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si
 
 Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& counters, float* distance,
                                          FirstHitEmission* emission) const {
+    return trace_gather_ray(ray, rng, counters, distance, emission, false);
+}
+
+Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& counters, float* distance,
+                                      FirstHitEmission* emission, bool caustic_chains) const {
     const RenderScene& rs = *scene_;
     // Walk through ideal specular surfaces; `depth` counts them. At glossy surfaces the glossy
     // lobes are followed too (up to settings_.max_glossy_bounces): reading them from the photons
     // would evaluate a sharp lobe per photon, whose rare aligned photons are fireflies.
+    // While the walk is a caustic chain (`caustic_chains`, and every bounce so far specular or
+    // glossy: `from` is null), emitters count nowhere: the caustic map holds that light.
     struct Walker {
         const FinalGatherer& g;
         const RenderScene& rs;
         Rng& rng;
         RayCounters& counters;
         FirstHitEmission* emission;
+        bool caustic_chains;
         /// Where a ray that samples a glossy lobe started, and the lobe's pdf for it (0 once a
         /// delta bounce followed: then no light sample could have found what it meets).
         struct GlossyOrigin {
@@ -161,9 +171,17 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
             const Bsdf bsdf = make_bsdf(rs, si, wo);
             if (bsdf.has_non_delta()) {
                 constexpr LobeMask kGlossy = mask_of(LobeKind::Glossy);
+                const bool caustic_chain = caustic_chains && !from && bsdf.continues_caustic(LobeKind::Glossy);
                 if ((bsdf.lobes() & kGlossy) && glossy_bounces < g.settings_.max_glossy_bounces) {
-                    radiance += glossy_lobes(si, bsdf, wo, depth, glossy_bounces);
+                    radiance += glossy_lobes(si, bsdf, wo, depth, glossy_bounces, caustic_chain);
                     radiance += radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_, rng, kNonDeltaLobes & ~kGlossy);
+                } else if ((bsdf.lobes() & kGlossy) && caustic_chain) {
+                    // The chain's last glossy lobe: the photons that came to it through a diffuse
+                    // surface (those straight from the lights or through caustic bounces would
+                    // continue the caustic chain).
+                    radiance += radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_, rng, kNonDeltaLobes & ~kGlossy);
+                    radiance += radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_, rng, kGlossy,
+                                                      photon_flags::kDirect | photon_flags::kCaustic);
                 } else {
                     radiance += radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_, rng);
                 }
@@ -179,25 +197,27 @@ Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& 
             return volume_transmittance(*rs.scene, si) * radiance;
         }
         /// The glossy lobes' reflection at a gather hit, as a path tracer takes it: a light
-        /// sample and a lobe sample, weighted by the power heuristic.
+        /// sample and a lobe sample, weighted by the power heuristic. In a caustic chain, the
+        /// lobe sample alone, and the chain goes on.
         Color glossy_lobes(const SurfaceInteraction& si, const Bsdf& bsdf, const Vec3& wo, int depth,
-                           int glossy_bounces) const {
+                           int glossy_bounces, bool caustic_chain) const {
             constexpr LobeMask kGlossy = mask_of(LobeKind::Glossy);
             SampleContext context{rng, counters};
-            Color radiance = sample_direct_light(rs, *rs.lights, si, bsdf, wo, context, true, kGlossy);
+            Color radiance(0.0f);
+            if (!caustic_chain) radiance += sample_direct_light(rs, *rs.lights, si, bsdf, wo, context, true, kGlossy);
             const float u_lobe = rng.next_float();
             const Vec2 u = rng.next_vec2();
             const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Radiance, kGlossy);
             if (s && s->pdf > 0.0f && !is_black(s->weight)) {
                 const GlossyOrigin origin{si.p, s->pdf};
-                radiance += s->weight *
-                            along(spawn_ray(rs, si, s->wi), depth, nullptr, false, glossy_bounces + 1, &origin);
+                radiance += s->weight * along(spawn_ray(rs, si, s->wi), depth, nullptr, false, glossy_bounces + 1,
+                                              caustic_chain ? nullptr : &origin);
             }
             return radiance;
         }
     };
     if (emission) *emission = FirstHitEmission{};
-    return Walker{*this, rs, rng, counters, emission}.along(ray, 0, distance, true);
+    return Walker{*this, rs, rng, counters, emission, caustic_chains}.along(ray, 0, distance, true);
 }
 
 GatherResult FinalGatherer::gather(const Vec3& p, const Vec3& n, const Vec3& geometric_normal, Rng& rng,
@@ -224,8 +244,8 @@ GatherResult FinalGatherer::gather(const Vec3& p, const Vec3& n, const Vec3& geo
             // Directions under the geometric surface (tilted shading normals) see nothing.
             if (glm::dot(direction, geometric_normal) <= 0.0f) continue;
             float d = 0.0f;
-            const Color L = gather_ray_radiance(Ray{rs.tracer->offset_origin(p, geometric_normal, direction), direction},
-                                                rng, counters, &d);
+            const Color L = trace_gather_ray(Ray{rs.tracer->offset_origin(p, geometric_normal, direction), direction},
+                                             rng, counters, &d, nullptr, maps_->caustic != nullptr);
             radiance[cell(j, k)] = L;
             distance[cell(j, k)] = d;
             sum += DVec3(L);

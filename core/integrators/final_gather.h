@@ -6,11 +6,13 @@
 // at no extra rays.
 //
 // Gather rays add no emitted light, and pass through ideal specular surfaces (up to a depth)
-// without counting emitters behind them either: light arriving through specular surfaces straight
-// from an emitter is the caustic map's share, so nothing is counted twice. Glossy lobes where a
-// gather ray lands are followed by sampling, with light samples there and the emitters their
-// rays meet weighted by the power heuristic: light a glossy lobe reflects is no caustic (the
-// caustic map holds L S+ D with S ideal specular only).
+// and sharply glossy ones (by sampling their lobes) without counting emitters behind them
+// either: light arriving through such surfaces straight from an emitter is the caustic map's
+// share (L S+ D, S ideal specular or sharply glossy: Bsdf::continues_caustic), so nothing is
+// counted twice. Other glossy lobes, and any glossy lobe once a gather ray's path has met a
+// surface of diffuse kind, take light samples and weight the emitters their rays meet by the
+// power heuristic, as a path tracer does. Without a caustic map every glossy lobe does: its
+// light then comes from the gather alone.
 #pragma once
 
 #include <array>
@@ -84,6 +86,10 @@ public:
         /// gather_ray_radiance returns; zero without an atmosphere).
         Color in_scattered{0.0f};
     };
+    /// For rays sampled from the glossy lobes of a visible point (and radiance-cache records):
+    /// glossy lobes met on the way count all the light they reflect, emitters included, so the
+    /// point reads the caustic map's glossy photons by its Lambertian lobe only
+    /// (photon_flags::kGlossyCaustic).
     Color gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& counters, float* distance,
                               FirstHitEmission* emission = nullptr) const;
 
@@ -91,6 +97,12 @@ public:
     const RenderScene& scene() const { return *scene_; }
 
 private:
+    /// gather_ray_radiance; `caustic_chains`: the light that reaches the ray's origin from an
+    /// emitter through specular and glossy bounces alone is the caustic map's (a gather for
+    /// irradiance at a diffuse point, when there is a caustic map).
+    Color trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& counters, float* distance,
+                           FirstHitEmission* emission, bool caustic_chains) const;
+
     std::shared_ptr<const RenderScene> scene_;
     std::shared_ptr<const PhotonMaps> maps_;
     GatherSettings settings_;

@@ -41,6 +41,13 @@ PhotonMapIntegrator::PhotonMapIntegrator(std::shared_ptr<const RenderScene> scen
         gather.gather_diffuse_sky = scene_->lights_with_sky_peaks != nullptr;
         gatherer_ = std::make_unique<FinalGatherer>(scene_, maps_, gather);
     }
+    if (maps_->caustic) {
+        for (const Photon& photon : maps_->caustic->tree().photons())
+            if (!(photon.user_flags() & photon_flags::kGlossyCaustic)) {
+                specular_caustics_ = true;
+                break;
+            }
+    }
     direct_lights_ = gatherer_ && scene_->lights_with_sky_peaks ? scene_->lights_with_sky_peaks.get()
                                                                   : scene_->lights.get();
     if (gatherer_ && settings_.radiance_cache.enabled) {
@@ -221,21 +228,24 @@ Color PhotonMapIntegrator::indirect_irradiance(const DiffusePoint& point, Sample
 
 /// Whether the caustic map's estimate at a visible point may add light that shows, next to the
 /// luminance `other` of what the point sends otherwise (emission, direct and indirect light). A
-/// surface that reads as diffuse reflects its irradiance whatever its direction, so its caustic
-/// is about rho(wo) / pi times the caustic irradiance precomputed at the nearest caustic photon:
-/// where that is under kInvisibleCausticRatio of `other`, the estimate (a hundred photons, each
-/// through the BSDF) is skipped. Each skipped sample leaves out under that share of its own value,
-/// so no pixel changes by more. No caustic photon within the estimate's radius means next to none
-/// would be found. Glossy and translucent surfaces are always estimated: their lobes can gather a
-/// caustic that is faint as irradiance into a highlight.
+/// surface that reads as diffuse (or is read by its Lambertian lobe alone: `lambertian_only`)
+/// reflects its irradiance whatever its direction, so its caustic is about rho(wo) / pi times the
+/// caustic irradiance precomputed at the nearest caustic photon: where that is under
+/// kInvisibleCausticRatio of `other`, the estimate (a hundred photons, each through the BSDF) is
+/// skipped. Each skipped sample leaves out under that share of its own value, so no pixel changes
+/// by more. No caustic photon within the estimate's radius means next to none would be found.
+/// Glossy and translucent surfaces read by their other lobes are always estimated: their lobes
+/// can gather a caustic that is faint as irradiance into a highlight.
 bool PhotonMapIntegrator::caustic_may_show(const Vec3& p, const Vec3& normal, const Bsdf& bsdf, const Vec3& wo,
-                                           float other) const {
+                                           float other, bool lambertian_only) const {
     // reads_as_diffuse() is false for rough transmission too.
-    if (!maps_->caustic_irradiance || !bsdf.reads_as_diffuse()) return true;
+    const bool diffuse = lambertian_only || bsdf.reads_as_diffuse();
+    const Color rho = !diffuse ? Color(0.0f) : lambertian_only ? bsdf.diffuse_reflectance(wo) : bsdf.diffuse_like_reflectance(wo);
+    if (diffuse && is_black(rho)) return false;
+    if (!maps_->caustic_irradiance || !diffuse) return true;
     Color irradiance;
     if (!maps_->caustic_irradiance->nearest_irradiance(p, normal, caustic_options_.max_radius, &irradiance)) return false;
-    const float caustic = luminance(bsdf.diffuse_like_reflectance(wo) * kInvPi * irradiance);
-    return caustic >= static_cast<float>(kInvisibleCausticRatio) * other;
+    return luminance(rho * kInvPi * irradiance) >= static_cast<float>(kInvisibleCausticRatio) * other;
 }
 
 RadianceParts PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_length,
@@ -390,11 +400,18 @@ RadianceParts PhotonMapIntegrator::surface_radiance(const Ray& ray, const Surfac
         // Last, so that what the point sends otherwise is known (caustic_may_show).
         if (maps_->caustic) {
             ++context.counters.caustic_points;
-            if (caustic_may_show(si.p, normal, bsdf, wo, luminance(radiance.total)))
-                radiance.add_caustic(maps_->caustic->estimate_radiance(si.p, normal, bsdf, wo,
-                                                                       estimate_options_at(caustic_options_, si, bsdf, front)));
-            else
+            // The rays (or the radiance cache) of the other non-delta lobes follow glossy lobes to
+            // the lights: they hold the glossy caustics those lobes reflect, and with no ideal
+            // specular caustics in the map, all the caustic light those lobes see.
+            const bool lambertian_only = glossy && !specular_caustics_;
+            if (caustic_may_show(si.p, normal, bsdf, wo, luminance(radiance.total), lambertian_only)) {
+                RadianceEstimateOptions options = estimate_options_at(caustic_options_, si, bsdf, front);
+                if (glossy) options.restricted_flags = photon_flags::kGlossyCaustic;
+                if (lambertian_only) options.lobes = kLambertianLobe;
+                radiance.add_caustic(maps_->caustic->estimate_radiance(si.p, normal, bsdf, wo, options));
+            } else {
                 ++context.counters.caustic_skipped;
+            }
         }
     }
     if (bsdf.has_delta() && depth < settings_.max_specular_depth) {

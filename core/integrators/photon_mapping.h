@@ -40,8 +40,8 @@ struct PhotonMapIntegratorSettings {
 
 /// Bump when the irradiance cache's prepass or gathering changes what it stores for the same
 /// inputs: every cached render cache then misses. 2: the light tree (LightSelection); 3: rough
-/// glass at gather hits read from both sides.
-inline constexpr uint32_t kRenderCacheAlgorithmVersion = 3;
+/// glass at gather hits read from both sides; 4: glossy caustics left to the caustic map.
+inline constexpr uint32_t kRenderCacheAlgorithmVersion = 4;
 
 /// Nearest volume photons per estimate of the in-scattered light along a gather ray, at most.
 inline constexpr uint32_t kGatherVolumePhotons = 32;
@@ -115,7 +115,9 @@ private:
     /// The radiance cache's field at a glossy point, extrapolating a little where no record is
     /// usable; false (BSDF-sampled rays instead) where none is even then.
     bool radiance_field(const Vec3& p, const Vec3& normal, RadianceCache::Field* field, SampleContext& context) const;
-    bool caustic_may_show(const Vec3& p, const Vec3& normal, const Bsdf& bsdf, const Vec3& wo, float other) const;
+    /// `lambertian_only`: the estimate reflects the photons by the Lambertian lobe alone.
+    bool caustic_may_show(const Vec3& p, const Vec3& normal, const Bsdf& bsdf, const Vec3& wo, float other,
+                          bool lambertian_only) const;
 
     std::shared_ptr<const RenderScene> scene_;
     std::shared_ptr<const PhotonMaps> maps_;
@@ -126,6 +128,9 @@ private:
     std::shared_ptr<const IrradianceCache> cache_;
     std::unique_ptr<RadianceCache> radiance_cache_;
     bool uses_radiance_cache_ = false;
+    /// Whether the caustic map holds photons of ideal specular paths alone (L S+ D without a
+    /// glossy bounce): glossy lobes read only those.
+    bool specular_caustics_ = false;
     /// What next-event estimation samples: the scene's lights, or with final gathering under an
     /// environment, the lights with only the sky's peaks (the gather collects the rest).
     const LightSet* direct_lights_ = nullptr;

@@ -68,6 +68,8 @@ LobeKind microfacet_lobe_kind(float roughness) {
 }
 
 bool in_mask(LobeMask mask, LobeKind kind) { return (mask & mask_of(kind)) != 0; }
+/// in_mask for a microfacet lobe (metal, dielectric layer, glass, coat) of kind `kind`.
+bool microfacet_in_mask(LobeMask mask, LobeKind kind) { return in_mask(mask, kind) && !(mask & kExcludeMicrofacet); }
 
 /// The slot u_lobe picks among those of positive probability (-1: none), and the probability
 /// below it (`chosen_lower`), so that the rest of u_lobe can be used again.
@@ -146,10 +148,16 @@ BsdfMaterial::BsdfMaterial(const Material& material, float metallic_value, float
     coat_alpha = std::max(sqr(coat_roughness), kMinAlpha);
     coat_kind = microfacet_lobe_kind(coat_roughness);
     if (coat > 0.0f) other_lobes |= mask_of(coat_kind);
+    // Every glossy lobe sharp: the layer and glass share one roughness, the coat has its own.
+    const bool glossy_layer = (reflects && specular_kind == LobeKind::Glossy) ||
+                              (glass_weight > 0.0f && glass_kind == LobeKind::Glossy);
+    const bool glossy_coat = coat > 0.0f && coat_kind == LobeKind::Glossy;
+    sharp_glossy = (glossy_layer || glossy_coat) && (!glossy_layer || roughness < kSharpGlossyRoughness) &&
+                   (!glossy_coat || coat_roughness < kSharpGlossyRoughness);
     lambertian_only = metallic <= 0.0f && glass_weight <= 0.0f && specular_f90 <= 0.0f && coat <= 0.0f;
 }
 
-LobeMask possible_lobes(const Scene& scene, const Material& m) {
+LobeMask possible_lobes(const Scene& scene, const Material& m, bool* sharp_glossy) {
     float metallic[2] = {m.metallic, m.metallic}, roughness[2] = {m.roughness, m.roughness};
     if (m.metallic_roughness_texture.present()) {
         const Texture& t = *scene.textures[static_cast<size_t>(m.metallic_roughness_texture.texture)];
@@ -166,24 +174,31 @@ LobeMask possible_lobes(const Scene& scene, const Material& m) {
         }
     }
     const Color colour = m.base_color_texture.present() ? Color(1.0f) : m.base_color;
-    // The range's ends, and a glossy roughness where the range holds one between them.
-    const float glossy = std::clamp(0.5f * (kDeltaRoughness + kGlossyRoughness), roughness[0], roughness[1]);
+    // The range's ends, and a sharp and a wider glossy roughness where the range holds them.
+    const float sharp = std::clamp(0.5f * (kDeltaRoughness + kSharpGlossyRoughness), roughness[0], roughness[1]);
+    const float glossy = std::clamp(0.5f * (kSharpGlossyRoughness + kGlossyRoughness), roughness[0], roughness[1]);
     // The clearcoat's roughness likewise (its factor only switches the lobe on).
     float coat_roughness[2] = {m.clearcoat_roughness, m.clearcoat_roughness};
     if (m.clearcoat_roughness_texture.present()) {
         coat_roughness[0] = 0.0f;  // conservative: the texture may hold any value
     }
-    const float coat_glossy = std::clamp(0.5f * (kDeltaRoughness + kGlossyRoughness), coat_roughness[0], coat_roughness[1]);
+    const float coat_sharp = std::clamp(0.5f * (kDeltaRoughness + kSharpGlossyRoughness), coat_roughness[0], coat_roughness[1]);
+    const float coat_glossy = std::clamp(0.5f * (kSharpGlossyRoughness + kGlossyRoughness), coat_roughness[0], coat_roughness[1]);
     const float coat = m.clearcoat > 0.0f ? m.clearcoat : 0.0f;
     LobeMask lobes = 0;
+    bool any_sharp = false, all_sharp = true;
     for (float mv : metallic) {
-        for (float rv : {roughness[0], roughness[1], glossy}) {
-            for (float cr : {coat_roughness[0], coat_roughness[1], coat_glossy}) {
+        for (float rv : {roughness[0], roughness[1], sharp, glossy}) {
+            for (float cr : {coat_roughness[0], coat_roughness[1], coat_sharp, coat_glossy}) {
                 const BsdfMaterial constants(m, mv, rv, coat, cr);
-                lobes |= Bsdf(constants, colour, Frame(Vec3(0, 0, 1)), Vec3(0, 0, 1)).lobes();
+                const LobeMask here = Bsdf(constants, colour, Frame(Vec3(0, 0, 1)), Vec3(0, 0, 1)).lobes();
+                lobes |= here;
+                any_sharp = any_sharp || constants.sharp_glossy;
+                if (here & mask_of(LobeKind::Glossy)) all_sharp = all_sharp && constants.sharp_glossy;
             }
         }
     }
+    if (sharp_glossy) *sharp_glossy = any_sharp && all_sharp;
     return lobes;
 }
 
@@ -273,10 +288,10 @@ Bsdf::SlotProbabilities Bsdf::slot_probabilities(const Vec3& wo, bool outside,
         max_component(diffuse_) > 0.0f) {
         p[kSlotDiffuse] = average(lambert_albedo(mu));
     }
-    if (in_mask(mask, m_->specular_kind) && (m_->metallic > 0.0f || m_->layer_weight > 0.0f)) {
+    if (microfacet_in_mask(mask, m_->specular_kind) && (m_->metallic > 0.0f || m_->layer_weight > 0.0f)) {
         p[kSlotSpecular] = average(specular_albedo(mu));
     }
-    if (in_mask(mask, m_->glass_kind) && m_->glass_weight > 0.0f) {
+    if (microfacet_in_mask(mask, m_->glass_kind) && m_->glass_weight > 0.0f) {
         const float f = fresnel_dielectric(mu, relative_ior(outside));
         p[kSlotGlass] = m_->glass_weight * (f + (1.0f - f) * average(base_color_));
     }
@@ -284,7 +299,7 @@ Bsdf::SlotProbabilities Bsdf::slot_probabilities(const Vec3& wo, bool outside,
         // The base is seen through the coat; the coat reflects its Fresnel share.
         const float through = coat_through(mu);
         for (int k = 0; k < 3; ++k) p[k] *= through;
-        if (in_mask(mask, m_->coat_kind)) p[kSlotCoat] = coat_fresnel(mu);
+        if (microfacet_in_mask(mask, m_->coat_kind)) p[kSlotCoat] = coat_fresnel(mu);
     }
     const float sum = p[0] + p[1] + p[2] + p[3];
     if (!(sum > 0.0f)) return {0.0f, 0.0f, 0.0f, 0.0f};
@@ -300,7 +315,7 @@ Color Bsdf::eval_local(const Vec3& wo, const Vec3& wi, bool outside, TransportMo
     // the base attenuated by the coat's directional Fresnel both ways (reciprocal; the
     // specification's mix(base, coat, c F_c) written for both directions).
     f *= coat_through(wo.z) * coat_through(std::abs(wi.z));
-    if (wi.z > 0.0f && !m_->coat_smooth && in_mask(mask, m_->coat_kind)) {
+    if (wi.z > 0.0f && !m_->coat_smooth && microfacet_in_mask(mask, m_->coat_kind)) {
         const GgxDistribution ggx(m_->coat_alpha);
         const Vec3 h = glm::normalize(wo + wi);
         const float fresnel = m_->coat * (kCoatF0 + (1.0f - kCoatF0) * schlick_weight(glm::dot(wo, h)));
@@ -318,8 +333,8 @@ Color Bsdf::eval_base_local(const Vec3& wo, const Vec3& wi, bool outside, Transp
             f += diffuse_weight_ * kInvPi * (Color(1.0f) - layer_albedo_towards(wo.z)) *
                  (Color(1.0f) - layer_albedo(wi.z)) * m_->diffuse_norm;
         }
-        const bool specular = !m_->smooth && in_mask(mask, m_->specular_kind);
-        const bool glass = !m_->glass_delta && m_->glass_weight > 0.0f && in_mask(mask, m_->glass_kind);
+        const bool specular = !m_->smooth && microfacet_in_mask(mask, m_->specular_kind);
+        const bool glass = !m_->glass_delta && m_->glass_weight > 0.0f && microfacet_in_mask(mask, m_->glass_kind);
         if (specular || glass) {
             // Torrance-Sparrow: F D G2 / (4 mu_o mu_i) (Walter et al. 2007, eq. 20).
             const Vec3 h = glm::normalize(wo + wi);
@@ -335,7 +350,7 @@ Color Bsdf::eval_base_local(const Vec3& wo, const Vec3& wi, bool outside, Transp
                            common);
             }
         }
-    } else if (wi.z < 0.0f && !m_->glass_delta && m_->glass_weight > 0.0f && in_mask(mask, m_->glass_kind)) {
+    } else if (wi.z < 0.0f && !m_->glass_delta && m_->glass_weight > 0.0f && microfacet_in_mask(mask, m_->glass_kind)) {
         // Rough dielectric transmission (Walter et al. 2007, eq. 21) with the generalized half
         // vector h ~ wo + eta wi, eta = n_i / n_o (wi's side over wo's side).
         const float eta = relative_ior(outside);

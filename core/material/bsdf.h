@@ -34,12 +34,23 @@ inline constexpr LobeMask mask_of(LobeKind k) { return static_cast<LobeMask>(k);
 /// the irradiance cache handles Lambertian reflection as rho / pi * E, and BSDF-sampled rays
 /// handle the rest (kNonDeltaLobes | kExcludeLambertian).
 inline constexpr LobeMask kExcludeLambertian = 8;
+/// Mask flag that leaves out every microfacet lobe (metal, dielectric layer, glass, coat) of
+/// whatever kind: with mask_of(LobeKind::Diffuse), the Lambertian lobe alone (kLambertianLobe).
+inline constexpr LobeMask kExcludeMicrofacet = 16;
+inline constexpr LobeMask kLambertianLobe = mask_of(LobeKind::Diffuse) | kExcludeMicrofacet;
 
 /// Perceptual roughness below which a microfacet lobe is treated as ideal specular (delta).
 inline constexpr float kDeltaRoughness = 0.02f;
 /// Perceptual roughness below which a non-delta microfacet lobe counts as glossy; at or above it
 /// the lobe counts as diffuse (photons are stored on it and it is gathered like diffuse light).
 inline constexpr float kGlossyRoughness = 0.4f;
+/// Perceptual roughness below which a glossy lobe is sharp: the caustic map holds L S+ D paths
+/// with S an ideal specular bounce or one off a material whose glossy lobes are all sharp
+/// (Jensen 2001, section 9.2: S specular or glossy). Light that such lobes focus is a caustic
+/// like a mirror's, which the final gather would find only by the few of its rays that meet a
+/// highlight (blotches at the irradiance records' scale); wider glossy lobes spread their light
+/// for the gather, and in the caustic map would ask for an estimate at nearly every point.
+inline constexpr float kSharpGlossyRoughness = 0.25f;
 
 struct BsdfSample {
     Vec3 wi;                  // world space, unit
@@ -92,12 +103,17 @@ struct BsdfMaterial {
     float coat_alpha = 0.0f;
     bool coat_smooth = true;
     LobeKind coat_kind = LobeKind::Delta;
+    /// It has a glossy lobe, and every glossy lobe it has is sharp (kSharpGlossyRoughness): its
+    /// glossy bounces continue caustic paths.
+    bool sharp_glossy = false;
 };
 
 /// The lobe kinds a material can have anywhere on its surface: with a metallicRoughnessTexture,
 /// the union over its texels' extremes of metallic and roughness (the base colour taken as
 /// white, so a texture can only remove lobes). For the render plan and the caustic casters.
-LobeMask possible_lobes(const Scene& scene, const Material& material);
+/// `sharp_glossy`, when given, tells whether every glossy lobe the surface has anywhere is sharp
+/// (BsdfMaterial::sharp_glossy), and it has one somewhere.
+LobeMask possible_lobes(const Scene& scene, const Material& material, bool* sharp_glossy = nullptr);
 
 /// The GGX alpha of the material's sharpest non-delta reflection lobe other than the Lambertian
 /// one (rough metal, rough dielectric layer, rough coat); 0 when it has none.
@@ -179,6 +195,13 @@ public:
                     TransportMode mode = TransportMode::Radiance) const;
 
     bool has_delta() const { return (lobes_ & mask_of(LobeKind::Delta)) != 0; }
+    /// Whether a bounce by a lobe of `kind` continues a caustic path (L S+ D): an ideal specular
+    /// one, or a glossy one where every glossy lobe is sharp (BsdfMaterial::sharp_glossy).
+    bool continues_caustic(LobeKind kind) const {
+        return kind == LobeKind::Delta || (kind == LobeKind::Glossy && m_->sharp_glossy);
+    }
+    /// Whether some lobe continues caustic paths.
+    bool may_continue_caustic() const { return has_delta() || (m_->sharp_glossy && (lobes_ & mask_of(LobeKind::Glossy))); }
     /// Whether sample() reads u_lobe: not for a BSDF of a single Lambertian lobe, where a caller
     /// drawing random numbers may skip it.
     bool samples_lobe_choice() const { return !pure_lambertian_; }

@@ -67,7 +67,8 @@ Color PhotonMap::estimate_radiance(const Vec3& p, const Vec3& normal, const Bsdf
         if (!(options.both_sides ? photon_counts_either_side(photon, normal) : photon_counts(photon, normal)))
             continue;
         const Vec3 wi = -photon.direction();
-        const Color f = bsdf.eval(wo, wi, TransportMode::Radiance, options.lobes);
+        const LobeMask lobes = photon.user_flags() & options.restricted_flags ? options.restricted_lobes : options.lobes;
+        const Color f = bsdf.eval(wo, wi, TransportMode::Radiance, lobes);
         DVec3 contribution = DVec3(f) * DVec3(photon.flux());
         if (bent) {
             // The photon's side of the surface: normal's, or the other one (both_sides).

@@ -21,10 +21,13 @@ namespace photond {
 /// Photon user flags: where the photon's path came from (light-path grammar, Heckbert 1990).
 namespace photon_flags {
 inline constexpr uint8_t kDirect = 1;   // first hit from the light: L D
-inline constexpr uint8_t kCaustic = 2;  // through one or more specular bounces: L S+ D
+inline constexpr uint8_t kCaustic = 2;  // through one or more specular or glossy bounces: L S+ D
 /// A volume photon stored inside a closed transmissive solid (Material::interior_scatters), not
 /// in the atmosphere: estimates in the one never count photons of the other.
 inline constexpr uint8_t kInterior = 4;
+/// A caustic photon (kCaustic) with a glossy bounce on its way: a visible point whose glossy
+/// lobes take rays (which follow glossy lobes to the lights) reads it by its Lambertian lobe only.
+inline constexpr uint8_t kGlossyCaustic = 8;
 }  // namespace photon_flags
 
 /// Fewer photons than this in an estimate give zero (the lecture's rule: too few to trust).
@@ -64,6 +67,10 @@ struct RadianceEstimateOptions {
     /// other side (arrived from behind, stored with the opposite normal) count too, through
     /// the BSDF's transmission.
     bool both_sides = false;
+    /// Photons with any of these flags are reflected by `restricted_lobes` instead of `lobes`
+    /// (photon_flags::kGlossyCaustic: by the Lambertian lobe alone where rays take the others).
+    uint8_t restricted_flags = 0;
+    LobeMask restricted_lobes = kLambertianLobe;
 };
 
 class PhotonMap {

@@ -135,7 +135,8 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
     Ray ray{emission->origin, emission->direction};
     if (glm::dot(emission->normal, emission->normal) > 0.0f)
         ray.origin = rs.tracer->offset_origin(emission->origin, emission->normal, emission->direction);
-    int specular_bounces = 0;
+    int specular_bounces = 0;  // ideal specular and sharply glossy ones (Bsdf::continues_caustic)
+    bool glossy_seen = false;
     bool diffuse_seen = false;
     // For the caustic map alone, a photon that no specular surface lies ahead of stores nothing.
     if (!whole_paths && rs.caustic_casters && !rs.caustic_casters->occluded(ray)) return;
@@ -207,26 +208,29 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
         const Bsdf bsdf = make_bsdf(rs, si, wo);
         if (bsdf.has_non_delta()) {
             const bool caustic_path = specular_bounces > 0 && !diffuse_seen;
-            const uint8_t flags = static_cast<uint8_t>((bounce == 0 ? photon_flags::kDirect : 0) |
-                                                       (caustic_path ? photon_flags::kCaustic : 0));
+            const uint8_t flags = static_cast<uint8_t>(
+                (bounce == 0 ? photon_flags::kDirect : 0) | (caustic_path ? photon_flags::kCaustic : 0) |
+                (caustic_path && glossy_seen ? photon_flags::kGlossyCaustic : 0));
             const Vec3 normal = glm::dot(si.surface_normal, wo) >= 0.0f ? si.surface_normal : -si.surface_normal;
             const TracedPhoton photon{make_photon(si.p, ray.direction, stored_flux(flux), flags, normal), path_in_batch};
             if (want_global) out.global.push_back(photon);
             if (want_caustic && caustic_path) out.caustic.push_back(photon);
         }
-        // Only caustic paths wanted, and no ideal specular way on from here: no need to sample it.
-        if (!whole_paths && !bsdf.has_delta()) return;
+        // Only caustic paths wanted, and no specular or glossy way on from here: no need to sample it.
+        if (!whole_paths && !bsdf.may_continue_caustic()) return;
         const float u_lobe = bsdf.samples_lobe_choice() ? rng.next_float() : 0.0f;
         const Vec2 u = rng.next_vec2();
         const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Importance);
         if (!s || !(s->pdf > 0.0f)) return;
-        // Caustic paths are L S+ D with S ideal specular: light a glossy lobe reflects is the
-        // final gather's, which follows glossy lobes by sampling (FinalGatherer).
-        if (s->kind != LobeKind::Delta) {
+        // Caustic paths are L S+ D with S ideal specular or sharp glossy (kSharpGlossyRoughness):
+        // the final gather leaves what such bounces bring from the lights to the caustic map
+        // (FinalGatherer::gather).
+        if (!bsdf.continues_caustic(s->kind)) {
             diffuse_seen = true;
             if (!whole_paths) return;  // only caustic paths are wanted, and this is none any more
         } else {
             ++specular_bounces;
+            glossy_seen = glossy_seen || s->kind == LobeKind::Glossy;
         }
         // Russian roulette on the reflectivity of the chosen component.
         if (!survives(flux * s->weight, stored_flux(flux))) return;

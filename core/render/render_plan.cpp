@@ -20,8 +20,10 @@ SceneLightPaths analyse_light_paths(const Scene& scene, const LightSet& lights) 
         const Material& m = scene.materials[i];
         // Every lobe the material can have anywhere (its textures can only scale colours and
         // move metallic and roughness within their texels' range).
-        const LobeMask lobes = possible_lobes(scene, m);
-        if (lobes & mask_of(LobeKind::Delta)) paths.has_specular = true;  // caustics: ideal specular
+        bool sharp_glossy = false;
+        const LobeMask lobes = possible_lobes(scene, m, &sharp_glossy);
+        // Caustics: ideal specular or sharp glossy bounces (kSharpGlossyRoughness).
+        if ((lobes & mask_of(LobeKind::Delta)) || sharp_glossy) paths.has_specular = true;
         if (lobes & kNonDeltaLobes) paths.has_receiver = true;
         // Diffuse-class lobes: the Lambertian one and microfacet lobes too rough to count as glossy.
         if ((lobes & mask_of(LobeKind::Diffuse)) && max_component(m.base_color) > 0.0f) paths.has_diffuse = true;
@@ -47,7 +49,8 @@ RenderPlan plan_photon_passes(const Scene& scene, const LightSet& lights, const 
         plan.caustic_map = decide("caustic_map", false, "the job asks for 0 caustic photons");
     } else if (!paths.has_specular) {
         plan.caustic_map = decide("caustic_map", false,
-                                  "no surface is ideal specular (mirror, smooth glass), so no L S+ D path exists");
+                                  "no surface is ideal specular or sharply glossy (mirror, glass, polished metal), so no "
+                                  "L S+ D path exists");
     } else if (!paths.has_receiver) {
         plan.caustic_map = decide("caustic_map", false, "no surface stores photons (every surface is ideal specular)");
     } else if (global && caustic_lights && caustic_lights->empty()) {
@@ -56,8 +59,8 @@ RenderPlan plan_photon_passes(const Scene& scene, const LightSet& lights, const 
                                   "specular surfaces");
     } else {
         plan.caustic_map = decide("caustic_map", true,
-                                  "ideal specular surfaces (mirrors, smooth glass) can focus light onto surfaces "
-                                  "that store photons");
+                                  "ideal specular and sharply glossy surfaces (mirrors, glass, polished metal) can focus "
+                                  "light onto surfaces that store photons");
     }
     if (request.global_photons == 0) {
         plan.global_map = decide("global_map", false, "the job asks for 0 global photons");

@@ -30,7 +30,7 @@ struct RenderPlan {
 /// positive area) and its lights.
 struct SceneLightPaths {
     bool has_light = false;       // a light with positive power
-    bool has_specular = false;    // a delta or glossy lobe that can redirect light
+    bool has_specular = false;    // a delta or sharp glossy lobe that can focus light (caustics)
     bool has_diffuse = false;     // a diffuse lobe with non-zero reflectance
     bool has_receiver = false;    // a surface that stores photons (any non-delta lobe)
 };

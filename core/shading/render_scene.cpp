@@ -26,14 +26,19 @@ Expected<std::shared_ptr<const RenderScene>> RenderScene::create(std::shared_ptr
         render_scene->scattering_interiors = render_scene->scattering_interiors || material.interior_scatters();
     }
     std::vector<uint32_t> specular;
-    constexpr LobeMask kCausticLobes = mask_of(LobeKind::Delta);  // L S+ D: S ideal specular
-    std::vector<LobeMask> lobes(scene->materials.size());
-    for (size_t i = 0; i < lobes.size(); ++i) {
+    // The caustic casters: surfaces with an ideal specular lobe, or sharp glossy ones only.
+    std::vector<bool> casts(scene->materials.size());
+    render_scene->sharp_glossy_materials.resize(scene->materials.size());
+    for (size_t i = 0; i < casts.size(); ++i) {
         const Material& m = scene->materials[i];
-        lobes[i] = m.varying_bsdf() ? possible_lobes(*scene, m) : render_scene->bsdf_materials[i].other_lobes;
+        bool sharp_glossy = render_scene->bsdf_materials[i].sharp_glossy;
+        const LobeMask lobes = m.varying_bsdf() ? possible_lobes(*scene, m, &sharp_glossy)
+                                                : render_scene->bsdf_materials[i].other_lobes;
+        render_scene->sharp_glossy_materials[i] = sharp_glossy;
+        casts[i] = (lobes & mask_of(LobeKind::Delta)) || sharp_glossy;
     }
     for (uint32_t t = 0; t < scene->triangles.size(); ++t) {
-        if (lobes[scene->triangle_materials[t]] & kCausticLobes) specular.push_back(t);
+        if (casts[scene->triangle_materials[t]]) specular.push_back(t);
     }
     if (!specular.empty()) {
         auto casters = RayTracer::build(device, *scene, &specular);

@@ -27,8 +27,12 @@ struct RenderScene {
     std::unique_ptr<LightSet> lights_with_sky_peaks;
     /// Some material's solid scatters light inside (Material::interior_scatters).
     bool scattering_interiors = false;
-    /// The triangles a caustic path (LS+D) can start on: those whose material has a delta or
-    /// glossy lobe; null when there are none. Photons emitted for the caustic map alone that miss
+    /// Per material: every glossy lobe it has anywhere is sharp (possible_lobes), so its glossy
+    /// bounces continue caustic paths; a material sharp only in parts is gathered as before
+    /// (caustic photons aimed at it would mostly die on its other parts).
+    std::vector<bool> sharp_glossy_materials;
+    /// The triangles a caustic path (LS+D) can start on: those whose material has a delta lobe or
+    /// sharp glossy ones only; null when there are none. Photons emitted for the caustic map alone that miss
     /// all of them are dropped after this one cheap ray instead of a trace through the scene.
     std::unique_ptr<RayTracer> caustic_casters;
     /// The bounding sphere of those triangles, which parallel photons for the caustic map alone

@@ -63,8 +63,10 @@ inline Bsdf make_bsdf(const RenderScene& rs, const SurfaceInteraction& si, const
     if (!material.varying_bsdf())
         return Bsdf(rs.bsdf_materials[si.material], mp.base_color, Frame(ns), ng);
     // Metallic, roughness or the clearcoat vary over the surface: the constants are derived here.
-    return Bsdf(BsdfMaterial(material, mp.metallic, mp.roughness, mp.clearcoat, mp.clearcoat_roughness),
-                mp.base_color, Frame(ns), ng);
+    BsdfMaterial constants(material, mp.metallic, mp.roughness, mp.clearcoat, mp.clearcoat_roughness);
+    // Glossy caustics come only off materials sharp all over (RenderScene::sharp_glossy_materials).
+    constants.sharp_glossy = constants.sharp_glossy && rs.sharp_glossy_materials[si.material];
+    return Bsdf(std::move(constants), mp.base_color, Frame(ns), ng);
 }
 
 }  // namespace photond
