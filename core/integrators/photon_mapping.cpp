@@ -406,8 +406,10 @@ RadianceParts PhotonMapIntegrator::surface_radiance(const Ray& ray, const Surfac
             const bool lambertian_only = glossy && !specular_caustics_;
             if (caustic_may_show(si.p, normal, bsdf, wo, luminance(radiance.total), lambertian_only)) {
                 RadianceEstimateOptions options = estimate_options_at(caustic_options_, si, bsdf, front);
-                if (glossy) options.restricted_flags = photon_flags::kGlossyCaustic;
-                if (lambertian_only) options.lobes = kLambertianLobe;
+                if (lambertian_only)
+                    options.lobes = kLambertianLobe;
+                else if (glossy)
+                    options.restricted_flags = photon_flags::kGlossyCaustic;
                 radiance.add_caustic(maps_->caustic->estimate_radiance(si.p, normal, bsdf, wo, options));
             } else {
                 ++context.counters.caustic_skipped;

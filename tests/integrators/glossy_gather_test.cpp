@@ -49,6 +49,29 @@ std::shared_ptr<const RenderScene> glossy_spheres() {
     return make_render_scene(builder.build().value());
 }
 
+/// glossy_spheres() through its camera at 48x32, the view the per-pixel comparisons use.
+Camera glossy_spheres_camera(const std::shared_ptr<const RenderScene>& rs) {
+    return Camera::create(rs->scene->cameras.at(0), 48, 32).value();
+}
+
+/// `path` at 1024 spp: the per-pixel reference of a glossy_spheres_camera view.
+Image path_reference(const std::shared_ptr<const RenderScene>& rs, const Camera& camera) {
+    TileSettings tiles;
+    tiles.samples_per_pixel = 1024;
+    return render_tiles(PathIntegrator(rs), camera, tiles).layers.beauty;
+}
+
+/// The photon maps of 100k global and `caustic` caustic photons (empty maps, after a failed
+/// expectation, when tracing fails).
+std::shared_ptr<const PhotonMaps> trace_maps(const std::shared_ptr<const RenderScene>& rs, uint32_t caustic) {
+    PhotonTracingSettings tracing;
+    tracing.global_photons = 100000;
+    tracing.caustic_photons = caustic;
+    auto traced = trace_photons(*rs, tracing);
+    EXPECT_TRUE(traced) << traced.error().message;
+    return traced ? std::make_shared<const PhotonMaps>(std::move(traced).value()) : std::make_shared<const PhotonMaps>();
+}
+
 /// `photon-map` without the irradiance cache: `global` photons (no caustic map), `rays` gather
 /// rays, `spp` samples per pixel.
 Image render_photon_map(const std::shared_ptr<const RenderScene>& rs, const Camera& camera, uint32_t global,
@@ -71,17 +94,10 @@ Image render_photon_map(const std::shared_ptr<const RenderScene>& rs, const Came
 
 TEST(GlossyGather, GlossyLobesFollowedBySamplingAgreeWithPathPerPixel) {
     const auto rs = glossy_spheres();
-    const Camera camera = Camera::create(rs->scene->cameras.at(0), 48, 32).value();
-    TileSettings path_tiles;
-    path_tiles.samples_per_pixel = 1024;
-    const Image reference = render_tiles(PathIntegrator(rs), camera, path_tiles).layers.beauty;
-
-    PhotonTracingSettings tracing;
-    tracing.global_photons = 100000;
-    tracing.caustic_photons = 0;
-    auto traced = trace_photons(*rs, tracing);
-    ASSERT_TRUE(traced) << traced.error().message;
-    const auto maps = std::make_shared<const PhotonMaps>(std::move(traced).value());
+    const Camera camera = glossy_spheres_camera(rs);
+    const Image reference = path_reference(rs, camera);
+    const auto maps = trace_maps(rs, 0);
+    ASSERT_TRUE(maps->global);
     const auto render = [&](int max_glossy_bounces) {
         PhotonMapIntegratorSettings settings;
         settings.gather.rays = 128;
@@ -116,24 +132,18 @@ TEST(GlossyGather, SharpGlossyCausticsComeFromTheCausticMap) {
     ASSERT_TRUE(plan.caustic_map) << "sharply glossy spheres focus light onto the floor";
     EXPECT_NE(plan.find("caustic_map")->reason.find("sharply glossy"), std::string::npos)
         << plan.find("caustic_map")->reason;
-    const Camera camera = Camera::create(rs->scene->cameras.at(0), 48, 32).value();
-    TileSettings path_tiles;
-    path_tiles.samples_per_pixel = 1024;
-    const Image reference = render_tiles(PathIntegrator(rs), camera, path_tiles).layers.beauty;
-    PhotonTracingSettings tracing;
-    tracing.global_photons = 100000;
-    tracing.caustic_photons = 20000;
-    auto traced = trace_photons(*rs, tracing);
-    ASSERT_TRUE(traced) << traced.error().message;
-    ASSERT_TRUE(traced->caustic);
+    const Camera camera = glossy_spheres_camera(rs);
+    const Image reference = path_reference(rs, camera);
+    const auto maps = trace_maps(rs, 20000);
+    ASSERT_TRUE(maps->caustic);
     size_t glossy_caustics = 0;
-    for (const Photon& photon : traced->caustic->tree().photons()) {
+    for (const Photon& photon : maps->caustic->tree().photons()) {
         if (photon.user_flags() & photon_flags::kGlossyCaustic) ++glossy_caustics;
     }
     EXPECT_GT(glossy_caustics, 10000u) << "the caustic map holds the spheres' glossy caustic";
     PhotonMapIntegratorSettings settings;
     settings.gather.rays = 64;
-    const PhotonMapIntegrator photon_map(rs, std::make_shared<const PhotonMaps>(std::move(traced).value()), settings);
+    const PhotonMapIntegrator photon_map(rs, maps, settings);
     TileSettings tiles;
     tiles.samples_per_pixel = 16;
     const Image image = render_tiles(photon_map, camera, tiles).layers.beauty;
