@@ -50,6 +50,8 @@ inline constexpr IntegerRange kPhotonCount{0, 50'000'000};  // photons.global, .
 inline constexpr IntegerRange kPhotonNeighbours{8, 1000};
 inline constexpr IntegerRange kSeed{0, std::numeric_limits<uint64_t>::max()};
 inline constexpr IntegerRange kGatherRays{1, 16384};
+// Jensen's short-ray rule: gather rays shorter than this many photon-estimate radii trace a bounce.
+inline constexpr NumberRange kShortRayRadii{0.0, 16.0};
 // Ward's accuracy a (the largest allowed error estimate of a cached irradiance record).
 inline constexpr NumberRange kCacheAccuracy{0.0, 1.0, true, false};
 // Record spacing in pixels (Tabellion & Lamorlette 2004); also min_spacing_px <= max_spacing_px.
@@ -154,6 +156,7 @@ struct PhotonSpec {
 
 struct GatherSpec {
     uint32_t rays = 0;
+    double short_ray_radii = 0.0;
 
     bool operator==(const GatherSpec&) const = default;
 };

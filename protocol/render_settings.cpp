@@ -20,6 +20,7 @@ RenderSettings to_render_settings(const Job& job) {
     photon_map.k_caustic = job.photons.k_caustic;
     photon_map.k_volume = job.photons.k_volume;
     photon_map.gather.rays = job.gather.rays;
+    photon_map.gather.short_ray_radii = static_cast<float>(job.gather.short_ray_radii);
     photon_map.use_irradiance_cache = job.irradiance_cache.enabled;
     CacheBuildSettings& cache = photon_map.irradiance_cache;
     cache.accuracy = static_cast<float>(job.irradiance_cache.a);

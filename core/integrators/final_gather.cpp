@@ -21,6 +21,7 @@ FinalGatherer::FinalGatherer(std::shared_ptr<const RenderScene> scene, std::shar
     : scene_(std::move(scene)), maps_(std::move(maps)), settings_(settings),
       grid_(GatherGrid::for_rays(settings.rays)) {
     if (settings_.max_radius <= 0.0f) settings_.max_radius = 0.2f * scene_->scene->bounds.radius();
+    if (settings_.max_radius_caustic <= 0.0f) settings_.max_radius_caustic = kCausticRadiusShare * scene_->scene->bounds.radius();
 }
 
 namespace {
@@ -28,16 +29,30 @@ namespace {
 /// Photons of an estimate at a gather hit on a normal-mapped surface read as diffuse.
 constexpr uint32_t kBentNormalPhotons = 32;
 
+/// Bounces a gather ray's path traces by the short-ray rule (GatherSettings::short_ray_radii)
+/// before it reads the photons wherever it lands: a contact's gap sends rays back and forth
+/// between its two surfaces, each bounce reflecting a share of the light.
+constexpr int kMaxShortRayBounces = 4;
+
+/// The nearest irradiance site on the side a hit is seen from (PhotonMap::nearest_irradiance).
+struct NearestSite {
+    bool found = false;
+    Color irradiance{0.0f};
+    float radius = 0.0f;
+};
+
 /// Radiance leaving a non-delta surface towards wo, from the photon maps: precomputed
 /// irradiance times rho / pi where every lobe is diffuse or as rough as the photon passes take
 /// for diffuse (the rough metal and dielectric layer of most glTF materials: read by their
 /// albedo at wo, exact under uniform light, instead of evaluating the BSDF per photon); for rough
 /// glass as rough, the same from both sides (one lobe sample picks the side and carries the
 /// lobe's weight); else the global map's estimate.
-/// `exclude_flags`: photons the estimate leaves out (where it falls back to one).
+/// `exclude_flags`: photons the estimate leaves out (where it falls back to one). `front_site`:
+/// the nearest site on wo's side, when the caller has looked it up already.
 Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si, const Bsdf& bsdf,
                             const Vec3& wo, const GatherSettings& settings, Rng& rng,
-                            LobeMask lobes = kNonDeltaLobes, uint8_t exclude_flags = 0) {
+                            LobeMask lobes = kNonDeltaLobes, uint8_t exclude_flags = 0,
+                            const NearestSite* front_site = nullptr) {
     if (!maps.global) return Color(0.0f);
     const bool front = glm::dot(si.surface_normal, wo) >= 0.0f;
     const Vec3 n = front ? si.surface_normal : -si.surface_normal;
@@ -47,8 +62,8 @@ Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si
     if (maps.irradiance && bent == Vec3(0.0f)) {
         Color e;
         if (bsdf.reads_as_diffuse(lobes)) {
-            if (maps.irradiance->nearest_irradiance(si.p, n, settings.max_radius, &e))
-                return bsdf.diffuse_like_reflectance(wo) * kInvPi * e;
+            if (front_site ? front_site->found : maps.irradiance->nearest_irradiance(si.p, n, settings.max_radius, &e))
+                return bsdf.diffuse_like_reflectance(wo) * kInvPi * (front_site ? front_site->irradiance : e);
         } else if (bsdf.reads_as_diffuse_from_both_sides(lobes)) {
             // Rough glass: each side's incident light taken as uniform, E_side / pi, exact for
             // uniform light on either side as the albedo read above is. A kNN estimate here
@@ -96,6 +111,8 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
         RayCounters& counters;
         FirstHitEmission* emission;
         bool caustic_chains;
+        /// Bounces traced so far by the short-ray rule.
+        int short_ray_bounces = 0;
         /// Where a ray that samples a glossy lobe started, and the lobe's pdf for it (0 once a
         /// delta bounce followed: then no light sample could have found what it meets).
         struct GlossyOrigin {
@@ -174,16 +191,16 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
                 const bool caustic_chain = caustic_chains && !from && bsdf.continues_caustic(LobeKind::Glossy);
                 if ((bsdf.lobes() & kGlossy) && glossy_bounces < g.settings_.max_glossy_bounces) {
                     radiance += glossy_lobes(si, bsdf, wo, depth, glossy_bounces, caustic_chain);
-                    radiance += radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_, rng, kNonDeltaLobes & ~kGlossy);
+                    radiance += elsewhere(si, bsdf, wo, depth, kNonDeltaLobes & ~kGlossy);
                 } else if ((bsdf.lobes() & kGlossy) && caustic_chain) {
                     // The chain's last glossy lobe: the photons that came to it through a diffuse
                     // surface (those straight from the lights or through caustic bounces would
                     // continue the caustic chain).
-                    radiance += radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_, rng, kNonDeltaLobes & ~kGlossy);
+                    radiance += elsewhere(si, bsdf, wo, depth, kNonDeltaLobes & ~kGlossy);
                     radiance += radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_, rng, kGlossy,
                                                       photon_flags::kDirect | photon_flags::kCaustic);
                 } else {
-                    radiance += radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_, rng);
+                    radiance += elsewhere(si, bsdf, wo, depth, kNonDeltaLobes);
                 }
             }
             if (bsdf.has_delta() && depth < g.settings_.max_specular_depth) {
@@ -195,6 +212,85 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
                 });
             }
             return volume_transmittance(*rs.scene, si) * radiance;
+        }
+        /// What `lobes` reflect at a non-delta hit of the light arriving from elsewhere: the
+        /// photons' estimate, or one bounce traced where the ray that came is short.
+        Color elsewhere(const SurfaceInteraction& si, const Bsdf& bsdf, const Vec3& wo, int depth, LobeMask lobes) const {
+            if (!(bsdf.lobes() & lobes)) return Color(0.0f);
+            NearestSite site;
+            if (is_short(si, wo, &site)) return short_ray_bounce(si, bsdf, wo, depth, lobes);
+            return radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_, rng, lobes, 0, site.found ? &site : nullptr);
+        }
+        /// Whether the ray that reached `si` is short next to the photon estimate's radius there
+        /// (GatherSettings::short_ray_radii): the nearest site's, or the search's cap where no
+        /// site is near (an estimate there spreads over the whole disc). The site looked up is
+        /// left in `site` for the estimate to use.
+        bool is_short(const SurfaceInteraction& si, const Vec3& wo, NearestSite* site) const {
+            const float factor = g.settings_.short_ray_radii;
+            // No estimate reaches further than the cap: longer rays are never short.
+            if (!(factor > 0.0f) || short_ray_bounces >= kMaxShortRayBounces || !g.maps_->global ||
+                !(si.distance < factor * g.settings_.max_radius))
+                return false;
+            float radius = g.settings_.max_radius;
+            if (g.maps_->irradiance) {
+                const Vec3 n = glm::dot(si.surface_normal, wo) >= 0.0f ? si.surface_normal : -si.surface_normal;
+                site->found = g.maps_->irradiance->nearest_irradiance(si.p, n, g.settings_.max_radius, &site->irradiance,
+                                                                      &site->radius);
+                if (site->found) radius = site->radius;
+            }
+            return si.distance < factor * radius;
+        }
+        /// Jensen's short-ray rule (GatherSettings::short_ray_radii): what `lobes` reflect at
+        /// `si`, as a visible point takes it: a light sample, the caustic map's estimate and one
+        /// lobe-sampled ray on (a new path: its glossy bounces count from 0), whose own short hits
+        /// trace again (up to kMaxShortRayBounces). With a caustic map the ray on counts no
+        /// emitter through specular and sharply glossy surfaces (a new caustic chain: the map
+        /// holds that light) and none straight ahead (the light sample, unweighted, does);
+        /// without one it is weighted against the light sample by the power heuristic, as
+        /// glossy lobes are.
+        Color short_ray_bounce(const SurfaceInteraction& si, const Bsdf& bsdf, const Vec3& wo, int depth,
+                               LobeMask lobes) const {
+            SampleContext context{rng, counters};
+            const bool caustics = g.maps_->caustic != nullptr;
+            Color radiance(0.0f);
+            if (caustics) {
+                // The diffuse sky, where gather rays see it, is the ray on's (as at a visible point).
+                const LightSet& lights =
+                    g.settings_.gather_diffuse_sky && rs.lights_with_sky_peaks ? *rs.lights_with_sky_peaks : *rs.lights;
+                radiance += sample_direct_light(rs, lights, si, bsdf, wo, context, false, lobes);
+                radiance += caustic_estimate(si, bsdf, wo, lobes);
+            } else {
+                radiance += sample_direct_light(rs, *rs.lights, si, bsdf, wo, context, true, lobes);
+            }
+            const float u_lobe = rng.next_float();
+            const Vec2 u = rng.next_vec2();
+            const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Radiance, lobes);
+            if (s && s->pdf > 0.0f && !is_black(s->weight)) {
+                const GlossyOrigin origin{si.p, s->pdf};
+                const Walker on{g, rs, rng, counters, nullptr, caustics, short_ray_bounces + 1};
+                radiance += s->weight * on.along(spawn_ray(rs, si, s->wi), depth, nullptr, false, 0,
+                                                 caustics ? nullptr : &origin);
+            }
+            return radiance;
+        }
+        /// The caustic map's light reflected by `lobes` at `si`: read as diffuse, the caustic
+        /// irradiance precomputed at the nearest caustic site (none near: no caustic there), as
+        /// the global map's is read; else the map's estimate.
+        Color caustic_estimate(const SurfaceInteraction& si, const Bsdf& bsdf, const Vec3& wo, LobeMask lobes) const {
+            const bool front = glm::dot(si.surface_normal, wo) >= 0.0f;
+            const Vec3 n = front ? si.surface_normal : -si.surface_normal;
+            if (g.maps_->caustic_irradiance && bsdf.reads_as_diffuse(lobes) && bent_shading_normal(si, front) == Vec3(0.0f)) {
+                Color e(0.0f);
+                if (!g.maps_->caustic_irradiance->nearest_irradiance(si.p, n, g.settings_.max_radius_caustic, &e))
+                    return Color(0.0f);
+                return bsdf.diffuse_like_reflectance(wo) * kInvPi * e;
+            }
+            RadianceEstimateOptions options;
+            options.k = g.settings_.k_caustic;
+            options.max_radius = g.settings_.max_radius_caustic;
+            options.cone_filter = true;
+            options.lobes = lobes;
+            return g.maps_->caustic->estimate_radiance(si.p, n, bsdf, wo, estimate_options_at(options, si, bsdf, front));
         }
         /// The glossy lobes' reflection at a gather hit, as a path tracer takes it: a light
         /// sample and a lobe sample, weighted by the power heuristic. In a caustic chain, the

@@ -31,6 +31,13 @@ struct GatherSettings {
     uint32_t k_global = 50;      // photons per radiance estimate where no precomputed irradiance fits
     uint32_t k_volume = 200;     // photons per volume-map estimate of the atmosphere's in-scattered light
     float max_radius = 0.0f;     // estimate radius cap (world units)
+    /// Jensen's short-ray rule: where a ray lands closer to where it left than this many times
+    /// the radius of the photon estimate there (the nearest irradiance site's), the estimate
+    /// reaches past what shadows the hit into light the hit cannot see (a contact's shadow), so
+    /// the hit is traced one bounce on instead, as a visible point is (final_gather.cpp); 0 never.
+    float short_ray_radii = 2.0f;
+    uint32_t k_caustic = 100;          // caustic photons per estimate at such a hit
+    float max_radius_caustic = 0.0f;   // their search radius cap (world units; 0: kCausticRadiusShare of the scene radius)
     /// Gather rays that leave the scene, straight away or through ideal specular surfaces, see
     /// the environment's diffuse sky (RenderScene::diffuse_sky), which light sampling and the
     /// caustic map then leave out (maps traced with a global map do); else they see nothing.

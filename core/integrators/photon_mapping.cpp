@@ -38,6 +38,8 @@ PhotonMapIntegrator::PhotonMapIntegrator(std::shared_ptr<const RenderScene> scen
         // record): fewer photons an estimate, as at normal-mapped gather hits.
         gather.k_volume = std::min(settings_.k_volume, kGatherVolumePhotons);
         gather.max_radius = global_options_.max_radius;
+        gather.k_caustic = caustic_options_.k;
+        gather.max_radius_caustic = caustic_options_.max_radius;
         gather.gather_diffuse_sky = scene_->lights_with_sky_peaks != nullptr;
         gatherer_ = std::make_unique<FinalGatherer>(scene_, maps_, gather);
     }
@@ -187,6 +189,9 @@ std::string PhotonMapIntegrator::render_cache_key(const std::string& photon_map_
     // Gather rays read the atmosphere's volume map (keys of scenes without one stay as they were).
     if (scene_->scene->atmosphere) hasher.update_value(uint32_t(gather.k_volume));
     hash_float(gather.max_radius);
+    hash_float(gather.short_ray_radii);
+    hasher.update_value(uint32_t(gather.k_caustic));
+    hash_float(gather.max_radius_caustic);
     hasher.update_value(uint8_t(gather.gather_diffuse_sky));
     // Glossy gather hits sample lights (final_gather.cpp): how they pick them changes the records.
     hasher.update_value(uint8_t(scene_->lights->selection()));

@@ -128,4 +128,26 @@ Photon make_photon(Vec3 position, Vec3 direction, Color flux, uint8_t user_flags
     return p;
 }
 
+Photon make_irradiance_site(Vec3 position, Vec3 normal, Color irradiance, float radius) {
+    Photon p = make_photon(position, normal, irradiance, 0, normal);
+    // 2^(code / 512 - 64): a relative step of 0.14 % from 2^-64 to 2^64, as fine at every scale
+    // (a scene scaled by any factor keeps its sites' radii to that step). Code 0 is zero.
+    uint32_t code = 0;
+    if (std::isfinite(radius) && radius > 0.0f) {
+        const double scaled = (std::log2(static_cast<double>(radius)) + Photon::kSiteRadiusLog2Offset) * Photon::kSiteRadiusStepsPerOctave;
+        code = static_cast<uint32_t>(std::clamp(std::lround(scaled), 1l, 65535l));
+    } else if (radius > 0.0f) {
+        code = 65535;  // +infinity: the largest
+    }
+    p.theta_ = uint8_t(code & 0xffu);
+    p.phi_ = uint8_t(code >> 8);
+    return p;
+}
+
+float Photon::site_radius() const {
+    const uint32_t code = theta_ | (uint32_t(phi_) << 8);
+    if (code == 0) return 0.0f;
+    return static_cast<float>(std::exp2(static_cast<double>(code) / kSiteRadiusStepsPerOctave - kSiteRadiusLog2Offset));
+}
+
 }  // namespace photond

@@ -158,8 +158,8 @@ Color PhotonMap::estimate_in_scattering(const Vec3& x, const Vec3& wo, float g, 
     return Color(sum / volume);
 }
 
-bool PhotonMap::nearest_irradiance(const Vec3& p, const Vec3& normal, float max_radius,
-                                   Color* irradiance) const {
+bool PhotonMap::nearest_irradiance(const Vec3& p, const Vec3& normal, float max_radius, Color* irradiance,
+                                   float* site_radius) const {
     if (tree_.empty()) return false;
     constexpr uint32_t kCandidates = 4;
     KnnResult& found = thread_scratch();
@@ -168,13 +168,13 @@ bool PhotonMap::nearest_irradiance(const Vec3& p, const Vec3& normal, float max_
     const KnnNeighbor* best = nullptr;
     for (const KnnNeighbor& n : found.neighbors) {
         const Photon& photon = tree_.photon(n.index);
-        const Vec3 photon_normal = photon.has_normal() ? photon.normal() : photon.direction();
-        if (glm::dot(photon_normal, normal) <= kIrradianceNormalCosine) continue;
+        if (!photon.has_normal() || glm::dot(photon.normal(), normal) <= kIrradianceNormalCosine) continue;
         // Nearest first; ties go to the smaller index so the choice is deterministic.
         if (!best || n.dist2 < best->dist2 || (n.dist2 == best->dist2 && n.index < best->index)) best = &n;
     }
     if (!best) return false;
     *irradiance = tree_.photon(best->index).flux();
+    if (site_radius) *site_radius = tree_.photon(best->index).site_radius();
     return true;
 }
 

@@ -121,10 +121,13 @@ public:
                                  const std::function<float(float)>& surface_distance = {}) const;
 
     /// Precomputed irradiance (Christensen 1999, "Faster photon map global illumination"): in a
-    /// map whose photons hold irradiance (flux) and surface normal (normal, or direction for
-    /// photons without one), the nearest one within max_radius whose normal agrees with `normal`
-    /// (cosine > kIrradianceNormalCosine). Returns false when none is near.
-    bool nearest_irradiance(const Vec3& p, const Vec3& normal, float max_radius, Color* irradiance) const;
+    /// map of irradiance sites (make_irradiance_site: irradiance as flux, a surface normal, the
+    /// estimate's radius), the nearest one within max_radius whose normal agrees with `normal`
+    /// (cosine > kIrradianceNormalCosine); sites without a normal are never taken. Returns
+    /// false when none is near; else its irradiance, and its estimate's radius in `site_radius`
+    /// when given.
+    bool nearest_irradiance(const Vec3& p, const Vec3& normal, float max_radius, Color* irradiance,
+                            float* site_radius = nullptr) const;
 
     bool empty() const { return tree_.empty(); }
     size_t size() const { return tree_.size(); }

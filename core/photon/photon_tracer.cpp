@@ -28,7 +28,6 @@ constexpr size_t kHintBlock = 256;  // sites whose estimates pass the hint on, o
 // A batch stores at most about this share of a map's photons: the chunks' buffers of traced
 // photons (28 bytes each) then stay a small part of the map's memory (photon_series.py's peak).
 constexpr double kBatchesPerMap = 8.0;
-constexpr float kIrradianceRadiusShare = 0.2f;             // irradiance estimate radius cap / scene radius
 
 /// A stored photon before its map is complete: packed as the map stores it, but with its flux
 /// not yet divided by the photons emitted for its map (Photon::scale_flux does that once they
@@ -294,8 +293,9 @@ std::vector<uint32_t> morton_order(const std::vector<IrradianceSite>& sites) {
     return order;
 }
 
-/// Irradiance at each site, estimated from `global` (the global map, or the caustic one), packed as photons whose flux is the
-/// irradiance and whose direction is the surface normal.
+/// Irradiance at each site, estimated from `global` (the global map, or the caustic one), packed
+/// with its estimate's radius (make_irradiance_site; max_radius where fewer than k photons were
+/// within it: the estimate then spread over the whole disc).
 std::shared_ptr<const PhotonMap> precompute_irradiance(const PhotonMap& global, const std::vector<IrradianceSite>& sites,
                                                        uint32_t k, float max_radius) {
     std::vector<Photon> points(sites.size());
@@ -314,7 +314,7 @@ std::shared_ptr<const PhotonMap> precompute_irradiance(const PhotonMap& global, 
             const IrradianceSite& site = sites[i];
             hint *= kRadiusHintWidening;
             const Color e = global.estimate_irradiance(site.position, site.normal, k, max_radius, 0, &hint);
-            points[i] = make_photon(site.position, site.normal, e, 0, site.normal);
+            points[i] = make_irradiance_site(site.position, site.normal, e, hint > 0.0f ? hint : max_radius);
         }
     });
     return std::make_shared<const PhotonMap>(std::move(points), 0);

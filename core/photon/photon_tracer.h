@@ -60,6 +60,8 @@ inline constexpr uint32_t kCausticTestMinPhotons = 8;
 /// The caustic estimate's radius cap as a share of the scene's bounding radius (the render's
 /// default too: core/integrators/photon_mapping.h).
 inline constexpr float kCausticRadiusShare = 0.05f;
+/// The precomputed irradiance estimates' radius cap as a share of the scene's bounding radius.
+inline constexpr float kIrradianceRadiusShare = 0.2f;
 
 struct PhotonTracingSettings {
     uint32_t global_photons = 200000;   // photons to store in the global map (0: no global map)

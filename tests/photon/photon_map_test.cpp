@@ -91,6 +91,26 @@ TEST(PhotonMap, AParallelSurfaceJustAboveIsNotRead) {
     EXPECT_TRUE(irradiance.nearest_irradiance(Vec3(0.6f, 0.1f, 0.6f), up, 0.3f, &e));
 }
 
+TEST(PhotonMap, TheNearestIrradianceSiteGivesItsIrradianceAndRadius) {
+    // Two sites on a plane: the nearer one's irradiance and estimate radius come back; a site
+    // facing another way, or one without a normal, is never taken.
+    const Vec3 up(0.0f, 1.0f, 0.0f);
+    const PhotonMap sites({make_irradiance_site(Vec3(0.0f), up, Color(1.0f), 0.05f),
+                           make_irradiance_site(Vec3(1.0f, 0.0f, 0.0f), up, Color(2.0f), 0.2f),
+                           make_irradiance_site(Vec3(0.1f, 0.0f, 0.0f), Vec3(1.0f, 0.0f, 0.0f), Color(3.0f), 0.3f),
+                           make_irradiance_site(Vec3(0.8f, 0.0f, 0.0f), Vec3(0.0f), Color(4.0f), 0.4f)},
+                          0);
+    Color e(-1.0f);
+    float radius = -1.0f;
+    ASSERT_TRUE(sites.nearest_irradiance(Vec3(0.2f, 0.0f, 0.0f), up, 2.0f, &e, &radius));
+    EXPECT_NEAR(e.x, 1.0f, 1e-3f);
+    EXPECT_NEAR(radius, 0.05f, 1e-4f);
+    ASSERT_TRUE(sites.nearest_irradiance(Vec3(0.75f, 0.0f, 0.0f), up, 2.0f, &e, &radius));
+    EXPECT_NEAR(e.x, 2.0f, 2e-3f);
+    EXPECT_NEAR(radius, 0.2f, 1e-4f);
+    EXPECT_FALSE(sites.nearest_irradiance(Vec3(0.75f, 0.0f, 0.0f), up, 0.2f, &e, &radius));
+}
+
 TEST(PhotonMap, AFlatSurfaceReadsTheSameWithOrWithoutNormals) {
     // Photons and queries in one plane: the disc is the sphere there and every normal agrees,
     // so the estimates are those of the sphere search on photons without normals, bit for bit.

@@ -256,5 +256,23 @@ TEST(Photon, EveryNormalCodeDecodesToAUnitVector) {
     }
 }
 
+TEST(Photon, IrradianceSiteKeepsItsRadiusWithinAStepAtEveryScale) {
+    // A site's estimate radius lives in the direction bytes (make_irradiance_site), on a log
+    // scale: within half a step, 2^(1/1024) - 1 = 0.068 %, from the tiniest scene to the largest.
+    const Vec3 normal = glm::normalize(Vec3(0.3f, 0.9f, -0.2f));
+    const float half_step = std::exp2(1.0f / 1024.0f) - 1.0f;
+    for (const float radius : {1e-15f, 1e-4f, 0.0123f, 0.11f, 1.0f, 3.7f, 250.0f, 6e4f, 9.6e4f, 1e15f}) {
+        const Photon site = make_irradiance_site(Vec3(1, 2, 3), normal, Color(0.5f, 1.0f, 2.0f), radius);
+        EXPECT_NEAR(site.site_radius(), radius, radius * half_step * 1.001f) << radius;
+        EXPECT_LT(angle_degrees(site.normal(), normal), 0.01f);
+        EXPECT_NEAR(site.flux().y, 1.0f, 1e-3f);
+    }
+    EXPECT_EQ(make_irradiance_site(Vec3(0), normal, Color(1.0f), 0.0f).site_radius(), 0.0f);
+    EXPECT_EQ(make_irradiance_site(Vec3(0), normal, Color(1.0f), -1.0f).site_radius(), 0.0f);
+    EXPECT_EQ(make_irradiance_site(Vec3(0), normal, Color(1.0f), kNaN).site_radius(), 0.0f);
+    EXPECT_GT(make_irradiance_site(Vec3(0), normal, Color(1.0f), kInf).site_radius(), 1e19f);
+    EXPECT_GT(make_irradiance_site(Vec3(0), normal, Color(1.0f), 1e-30f).site_radius(), 0.0f);
+}
+
 }  // namespace
 }  // namespace photond

@@ -65,7 +65,8 @@ TEST(PhotonTracer, FirstHitsCarryTheLightsTotalPower) {
 
 TEST(PhotonTracer, PhotonsKeepTheNormalOfTheSideTheyLandedOn) {
     // In the closed room every photon lies on a wall and arrived from the inside: its normal is
-    // the wall's inward one, and the precomputed irradiance photons carry it too.
+    // the wall's inward one, and the precomputed irradiance sites carry it too, with the radius
+    // of their estimate.
     auto rs = make_render_scene(closed_room(0.5f, Vec3(0.3f, 1.0f, -0.2f), Color(1.0f)));
     PhotonTracingSettings settings;
     settings.global_photons = 20000;
@@ -91,7 +92,13 @@ TEST(PhotonTracer, PhotonsKeepTheNormalOfTheSideTheyLandedOn) {
                 // Arrived from the inside, up to the direction's 0.8 degree (0.014) bins.
                 ASSERT_GT(glm::dot(-photon.direction(), n), -0.015f);
             } else {
-                ASSERT_GT(glm::dot(photon.direction(), n), 0.999f);  // 0.8 degree bins
+                // A site keeps its estimate's radius: the k-th photon's, or the cap's where fewer
+                // were within it.
+                const float cap = kIrradianceRadiusShare * rs->scene->bounds.radius();
+                float radius = 0.0f;
+                maps->global->estimate_irradiance(photon.position, photon.normal(), settings.k_irradiance, cap, 0, &radius);
+                if (radius == 0.0f) radius = cap;
+                ASSERT_NEAR(photon.site_radius(), radius, 1e-3f * radius);
             }
         }
     }

@@ -109,6 +109,7 @@ const std::map<std::string, json>& changed_values() {
         {"photons.k_volume", 64},
         {"photons.seed", 77},
         {"gather.rays", 100},
+        {"gather.short_ray_radii", 0.5},
         {"irradiance_cache.enabled", false},
         {"irradiance_cache.a", 0.25},
         {"irradiance_cache.gradients", false},
