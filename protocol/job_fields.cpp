@@ -788,9 +788,10 @@ std::vector<JobField> make_job_fields() {
     fields.push_back(integer_field(JOB_MEMBER(gather.rays), limits::kGatherRays, "final-gather rays per record",
                                    {"128", "256", "2048"}));
     fields.push_back(number_field(JOB_MEMBER(gather.short_ray_radii), limits::kShortRayRadii,
-                                  "a gather ray that lands closer than this many photon-estimate radii (where the "
-                                  "estimate would reach past a contact's shadow) traces one bounce there instead "
-                                  "of reading the photons (Jensen's short-ray rule); 0 never",
+                                  "a gather or glossy ray that lands closer than this many photon-estimate radii "
+                                  "(where the estimate would reach past a contact's shadow) traces a bounce on "
+                                  "there instead of reading the photons, up to 4 a ray (Jensen's short-ray rule); "
+                                  "0 never",
                                   {"2.0", "2.0", "2.0"}));
     fields.push_back(bool_field(JOB_MEMBER(irradiance_cache.enabled),
                                 "cache final-gather irradiance (Ward et al. 1988)", {"true", "true", "true"}));

@@ -14,6 +14,7 @@ nlohmann::json to_json(const RenderStatistics& s) {
         {"passes", passes},
         {"rays", s.rays},
         {"shadow_rays", s.shadow_rays},
+        {"short_ray_bounces", s.short_ray_bounces},
         {"rays_per_second", s.rays_per_second()},
         {"render_seconds", s.render_seconds},
         {"total_seconds", s.total_seconds},

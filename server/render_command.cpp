@@ -221,6 +221,9 @@ void print_statistics(const RenderStatistics& s) {
     std::fprintf(stderr, "  rays %llu + shadow rays %llu, %.2f Mrays/s\n",
                  static_cast<unsigned long long>(s.rays), static_cast<unsigned long long>(s.shadow_rays),
                  s.rays_per_second() * 1e-6);
+    if (s.short_ray_bounces > 0)
+        std::fprintf(stderr, "  short-ray rule: %llu gather hits traced a bounce on (gather.short_ray_radii)\n",
+                     static_cast<unsigned long long>(s.short_ray_bounces));
     for (const std::string& warning : s.warnings) std::fprintf(stderr, "  warning: %s\n", warning.c_str());
 }
 

@@ -648,6 +648,7 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
         const PreviewResult previewed = render_preview(cheap ? *cheap : renderer, *camera, preview, options.callbacks);
         stats.rays += previewed.counters.rays;
         stats.shadow_rays += previewed.counters.shadow_rays;
+        stats.short_ray_bounces += previewed.counters.short_ray_bounces;
         RenderStatistics::PreviewFigures figures;
         figures.stride = previewed.stride;
         figures.samples = previewed.samples;
@@ -697,6 +698,7 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
         }
         stats.rays += prepared->counters.rays;
         stats.shadow_rays += prepared->counters.shadow_rays;
+        stats.short_ray_bounces += prepared->counters.short_ray_bounces;
     }
 
     if (options.caches_only) {
@@ -713,6 +715,7 @@ Expected<PipelineResult> run_job(const protocol::Job& job, std::shared_ptr<Embre
     stats.passes.push_back({"render", stats.render_seconds});
     stats.rays += rendered.counters.rays;
     stats.shadow_rays += rendered.counters.shadow_rays;
+    stats.short_ray_bounces += rendered.counters.short_ray_bounces;
     stats.caustic_points = rendered.counters.caustic_points;
     stats.caustic_skipped = rendered.counters.caustic_skipped;
     if (stats.irradiance_cache) {

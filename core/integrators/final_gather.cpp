@@ -21,6 +21,7 @@ FinalGatherer::FinalGatherer(std::shared_ptr<const RenderScene> scene, std::shar
     : scene_(std::move(scene)), maps_(std::move(maps)), settings_(settings),
       grid_(GatherGrid::for_rays(settings.rays)) {
     if (settings_.max_radius <= 0.0f) settings_.max_radius = 0.2f * scene_->scene->bounds.radius();
+    site_radius_cap_ = kIrradianceRadiusShare * scene_->scene->bounds.radius();
     if (settings_.max_radius_caustic <= 0.0f) settings_.max_radius_caustic = kCausticRadiusShare * scene_->scene->bounds.radius();
 }
 
@@ -29,9 +30,9 @@ namespace {
 /// Photons of an estimate at a gather hit on a normal-mapped surface read as diffuse.
 constexpr uint32_t kBentNormalPhotons = 32;
 
-/// Bounces a gather ray's path traces by the short-ray rule (GatherSettings::short_ray_radii)
-/// before it reads the photons wherever it lands: a contact's gap sends rays back and forth
-/// between its two surfaces, each bounce reflecting a share of the light.
+/// Bounces one gather ray traces by the short-ray rule (GatherSettings::short_ray_radii), in all
+/// its branches together, before it reads the photons wherever it lands: a contact's gap sends
+/// rays back and forth between its two surfaces, each bounce reflecting a share of the light.
 constexpr int kMaxShortRayBounces = 4;
 
 /// The nearest irradiance site on the side a hit is seen from (PhotonMap::nearest_irradiance).
@@ -111,8 +112,9 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
         RayCounters& counters;
         FirstHitEmission* emission;
         bool caustic_chains;
-        /// Bounces traced so far by the short-ray rule.
-        int short_ray_bounces = 0;
+        /// Bounces the short-ray rule may still trace, shared by every walker of the gather ray
+        /// (a hit's short-ray bounce and its glossy lobes' ray both go on from it).
+        int& short_ray_budget;
         /// Where a ray that samples a glossy lobe started, and the lobe's pdf for it (0 once a
         /// delta bounce followed: then no light sample could have found what it meets).
         struct GlossyOrigin {
@@ -189,18 +191,20 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
             if (bsdf.has_non_delta()) {
                 constexpr LobeMask kGlossy = mask_of(LobeKind::Glossy);
                 const bool caustic_chain = caustic_chains && !from && bsdf.continues_caustic(LobeKind::Glossy);
-                if ((bsdf.lobes() & kGlossy) && glossy_bounces < g.settings_.max_glossy_bounces) {
+                NearestSite site;
+                if ((bsdf.lobes() & kGlossy) &&
+                    (glossy_bounces < g.settings_.max_glossy_bounces || (caustic_chain && is_short(si, wo, &site) && short_ray_budget-- > 0))) {
                     radiance += glossy_lobes(si, bsdf, wo, depth, glossy_bounces, caustic_chain);
-                    radiance += elsewhere(si, bsdf, wo, depth, kNonDeltaLobes & ~kGlossy);
+                    radiance += photons_or_bounce(si, bsdf, wo, depth, kNonDeltaLobes & ~kGlossy);
                 } else if ((bsdf.lobes() & kGlossy) && caustic_chain) {
                     // The chain's last glossy lobe: the photons that came to it through a diffuse
                     // surface (those straight from the lights or through caustic bounces would
                     // continue the caustic chain).
-                    radiance += elsewhere(si, bsdf, wo, depth, kNonDeltaLobes & ~kGlossy);
+                    radiance += photons_or_bounce(si, bsdf, wo, depth, kNonDeltaLobes & ~kGlossy);
                     radiance += radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_, rng, kGlossy,
                                                       photon_flags::kDirect | photon_flags::kCaustic);
                 } else {
-                    radiance += elsewhere(si, bsdf, wo, depth, kNonDeltaLobes);
+                    radiance += photons_or_bounce(si, bsdf, wo, depth, kNonDeltaLobes);
                 }
             }
             if (bsdf.has_delta() && depth < g.settings_.max_specular_depth) {
@@ -215,35 +219,32 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
         }
         /// What `lobes` reflect at a non-delta hit of the light arriving from elsewhere: the
         /// photons' estimate, or one bounce traced where the ray that came is short.
-        Color elsewhere(const SurfaceInteraction& si, const Bsdf& bsdf, const Vec3& wo, int depth, LobeMask lobes) const {
+        Color photons_or_bounce(const SurfaceInteraction& si, const Bsdf& bsdf, const Vec3& wo, int depth,
+                                LobeMask lobes) const {
             if (!(bsdf.lobes() & lobes)) return Color(0.0f);
             NearestSite site;
             if (is_short(si, wo, &site)) return short_ray_bounce(si, bsdf, wo, depth, lobes);
             return radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_, rng, lobes, 0, site.found ? &site : nullptr);
         }
-        /// Whether the ray that reached `si` is short next to the photon estimate's radius there
-        /// (GatherSettings::short_ray_radii): the nearest site's, or the search's cap where no
-        /// site is near (an estimate there spreads over the whole disc). The site looked up is
+        /// Whether the ray that reached `si` is short next to the radius of the nearest
+        /// irradiance site's estimate (GatherSettings::short_ray_radii). Where no site is near
+        /// (or the maps have none) the hit reads the photons as before. The site looked up is
         /// left in `site` for the estimate to use.
         bool is_short(const SurfaceInteraction& si, const Vec3& wo, NearestSite* site) const {
             const float factor = g.settings_.short_ray_radii;
-            // No estimate reaches further than the cap: longer rays are never short.
-            if (!(factor > 0.0f) || short_ray_bounces >= kMaxShortRayBounces || !g.maps_->global ||
-                !(si.distance < factor * g.settings_.max_radius))
+            // No site's estimate reaches further than the sites' cap: longer rays are never short.
+            if (!(factor > 0.0f) || short_ray_budget <= 0 || !g.maps_->global || !g.maps_->irradiance ||
+                !(si.distance < factor * g.site_radius_cap_))
                 return false;
-            float radius = g.settings_.max_radius;
-            if (g.maps_->irradiance) {
-                const Vec3 n = glm::dot(si.surface_normal, wo) >= 0.0f ? si.surface_normal : -si.surface_normal;
-                site->found = g.maps_->irradiance->nearest_irradiance(si.p, n, g.settings_.max_radius, &site->irradiance,
-                                                                      &site->radius);
-                if (site->found) radius = site->radius;
-            }
-            return si.distance < factor * radius;
+            const Vec3 n = glm::dot(si.surface_normal, wo) >= 0.0f ? si.surface_normal : -si.surface_normal;
+            site->found = g.maps_->irradiance->nearest_irradiance(si.p, n, g.settings_.max_radius, &site->irradiance,
+                                                                  &site->radius);
+            return site->found && si.distance < factor * site->radius;
         }
         /// Jensen's short-ray rule (GatherSettings::short_ray_radii): what `lobes` reflect at
         /// `si`, as a visible point takes it: a light sample, the caustic map's estimate and one
         /// lobe-sampled ray on (a new path: its glossy bounces count from 0), whose own short hits
-        /// trace again (up to kMaxShortRayBounces). With a caustic map the ray on counts no
+        /// trace again (kMaxShortRayBounces for the gather ray). With a caustic map the ray on counts no
         /// emitter through specular and sharply glossy surfaces (a new caustic chain: the map
         /// holds that light) and none straight ahead (the light sample, unweighted, does);
         /// without one it is weighted against the light sample by the power heuristic, as
@@ -251,6 +252,8 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
         Color short_ray_bounce(const SurfaceInteraction& si, const Bsdf& bsdf, const Vec3& wo, int depth,
                                LobeMask lobes) const {
             SampleContext context{rng, counters};
+            --short_ray_budget;
+            ++counters.short_ray_bounces;
             const bool caustics = g.maps_->caustic != nullptr;
             Color radiance(0.0f);
             if (caustics) {
@@ -267,30 +270,25 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
             const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Radiance, lobes);
             if (s && s->pdf > 0.0f && !is_black(s->weight)) {
                 const GlossyOrigin origin{si.p, s->pdf};
-                const Walker on{g, rs, rng, counters, nullptr, caustics, short_ray_bounces + 1};
+                const Walker on{g, rs, rng, counters, nullptr, caustics, short_ray_budget};
                 radiance += s->weight * on.along(spawn_ray(rs, si, s->wi), depth, nullptr, false, 0,
                                                  caustics ? nullptr : &origin);
             }
             return radiance;
         }
-        /// The caustic map's light reflected by `lobes` at `si`: read as diffuse, the caustic
-        /// irradiance precomputed at the nearest caustic site (none near: no caustic there), as
-        /// the global map's is read; else the map's estimate.
+        /// The caustic map's light reflected by `lobes` at `si`, a short ray's hit: its estimate
+        /// from a disc no wider than the ray is long over short_ray_radii, the rule's own bound,
+        /// so that it too stays out of light that the surfaces meeting there shadow (a caustic
+        /// ring around a sphere's contact). Too few photons there read as none.
         Color caustic_estimate(const SurfaceInteraction& si, const Bsdf& bsdf, const Vec3& wo, LobeMask lobes) const {
             const bool front = glm::dot(si.surface_normal, wo) >= 0.0f;
-            const Vec3 n = front ? si.surface_normal : -si.surface_normal;
-            if (g.maps_->caustic_irradiance && bsdf.reads_as_diffuse(lobes) && bent_shading_normal(si, front) == Vec3(0.0f)) {
-                Color e(0.0f);
-                if (!g.maps_->caustic_irradiance->nearest_irradiance(si.p, n, g.settings_.max_radius_caustic, &e))
-                    return Color(0.0f);
-                return bsdf.diffuse_like_reflectance(wo) * kInvPi * e;
-            }
             RadianceEstimateOptions options;
             options.k = g.settings_.k_caustic;
-            options.max_radius = g.settings_.max_radius_caustic;
+            options.max_radius = std::min(g.settings_.max_radius_caustic, si.distance / g.settings_.short_ray_radii);
             options.cone_filter = true;
             options.lobes = lobes;
-            return g.maps_->caustic->estimate_radiance(si.p, n, bsdf, wo, estimate_options_at(options, si, bsdf, front));
+            return g.maps_->caustic->estimate_radiance(si.p, front ? si.surface_normal : -si.surface_normal, bsdf, wo,
+                                                       estimate_options_at(options, si, bsdf, front));
         }
         /// The glossy lobes' reflection at a gather hit, as a path tracer takes it: a light
         /// sample and a lobe sample, weighted by the power heuristic. In a caustic chain, the
@@ -313,7 +311,8 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
         }
     };
     if (emission) *emission = FirstHitEmission{};
-    return Walker{*this, rs, rng, counters, emission, caustic_chains}.along(ray, 0, distance, true);
+    int short_ray_budget = kMaxShortRayBounces;
+    return Walker{*this, rs, rng, counters, emission, caustic_chains, short_ray_budget}.along(ray, 0, distance, true);
 }
 
 GatherResult FinalGatherer::gather(const Vec3& p, const Vec3& n, const Vec3& geometric_normal, Rng& rng,

@@ -13,6 +13,12 @@
 // surface of diffuse kind, take light samples and weight the emitters their rays meet by the
 // power heuristic, as a path tracer does. Without a caustic map every glossy lobe does: its
 // light then comes from the gather alone.
+//
+// Jensen's short-ray rule (GatherSettings::short_ray_radii): a hit closer to where its ray left
+// than the photon estimate there is wide is traced a bounce on instead of read from the photons,
+// as a visible point is (a light sample, the caustic map, one lobe sample), so a gather ray's path
+// takes direct light there too. Still read from the photons, without the rule: the last glossy
+// lobe of a caustic chain, and rough glass's far side.
 #pragma once
 
 #include <array>
@@ -114,6 +120,9 @@ private:
     std::shared_ptr<const PhotonMaps> maps_;
     GatherSettings settings_;
     GatherGrid grid_;
+    /// The irradiance sites' estimate radius cap (kIrradianceRadiusShare of the scene's radius):
+    /// a ray longer than short_ray_radii of it is never short.
+    float site_radius_cap_ = 0.0f;
 };
 
 }  // namespace photond

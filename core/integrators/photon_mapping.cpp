@@ -190,8 +190,11 @@ std::string PhotonMapIntegrator::render_cache_key(const std::string& photon_map_
     if (scene_->scene->atmosphere) hasher.update_value(uint32_t(gather.k_volume));
     hash_float(gather.max_radius);
     hash_float(gather.short_ray_radii);
-    hasher.update_value(uint32_t(gather.k_caustic));
-    hash_float(gather.max_radius_caustic);
+    // Short gather rays read the caustic map: its estimates' settings, where they are read.
+    if (gather.short_ray_radii > 0.0f && maps_->caustic) {
+        hasher.update_value(uint32_t(gather.k_caustic));
+        hash_float(gather.max_radius_caustic);
+    }
     hasher.update_value(uint8_t(gather.gather_diffuse_sky));
     // Glossy gather hits sample lights (final_gather.cpp): how they pick them changes the records.
     hasher.update_value(uint8_t(scene_->lights->selection()));

@@ -141,8 +141,9 @@ Photon make_photon(Vec3 position, Vec3 direction, Color flux, uint8_t user_flags
 
 /// Packs a precomputed irradiance site (PhotonMap::nearest_irradiance): its position, surface
 /// normal (which the site must have: a zero or non-finite one gives a site no lookup accepts),
-/// irradiance as its flux and its estimate's radius (Photon::site_radius; negative or non-finite
-/// is stored as 0, below 2^-64 as that, beyond 2^64 as that).
+/// irradiance as its flux and its estimate's radius (Photon::site_radius; negative and NaN are
+/// stored as 0, a positive radius below 2^-64 as that, beyond about 2^64 and +infinity as the
+/// largest code, 2^(65535 / 512 - 64)).
 Photon make_irradiance_site(Vec3 position, Vec3 normal, Color irradiance, float radius);
 
 }  // namespace photond

@@ -109,9 +109,9 @@ struct PhotonTracingStatistics {
 };
 
 /// The maps of a scene; a map not asked for is null. `irradiance` holds precomputed irradiance
-/// at a subset of the global photons (photon flux = irradiance, direction and normal = surface
-/// normal), `caustic_irradiance` the caustic map's at a subset of the caustic photons (with
-/// kCausticTestPhotons an estimate), when both maps exist.
+/// at a subset of the global photons as irradiance sites (make_irradiance_site: irradiance,
+/// surface normal, the estimate's radius), `caustic_irradiance` the caustic map's at a subset of
+/// the caustic photons (with kCausticTestPhotons an estimate), when both maps exist.
 struct PhotonMaps {
     std::shared_ptr<const PhotonMap> global;
     std::shared_ptr<const PhotonMap> caustic;

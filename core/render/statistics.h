@@ -25,6 +25,8 @@ struct RenderStatistics {
     std::vector<PassTiming> passes;
     uint64_t rays = 0;         // intersection queries
     uint64_t shadow_rays = 0;  // occlusion queries
+    /// Gather and glossy-ray hits traced a bounce on by the short-ray rule, in every pass.
+    uint64_t short_ray_bounces = 0;
     double render_seconds = 0.0;  // the tile pass alone
     double total_seconds = 0.0;
     bool cancelled = false;

@@ -23,6 +23,7 @@ struct RayCounters {
     uint64_t radiance_misses = 0;     // ... that no record covered (BSDF-sampled rays instead)
     uint64_t caustic_points = 0;      // visible points where the caustic map could be read
     uint64_t caustic_skipped = 0;     // ... where it was not, its light too faint to show
+    uint64_t short_ray_bounces = 0;   // gather hits traced a bounce on (GatherSettings::short_ray_radii)
 
     RayCounters& operator+=(const RayCounters& o) {
         rays += o.rays;
@@ -33,6 +34,7 @@ struct RayCounters {
         radiance_misses += o.radiance_misses;
         caustic_points += o.caustic_points;
         caustic_skipped += o.caustic_skipped;
+        short_ray_bounces += o.short_ray_bounces;
         return *this;
     }
 };
