@@ -790,8 +790,7 @@ std::vector<JobField> make_job_fields() {
     fields.push_back(number_field(JOB_MEMBER(gather.short_ray_radii), limits::kShortRayRadii,
                                   "a gather or glossy ray that lands closer than this many photon-estimate radii "
                                   "(where the estimate would reach past a contact's shadow) traces a bounce on "
-                                  "there instead of reading the photons, up to 4 a ray (Jensen's short-ray rule); "
-                                  "0 never",
+                                  "there instead of reading the photons (Jensen's short-ray rule); 0 never",
                                   {"2.0", "2.0", "2.0"}));
     fields.push_back(bool_field(JOB_MEMBER(irradiance_cache.enabled),
                                 "cache final-gather irradiance (Ward et al. 1988)", {"true", "true", "true"}));

@@ -17,8 +17,8 @@
 // Jensen's short-ray rule (GatherSettings::short_ray_radii): a hit closer to where its ray left
 // than the photon estimate there is wide is traced a bounce on instead of read from the photons,
 // as a visible point is (a light sample, the caustic map, one lobe sample), so a gather ray's path
-// takes direct light there too. Still read from the photons, without the rule: the last glossy
-// lobe of a caustic chain, and rough glass's far side.
+// takes direct light there too; the last glossy lobe of a caustic chain is followed a bounce
+// more there. Still read from the photons, without the rule: rough glass's far side.
 #pragma once
 
 #include <array>
@@ -112,9 +112,10 @@ public:
 private:
     /// gather_ray_radiance; `caustic_chains`: the light that reaches the ray's origin from an
     /// emitter through specular and glossy bounces alone is the caustic map's (a gather for
-    /// irradiance at a diffuse point, when there is a caustic map).
+    /// irradiance at a diffuse point, when there is a caustic map). `short_ray_bounces`: the
+    /// bounces the short-ray rule may trace for this ray.
     Color trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& counters, float* distance,
-                           FirstHitEmission* emission, bool caustic_chains) const;
+                           FirstHitEmission* emission, bool caustic_chains, int short_ray_bounces) const;
 
     std::shared_ptr<const RenderScene> scene_;
     std::shared_ptr<const PhotonMaps> maps_;

@@ -311,7 +311,7 @@ TEST(GlossyGather, AGlossySphereReflectsTheShadowItStandsInAsPathDoes) {
             return base_mean(result.layers.beauty) / reference - 1.0;
         };
         const double traced = render(GatherSettings{}.short_ray_radii), read = render(0.0f);
-        // Measured at 64 spp: roughness 0.3 traced +4.9 %, read +49.9 %; 0.2 traced +9.4 %, read
+        // Measured at 64 spp: roughness 0.3 traced +5.2 %, read +49.9 %; 0.2 traced +9.7 %, read
         // +39.7 % (at 128 spp +3.7 % and +5.9 %: the gap's bounces are noisy). What the rule
         // leaves is the estimate's blur at hits a few radii away: with 4 radii instead of 2,
         // +1.2 % and +3.3 %, for more bounces everywhere.
