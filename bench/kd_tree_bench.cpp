@@ -8,6 +8,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <vector>
 
@@ -21,6 +22,10 @@ constexpr uint32_t kPhotonCount = 1u << 20;
 constexpr uint32_t kQueryCount = 1u << 14;
 constexpr uint32_t kK = 50;
 constexpr float kMaxRadius = 0.05f;  // in a unit box; the 50th photon is nearer on average
+
+/// The search radius for k photons: kMaxRadius grown as the k-th photon's distance grows on the
+/// Cornell planes (sqrt k; faster than in the box's volume, cbrt k).
+float max_radius_for(uint32_t k) { return kMaxRadius * std::sqrt(float(k) / float(kK)); }
 
 // Scene 0: uniform in the unit box. Scene 1: a Cornell box, photons on five walls of the unit
 // cube (floor, ceiling, back, left, right), as a global photon map stores them.
@@ -208,11 +213,13 @@ template <class Tree>
 void BM_KNearest(benchmark::State& state) {
     const Data& data = Data::get(int(state.range(0)));
     const Tree tree(data.photons);
+    const auto k = uint32_t(state.range(1));
+    const float max_radius = max_radius_for(k);
     KnnResult result;
     uint64_t found = 0, queries = 0;
     size_t q = 0;
     for (auto _ : state) {
-        tree.k_nearest(data.queries[q], kK, kMaxRadius, result);
+        tree.k_nearest(data.queries[q], k, max_radius, result);
         found += result.size();
         ++queries;
         q = (q + 1) % data.queries.size();
@@ -236,8 +243,13 @@ BENCHMARK(BM_Build<JensenKdTree>)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(1.0);
-BENCHMARK(BM_KNearest<PhotonKdTree>)->ArgName("scene")->Arg(0)->Arg(1);
-BENCHMARK(BM_KNearest<JensenKdTree>)->ArgName("scene")->Arg(0)->Arg(1);
+// k: the estimates' (k_global 50, k_caustic 100, k_volume 200) and the irradiance sites' 4.
+BENCHMARK(BM_KNearest<PhotonKdTree>)
+    ->ArgNames({"scene", "k"})
+    ->ArgsProduct({{0, 1}, {4, 50, 100, 200}});
+BENCHMARK(BM_KNearest<JensenKdTree>)
+    ->ArgNames({"scene", "k"})
+    ->ArgsProduct({{0, 1}, {4, 50, 100, 200}});
 
 }  // namespace
 }  // namespace photond
