@@ -243,7 +243,8 @@ BENCHMARK(BM_Build<JensenKdTree>)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(1.0);
-// k: the estimates' (k_global 50, k_caustic 100, k_volume 200) and the irradiance sites' 4.
+// k: the estimates' (k_global 50, k_caustic 100, k_volume 100; 400 in `reference`) and the
+// irradiance sites' 4; 200 for scale.
 BENCHMARK(BM_KNearest<PhotonKdTree>)
     ->ArgNames({"scene", "k"})
     ->ArgsProduct({{0, 1}, {4, 50, 100, 200}});

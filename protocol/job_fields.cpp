@@ -780,9 +780,12 @@ std::vector<JobField> make_job_fields() {
                                    "or inside solids that scatter (photon-map integrator; only when the job's "
                                    "atmosphere or material_media scatter)",
                                    {"100000", "400000", "2000000"}));
+    // `final` reads 100, not 200: on foggy-room a smaller sphere blurs the light less and a
+    // pixel averages more estimates than one holds photons (block relMSE 0.0019 vs 0.0020 over
+    // two seeds, 21 % less time at 400k photons).
     fields.push_back(integer_field(JOB_MEMBER(photons.k_volume), limits::kPhotonNeighbours,
                                    "nearest photons per volume-map estimate of in-scattered light",
-                                   {"100", "200", "400"}));
+                                   {"100", "100", "400"}));
     fields.push_back(integer_field(JOB_MEMBER(photons.seed), limits::kSeed, "seed of the photon tracing",
                                    {"1", "1", "1"}));
     fields.push_back(integer_field(JOB_MEMBER(gather.rays), limits::kGatherRays, "final-gather rays per record",

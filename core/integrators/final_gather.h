@@ -35,7 +35,7 @@ struct GatherSettings {
     /// heuristic) before it reads the photon maps with the lobe; 0 reads them at once.
     int max_glossy_bounces = 2;
     uint32_t k_global = 50;      // photons per radiance estimate where no precomputed irradiance fits
-    uint32_t k_volume = 200;     // photons per volume-map estimate of the atmosphere's in-scattered light
+    uint32_t k_volume = 100;     // photons per volume-map estimate of the atmosphere's in-scattered light
     float max_radius = 0.0f;     // estimate radius cap (world units)
     /// Jensen's short-ray rule: where a ray lands closer to where it left than this many times
     /// the radius of the photon estimate there (the nearest irradiance site's), the estimate

@@ -25,7 +25,7 @@ namespace photond {
 struct PhotonMapIntegratorSettings {
     uint32_t k_global = 50;
     uint32_t k_caustic = 100;
-    uint32_t k_volume = 200;  // photons per volume-map estimate of the atmosphere's in-scattered light
+    uint32_t k_volume = 100;  // photons per volume-map estimate of the atmosphere's in-scattered light
     float max_radius_global = 0.0f;   // world units; 0 = kDefaultGlobalRadiusShare of the scene
     float max_radius_caustic = 0.0f;  // world units; 0 = kDefaultCausticRadiusShare of the scene
     int max_specular_depth = 16;

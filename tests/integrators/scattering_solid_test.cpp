@@ -93,8 +93,8 @@ Environment half_sky() {
 
 /// The mean radiance of rays along `direction` (an axis) through a grid of points over the
 /// sphere's disc seen that way (radius 0.48 of its 0.5: every ray crosses the solid), `samples`
-/// each. One ray's mean carries the noise of the few photon estimates along it (a few percent at
-/// k = 200); the disc's averages that out and keeps what is systematic.
+/// each. One ray's mean carries the noise of the few photon estimates along it (a few percent);
+/// the disc's averages that out and keeps what is systematic.
 Color disc_mean(const Integrator& integrator, const Vec3& direction, int samples) {
     const Vec3 u = std::abs(direction.y) > 0.5f ? Vec3(1.0f, 0.0f, 0.0f) : Vec3(0.0f, 1.0f, 0.0f);
     const Vec3 v = glm::cross(direction, u);
@@ -113,6 +113,21 @@ Color disc_mean(const Integrator& integrator, const Vec3& direction, int samples
     return Color(sum / double(rays));
 }
 
+/// The mean radiance of rays along -z that graze the sphere's rim at 0.46 of its 0.5 radius, where
+/// most of an estimate's sphere lies outside the solid: `rays` of them around the rim, `samples`
+/// each. The rays' estimates draw on different photons, so their mean keeps what is systematic;
+/// one ray's mean is as far off as its few photon neighbourhoods happen to be (up to 11 % at
+/// k = 200 for some photon seeds).
+Color rim_mean(const Integrator& integrator, int rays, int samples) {
+    DVec3 sum(0.0);
+    for (int i = 0; i < rays; ++i) {
+        const float angle = 2.0f * kPi * (float(i) + 0.5f) / float(rays);
+        const Vec3 origin(0.46f * std::cos(angle), 0.46f * std::sin(angle), 3.0f);
+        sum += DVec3(mean_radiance(integrator, ray_from(origin, Vec3(0.0f, 0.0f, -1.0f)), samples, uint64_t(i + 1)));
+    }
+    return Color(sum / double(rays));
+}
+
 TEST(ScatteringSolid, PhotonMapKeepsAUniformSkysRadianceInsideGlass) {
     for (const float ior : {1.0f, 1.5f}) {
         const auto rs = glass_sphere_under(ior, uniform_sky());
@@ -124,8 +139,9 @@ TEST(ScatteringSolid, PhotonMapKeepsAUniformSkysRadianceInsideGlass) {
         const Color got = disc_mean(*integrator, Vec3(0.0f, 0.0f, -1.0f), 64);
         for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], 1.0f, 0.04f) << "ior " << ior << " channel " << c;
         // Rays that graze the rim, where most of an estimate's sphere lies outside the solid.
-        const Color rim = mean_radiance(*integrator, ray_from(Vec3(0.0f, 0.46f, 3.0f), Vec3(0.0f, 0.0f, -1.0f)), 2000);
-        for (int c = 0; c < 3; ++c) EXPECT_NEAR(rim[c], 1.0f, 0.08f) << "ior " << ior << " rim, channel " << c;
+        // Measured over photon seeds 1 to 4: within 2.5 % (k = 100) and 3.5 % (k = 200).
+        const Color rim = rim_mean(*integrator, 16, 125);
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(rim[c], 1.0f, 0.05f) << "ior " << ior << " rim, channel " << c;
     }
 }
 

@@ -90,7 +90,7 @@ TEST(JobPresets, FinalIsTheDefaultPresetWithItsValues) {
     EXPECT_EQ(job.photons.k_global, 50u);
     EXPECT_EQ(job.photons.k_caustic, 100u);
     EXPECT_EQ(job.photons.volume, 400000u);
-    EXPECT_EQ(job.photons.k_volume, 200u);
+    EXPECT_EQ(job.photons.k_volume, 100u);
     EXPECT_EQ(job.photons.seed, 1u);
     EXPECT_EQ(job.gather.rays, 256u);
     EXPECT_TRUE(job.irradiance_cache.enabled);
@@ -1098,7 +1098,7 @@ TEST(JobAtmosphere, EveryIntegratorRendersIt) {
     ASSERT_TRUE(final_job.atmosphere);
     EXPECT_EQ(final_job.atmosphere->sigma_s, (std::array<double, 3>{0.1, 0.1, 0.1}));
     EXPECT_EQ(final_job.photons.volume, 400000u);
-    EXPECT_EQ(final_job.photons.k_volume, 200u);
+    EXPECT_EQ(final_job.photons.k_volume, 100u);
     json preview = with_atmosphere({{"sigma_s", 0.1}}, "");
     preview["preset"] = "preview";
     EXPECT_TRUE(accepts(preview));
