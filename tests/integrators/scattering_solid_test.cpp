@@ -116,7 +116,7 @@ Color disc_mean(const Integrator& integrator, const Vec3& direction, int samples
 /// The mean radiance of rays along -z that graze the sphere's rim at 0.46 of its 0.5 radius, where
 /// most of an estimate's sphere lies outside the solid: `rays` of them around the rim, `samples`
 /// each. The rays' estimates draw on different photons, so their mean keeps what is systematic;
-/// one ray's mean is as far off as its few photon neighbourhoods happen to be (up to 11 % at
+/// one ray's mean is as far off as its few photon neighbourhoods happen to be (up to 10.4 % at
 /// k = 200 for some photon seeds).
 Color rim_mean(const Integrator& integrator, int rays, int samples) {
     DVec3 sum(0.0);
