@@ -16,15 +16,18 @@ int run_compare_command(std::span<const std::string> args) {
     constexpr const char* kUsage =
         "usage: photond compare IMAGE.exr REFERENCE.exr [--region x0,y0,x1,y1] [--epsilon E] "
         "[--block N]\n"
-        "                       [--error-png F] [--json]\n"
+        "                       [--worst N] [--error-png F] [--json]\n"
         "prints relMSE, RMSE, the 99th percentile of per-pixel absolute error, and the mean bias;\n"
         "--block N compares N x N block averages (the region still in pixels, rounded out to blocks);\n"
+        "--worst N lists the N pixels (blocks) of largest relative squared error, each with its\n"
+        "share of the relMSE, its value and the reference's (blocks by their top-left pixel);\n"
         "--error-png F writes the per-pixel relative squared error as a PNG (white = 1 or more);\n"
         "--json prints the figures as one JSON object (bias as a fraction, not in percent)\n";
     std::vector<std::string> files;
     std::optional<PixelRect> region;
     double epsilon = 0.01;
     int block = 1;
+    size_t worst = 0;
     std::string error_png;
     bool json = false;
     for (size_t i = 0; i < args.size(); ++i) {
@@ -41,6 +44,14 @@ int run_compare_command(std::span<const std::string> args) {
             error_png = args[++i];
         } else if (args[i] == "--block" && i + 1 < args.size()) {
             block = std::max(1, std::atoi(args[++i].c_str()));
+        } else if (args[i] == "--worst" && i + 1 < args.size()) {
+            const int n = std::atoi(args[++i].c_str());
+            if (n < 1 || n > 10000) {
+                std::fprintf(stderr, "photond compare: --worst expects a count from 1 to 10000, not '%s'\n",
+                             args[i].c_str());
+                return 2;
+            }
+            worst = static_cast<size_t>(n);
         } else if (args[i] == "--json") {
             json = true;
         } else if (args[i] == "-h" || args[i] == "--help") {
@@ -79,8 +90,8 @@ int run_compare_command(std::span<const std::string> args) {
         region = PixelRect{region->x0 / block, region->y0 / block, (region->x1 + block - 1) / block,
                            (region->y1 + block - 1) / block};
     auto e = block > 1 ? compare_images(downsample(image->beauty, block),
-                                        downsample(reference->beauty, block), region, epsilon)
-                       : compare_images(image->beauty, reference->beauty, region, epsilon);
+                                        downsample(reference->beauty, block), region, epsilon, worst)
+                       : compare_images(image->beauty, reference->beauty, region, epsilon, worst);
     if (!e) {
         std::fprintf(stderr, "photond compare: %s\n", e.error().message.c_str());
         return 1;
@@ -93,19 +104,35 @@ int run_compare_command(std::span<const std::string> args) {
             std::snprintf(text, sizeof text, "%.9g", v);
             return std::string(text);
         };
+        std::string listing;
+        for (const PixelError& p : e->worst) {
+            const auto color = [&](const Color& c) {
+                std::string text = "[";
+                for (int k = 0; k < 3; ++k) text += (k ? ", " : "") + number(c[k]);
+                return text + "]";
+            };
+            listing += std::string(listing.empty() ? "" : ", ") + "{\"x\": " + std::to_string(p.x * block) +
+                       ", \"y\": " + std::to_string(p.y * block) + ", \"relmse\": " + number(p.relative_squared_error) +
+                       ", \"share\": " + number(p.share) + ", \"value\": " + color(p.value) +
+                       ", \"reference\": " + color(p.reference) + "}";
+        }
         std::printf(
             "{\"relmse\": %s, \"rmse\": %s, \"p99\": %s, \"mean\": %s, \"reference_mean\": %s, "
-            "\"bias\": %s, \"pixels\": %zu, \"epsilon\": %s, \"block\": %d}\n",
+            "\"bias\": %s, \"pixels\": %zu, \"epsilon\": %s, \"block\": %d%s}\n",
             number(e->relative_mse).c_str(), number(e->rmse).c_str(),
             number(e->p99_abs_error).c_str(), number(e->mean).c_str(),
             number(e->reference_mean).c_str(), number(e->mean_bias).c_str(), e->pixels,
-            number(epsilon).c_str(), block);
+            number(epsilon).c_str(), block, worst > 0 ? (", \"worst\": [" + listing + "]").c_str() : "");
         return 0;
     }
     std::printf(
         "relmse %.6g rmse %.6g p99 %.6g mean %.6g reference_mean %.6g bias %+.4f%% pixels %zu\n",
         e->relative_mse, e->rmse, e->p99_abs_error, e->mean, e->reference_mean,
         100.0 * e->mean_bias, e->pixels);
+    for (const PixelError& p : e->worst)
+        std::printf("worst %s (%d, %d): relmse %.6g, %.1f%% of the relMSE, value (%.6g, %.6g, %.6g) reference (%.6g, %.6g, %.6g)\n",
+                    block > 1 ? "block at" : "pixel", p.x * block, p.y * block, p.relative_squared_error, 100.0 * p.share,
+                    p.value[0], p.value[1], p.value[2], p.reference[0], p.reference[1], p.reference[2]);
     return 0;
 }
 

@@ -28,7 +28,7 @@ Image downsample(const Image& image, int factor) {
 }
 
 Expected<ImageError> compare_images(const Image& image, const Image& reference,
-                                    std::optional<PixelRect> region, double epsilon) {
+                                    std::optional<PixelRect> region, double epsilon, size_t worst_count) {
     if (image.width() != reference.width() || image.height() != reference.height()) {
         return Error{"compare: image is " + std::to_string(image.width()) + "x" + std::to_string(image.height()) +
                      " but the reference is " + std::to_string(reference.width()) + "x" +
@@ -40,20 +40,37 @@ Expected<ImageError> compare_images(const Image& image, const Image& reference,
     double sum_rel = 0.0, sum_sq = 0.0, sum = 0.0, sum_ref = 0.0;
     std::vector<double> abs_errors;
     abs_errors.reserve(static_cast<size_t>(area.area()));
+    std::vector<PixelError> pixel_errors;
+    if (worst_count > 0) pixel_errors.reserve(static_cast<size_t>(area.area()));
     for (int y = area.y0; y < area.y1; ++y) {
         for (int x = area.x0; x < area.x1; ++x) {
             const Color a = image.at(x, y), r = reference.at(x, y);
-            double pixel_abs = 0.0;
+            double pixel_abs = 0.0, pixel_rel = 0.0;
             for (int c = 0; c < 3; ++c) {
                 const double d = static_cast<double>(a[c]) - static_cast<double>(r[c]);
-                sum_rel += d * d / (static_cast<double>(r[c]) * r[c] + epsilon);
+                pixel_rel += d * d / (static_cast<double>(r[c]) * r[c] + epsilon);
                 sum_sq += d * d;
                 pixel_abs += std::abs(d) / 3.0;
                 sum += a[c];
                 sum_ref += r[c];
             }
             abs_errors.push_back(pixel_abs);
+            sum_rel += pixel_rel;
+            if (worst_count > 0) pixel_errors.push_back({x, y, pixel_rel / 3.0, 0.0, a, r});
         }
+    }
+    if (worst_count > 0) {
+        const size_t count = std::min(worst_count, pixel_errors.size());
+        // Largest first, ties by row and column: the listing is the same on every run.
+        std::partial_sort(pixel_errors.begin(), pixel_errors.begin() + static_cast<ptrdiff_t>(count),
+                          pixel_errors.end(), [](const PixelError& a, const PixelError& b) {
+                              if (a.relative_squared_error != b.relative_squared_error)
+                                  return a.relative_squared_error > b.relative_squared_error;
+                              return a.y != b.y ? a.y < b.y : a.x < b.x;
+                          });
+        pixel_errors.resize(count);
+        for (PixelError& p : pixel_errors) p.share = sum_rel > 0.0 ? 3.0 * p.relative_squared_error / sum_rel : 0.0;
+        e.worst = std::move(pixel_errors);
     }
     const double n = static_cast<double>(area.area());
     e.pixels = static_cast<size_t>(area.area());

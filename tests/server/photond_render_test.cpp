@@ -624,3 +624,39 @@ TEST_F(PhotondRender, FoggyBoxWithAVolumePhotonMapAgreesWithPath) {
     }
     EXPECT_FALSE(first.empty());
 }
+
+TEST_F(PhotondRender, CompareListsTheWorstPixelsAndBlocks) {
+    // Two real EXR files, 16 x 8 of 0.5, the image with one bright pixel at (13, 5) and a dimmer
+    // one at (2, 1): `--worst` names them in order, with their share of the relMSE.
+    photond::ImageLayers reference{photond::Image(16, 8, photond::Color(0.5f)), {}};
+    photond::ImageLayers image = reference;
+    image.beauty.at(13, 5) = photond::Color(2.5f);
+    image.beauty.at(2, 1) = photond::Color(1.5f);
+    ASSERT_TRUE(photond::write_exr(dir_ / "ref.exr", reference, {photond::ExrPixelType::Float, 32}).is_ok());
+    ASSERT_TRUE(photond::write_exr(dir_ / "img.exr", image, {photond::ExrPixelType::Float, 32}).is_ok());
+    const std::string files = (dir_ / "img.exr").string() + " " + (dir_ / "ref.exr").string();
+
+    const auto pixels = run("compare --json --worst 2 " + files);
+    ASSERT_EQ(pixels.exit_code, 0) << pixels.output;
+    const auto p = json::parse(pixels.output);
+    ASSERT_EQ(p.at("worst").size(), 2u) << pixels.output;
+    EXPECT_EQ(p["worst"][0].at("x"), 13);
+    EXPECT_EQ(p["worst"][0].at("y"), 5);
+    EXPECT_NEAR(p["worst"][0].at("value")[0].get<double>(), 2.5, 1e-9);
+    EXPECT_NEAR(p["worst"][0].at("reference")[0].get<double>(), 0.5, 1e-9);
+    // (2^2) / (0.25 + 0.01) against (1^2) / 0.26: 4 of 5 of the sum.
+    EXPECT_NEAR(p["worst"][0].at("share").get<double>(), 0.8, 1e-6);
+    EXPECT_EQ(p["worst"][1].at("x"), 2);
+    EXPECT_EQ(p["worst"][1].at("y"), 1);
+    EXPECT_NEAR(p["worst"][1].at("share").get<double>(), 0.2, 1e-6);
+
+    // In 4 x 4 blocks the bright pixel's block is named by its top-left pixel.
+    const auto blocks = run("compare --worst 1 --block 4 " + files);
+    ASSERT_EQ(blocks.exit_code, 0) << blocks.output;
+    EXPECT_NE(blocks.output.find("worst block at (12, 4): relmse"), std::string::npos) << blocks.output;
+    // Without --worst the JSON has no listing; a count that is no count is refused by name.
+    EXPECT_FALSE(json::parse(run("compare --json " + files).output).contains("worst"));
+    const auto bad = run("compare --worst none " + files);
+    EXPECT_EQ(bad.exit_code, 2);
+    EXPECT_NE(bad.output.find("--worst expects a count"), std::string::npos) << bad.output;
+}
