@@ -104,13 +104,13 @@ int run_compare_command(std::span<const std::string> args) {
             std::snprintf(text, sizeof text, "%.9g", v);
             return std::string(text);
         };
+        const auto color = [&](const Color& c) {
+            std::string text = "[";
+            for (int k = 0; k < 3; ++k) text += (k ? ", " : "") + number(c[k]);
+            return text + "]";
+        };
         std::string listing;
         for (const PixelError& p : e->worst) {
-            const auto color = [&](const Color& c) {
-                std::string text = "[";
-                for (int k = 0; k < 3; ++k) text += (k ? ", " : "") + number(c[k]);
-                return text + "]";
-            };
             listing += std::string(listing.empty() ? "" : ", ") + "{\"x\": " + std::to_string(p.x * block) +
                        ", \"y\": " + std::to_string(p.y * block) + ", \"relmse\": " + number(p.relative_squared_error) +
                        ", \"share\": " + number(p.share) + ", \"value\": " + color(p.value) +
