@@ -75,12 +75,9 @@ int run_compare_command(std::span<const std::string> args) {
     if (!error_png.empty() && image->beauty.width() == reference->beauty.width() &&
         image->beauty.height() == reference->beauty.height()) {
         Image error(image->beauty.width(), image->beauty.height());
-        for (size_t p = 0; p < error.pixel_count(); ++p) {
-            const Color d = image->beauty.pixels()[p] - reference->beauty.pixels()[p];
-            const Color r = reference->beauty.pixels()[p];
-            error.pixels()[p] =
-                Color(average(d * d / (r * r + Color(static_cast<float>(epsilon)))));
-        }
+        for (size_t p = 0; p < error.pixel_count(); ++p)
+            error.pixels()[p] = Color(static_cast<float>(
+                relative_squared_error(image->beauty.pixels()[p], reference->beauty.pixels()[p], epsilon)));
         if (Status st = write_png_preview(error_png, error); !st) {
             std::fprintf(stderr, "photond compare: %s\n", st.error().message.c_str());
             return 1;

@@ -27,6 +27,15 @@ Image downsample(const Image& image, int factor) {
     return out;
 }
 
+double relative_squared_error(const Color& value, const Color& reference, double epsilon) {
+    double sum = 0.0;
+    for (int c = 0; c < 3; ++c) {
+        const double d = static_cast<double>(value[c]) - static_cast<double>(reference[c]);
+        sum += d * d / (static_cast<double>(reference[c]) * reference[c] + epsilon);
+    }
+    return sum / 3.0;
+}
+
 Expected<ImageError> compare_images(const Image& image, const Image& reference,
                                     std::optional<PixelRect> region, double epsilon, size_t worst_count) {
     if (image.width() != reference.width() || image.height() != reference.height()) {
@@ -45,10 +54,10 @@ Expected<ImageError> compare_images(const Image& image, const Image& reference,
     for (int y = area.y0; y < area.y1; ++y) {
         for (int x = area.x0; x < area.x1; ++x) {
             const Color a = image.at(x, y), r = reference.at(x, y);
-            double pixel_abs = 0.0, pixel_rel = 0.0;
+            const double pixel_rel = relative_squared_error(a, r, epsilon);
+            double pixel_abs = 0.0;
             for (int c = 0; c < 3; ++c) {
                 const double d = static_cast<double>(a[c]) - static_cast<double>(r[c]);
-                pixel_rel += d * d / (static_cast<double>(r[c]) * r[c] + epsilon);
                 sum_sq += d * d;
                 pixel_abs += std::abs(d) / 3.0;
                 sum += a[c];
@@ -56,7 +65,7 @@ Expected<ImageError> compare_images(const Image& image, const Image& reference,
             }
             abs_errors.push_back(pixel_abs);
             sum_rel += pixel_rel;
-            if (worst_count > 0) pixel_errors.push_back({x, y, pixel_rel / 3.0, 0.0, a, r});
+            if (worst_count > 0) pixel_errors.push_back({x, y, pixel_rel, 0.0, a, r});
         }
     }
     if (worst_count > 0) {
@@ -69,12 +78,12 @@ Expected<ImageError> compare_images(const Image& image, const Image& reference,
                               return a.y != b.y ? a.y < b.y : a.x < b.x;
                           });
         pixel_errors.resize(count);
-        for (PixelError& p : pixel_errors) p.share = sum_rel > 0.0 ? 3.0 * p.relative_squared_error / sum_rel : 0.0;
+        for (PixelError& p : pixel_errors) p.share = sum_rel > 0.0 ? p.relative_squared_error / sum_rel : 0.0;
         e.worst = std::move(pixel_errors);
     }
     const double n = static_cast<double>(area.area());
     e.pixels = static_cast<size_t>(area.area());
-    e.relative_mse = sum_rel / (3.0 * n);
+    e.relative_mse = sum_rel / n;
     e.rmse = std::sqrt(sum_sq / (3.0 * n));
     const size_t p99 = std::min(abs_errors.size() - 1, static_cast<size_t>(0.99 * static_cast<double>(abs_errors.size())));
     std::nth_element(abs_errors.begin(), abs_errors.begin() + static_cast<ptrdiff_t>(p99), abs_errors.end());

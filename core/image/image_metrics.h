@@ -12,7 +12,7 @@ namespace photond {
 /// One pixel's share of an ImageError: where an error comes from.
 struct PixelError {
     int x = 0, y = 0;
-    double relative_squared_error = 0.0;  // mean over channels of (x - r)^2 / (r^2 + epsilon)
+    double relative_squared_error = 0.0;  // relative_squared_error(value, reference, epsilon)
     double share = 0.0;                    // of the compared area's relMSE sum (0 to 1)
     Color value{0.0f}, reference{0.0f};
 };
@@ -29,6 +29,10 @@ struct ImageError {
     /// as many as compare_images was asked for.
     std::vector<PixelError> worst;
 };
+
+/// A pixel's relative squared error against its reference, the mean over channels of
+/// (x - r)^2 / (r^2 + epsilon): what relMSE averages over pixels.
+double relative_squared_error(const Color& value, const Color& reference, double epsilon);
 
 /// The image averaged over factor x factor blocks (a box filter), for comparisons where pixel
 /// noise of the reference must not dominate. Edge blocks average what they hold.
