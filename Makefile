@@ -56,7 +56,7 @@ tsan: deps
 # (run by CI). Embree and oneTBB are not instrumented, so leak checking is off. Every test runs;
 # a sanitizer report stops the run at once (exit code 86), other failures are listed at the end.
 ASAN_TESTS := degenerate_geometry_test degenerate_light_test scale_invariance_test fireflies_test \
-	scene_transform_test builtin_scenes_test gltf_loader_test emission_test analytic_lighting_test \
+	scene_transform_test builtin_scenes_test gltf_loader_test emission_test emission_focus_test analytic_lighting_test \
 	tile_renderer_test photon_test kd_tree_test photon_map_test photon_map_io_test photon_tracer_test \
 	final_gather_test exr_io_test png_preview_test environment_light_test material_textures_test alpha_test \
 	clearcoat_test gltf_loader_fuzz_test exr_assemble_test irradiance_cache_io_test caustic_skip_test \

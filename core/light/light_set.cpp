@@ -412,7 +412,7 @@ Vec3 LightSet::parallel_origin(const Vec3& direction, Vec2 u, const EmissionFocu
 }
 
 std::optional<EmissionSample> LightSet::sample_emission(float u_select, Vec2 u_position, Vec2 u_direction,
-                                                        const EmissionFocus* focus) const {
+                                                        const EmissionFocus* focus, float u_focus) const {
     if (empty()) return std::nullopt;
     float choice_pdf = 0.0f;
     const uint32_t index = selection_.sample(u_select, &choice_pdf);
@@ -420,21 +420,45 @@ std::optional<EmissionSample> LightSet::sample_emission(float u_select, Vec2 u_p
     const Entry& e = lights_[index];
     EmissionSample s;
     s.light = index;
+    // Photons from a position aimed at the focus spheres (core/light/emission_focus.h): the
+    // direction, and its density; `plain` when aiming would not pay.
+    const bool aimed = focus && !focus->spheres.empty();
+    FocusedDirection towards;
+    const auto aim = [&](const EmitterView& emitter) {
+        towards = sample_focused_direction(*focus, emitter, u_focus, u_direction);
+        if (towards.outcome == FocusOutcome::aimed) s.direction = towards.direction;
+        return towards.outcome;
+    };
     switch (e.kind) {
         case LightKind::Point: {
             const PunctualLight& l = scene_->lights[e.index];
             s.origin = l.position;
+            const FocusOutcome outcome = aimed ? aim({.origin = s.origin}) : FocusOutcome::plain;
+            if (outcome == FocusOutcome::nothing) return s;  // a photon of no flux
+            if (outcome == FocusOutcome::aimed) {
+                s.flux_weight = e.emission_weight * (kInv4Pi / towards.pdf);
+                break;
+            }
             s.direction = sample_uniform_sphere(u_direction);
             s.flux_weight = e.emission_weight;
             break;
         }
         case LightKind::Spot: {
             const PunctualLight& l = scene_->lights[e.index];
+            s.origin = l.position;
             const float cos_max = std::min(l.cos_outer, l.cos_inner);
+            const FocusOutcome outcome =
+                aimed ? aim({.origin = s.origin, .cone_axis = l.direction, .cone_cos = cos_max,
+                             .measure = 1.0f / uniform_cone_pdf(cos_max)})
+                      : FocusOutcome::plain;
+            if (outcome == FocusOutcome::nothing) return s;
+            if (outcome == FocusOutcome::aimed) {
+                s.flux_weight = l.intensity * spot_falloff(l, glm::dot(s.direction, l.direction)) / (towards.pdf * choice_pdf);
+                break;
+            }
             const Vec3 local = sample_uniform_cone(u_direction, cos_max);
             // The falloff from the sample's 1 - cos, exact where local.z has rounded to 1.
             const float one_minus_cos = u_direction.x * (1.0f - cos_max);
-            s.origin = l.position;
             s.direction = Frame(l.direction).to_world(local);
             s.flux_weight = l.intensity * spot_falloff_from_axis(l, one_minus_cos) /
                             (uniform_cone_pdf(cos_max) * choice_pdf);
@@ -467,18 +491,33 @@ std::optional<EmissionSample> LightSet::sample_emission(float u_select, Vec2 u_p
             const Vec2 b = sample_uniform_triangle(u_position);
             s.origin = e.point_at(b);
             const Frame* face = &e.front_frame;
-            Vec2 ud = u_direction;
-            if (e.double_sided) {  // pick a face, reusing the random number
-                if (ud.x < 0.5f) {
-                    ud.x *= 2.0f;
-                } else {
-                    ud.x = std::min((ud.x - 0.5f) * 2.0f, 0x1.fffffep-1f);
-                    face = &e.back_frame;
+            float density_ratio = 1.0f;  // the cosine distribution's density over the one sampled
+            const FocusOutcome outcome =
+                aimed ? aim({.origin = s.origin,
+                             .normal = e.double_sided ? Vec3(0.0f) : e.front_frame.n,
+                             .measure = e.double_sided ? 4.0f * kPi : kPi})
+                      : FocusOutcome::plain;
+            if (outcome == FocusOutcome::nothing) return s;
+            if (outcome == FocusOutcome::aimed) {
+                const float cos_front = glm::dot(s.direction, e.front_frame.n);
+                if (!e.double_sided && !(cos_front > 0.0f)) return s;
+                if (cos_front < 0.0f) face = &e.back_frame;
+                // Two faces each take half the photons.
+                density_ratio = std::abs(cos_front) * (e.double_sided ? 0.5f : 1.0f) * kInvPi / towards.pdf;
+            } else {
+                Vec2 ud = u_direction;
+                if (e.double_sided) {  // pick a face, reusing the random number
+                    if (ud.x < 0.5f) {
+                        ud.x *= 2.0f;
+                    } else {
+                        ud.x = std::min((ud.x - 0.5f) * 2.0f, 0x1.fffffep-1f);
+                        face = &e.back_frame;
+                    }
                 }
+                s.direction = face->to_world(sample_cosine_hemisphere(ud));
             }
             s.normal = face->n;
-            s.direction = face->to_world(sample_cosine_hemisphere(ud));
-            s.flux_weight = e.textured ? e.emission_weight * emissive_texel(e, b) : e.emission_weight;
+            s.flux_weight = (e.textured ? e.emission_weight * emissive_texel(e, b) : e.emission_weight) * density_ratio;
             const Material& m = scene_->materials[scene_->triangle_materials[e.index]];
             if (m.alpha_tested()) s.flux_weight *= emitter_coverage(m, *scene_, e.index, b);
             break;

@@ -7,6 +7,7 @@
 #include <optional>
 #include <vector>
 
+#include "core/light/emission_focus.h"
 #include "core/light/environment_light.h"
 #include "core/light/light_tree.h"
 #include "core/math/frame.h"
@@ -44,14 +45,6 @@ struct EmissionSample {
     Vec3 normal{0.0f};     // emitter normal at the origin (zero for point lights)
     Color flux_weight{0.0f};
     uint32_t light = 0;    // index into LightSet
-};
-
-/// A sphere that parallel photons (directional lights, soft suns, the environment) are aimed
-/// at instead of the whole scene: photons meant for the caustic map alone need only reach the
-/// specular surfaces (a projection map for distant lights, Jensen 2001, section 5.3).
-struct EmissionFocus {
-    Vec3 center{0.0f};
-    float radius = 0.0f;
 };
 
 class LightSet {
@@ -102,11 +95,14 @@ public:
     /// triangles (uniform by area, cosine-weighted direction), the environment (directions by
     /// its importance distribution, parallel from a disc of the scene's bounding sphere).
     /// The random numbers by value: references would keep a caller's in memory.
-    /// With `focus`, parallel photons start on a disc of the focus sphere's radius around its
-    /// centre (still outside the scene's bounding sphere) and their flux is scaled by the
-    /// smaller disc's area: unbiased for every path whose first hit lies in that sphere.
+    /// With `focus` (core/light/emission_focus.h), parallel photons start on a disc of the focus
+    /// sphere's radius around its centre (still outside the scene's bounding sphere) and their
+    /// flux is scaled by the smaller disc's area; photons from a position take a direction towards
+    /// the focus spheres (sample_focused_direction, choosing a sphere by `u_focus`) and carry the
+    /// light's density of it over the one it was drawn with. Unbiased for every path whose first
+    /// hit lies in a focus sphere.
     std::optional<EmissionSample> sample_emission(float u_select, Vec2 u_position, Vec2 u_direction,
-                                                  const EmissionFocus* focus = nullptr) const;
+                                                  const EmissionFocus* focus = nullptr, float u_focus = 0.0f) const;
 
     /// Spot light angular falloff of KHR_lights_punctual (quadratic in the cosine).
     static float spot_falloff(const PunctualLight& light, float cos_angle);

@@ -7,6 +7,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <limits>
 #include <utility>
@@ -63,6 +64,7 @@ struct MapBuilder {
     bool active = false;      // still collecting
     bool complete = true;
     uint64_t emitted = 0;     // photons emitted for this map (set when it fills or stops)
+    uint64_t first = 0;       // the emission its photons count from (restart)
     size_t count = 0;         // photons collected so far
     double flux_sum = 0.0;    // their flux's luminance, not yet divided by the emissions
     /// The collected photons in emission order, flux not yet divided (TracedPhoton), in one
@@ -79,7 +81,7 @@ struct MapBuilder {
             TracedPhotons& traced = chunks[c].*member;
             if (count + traced.size() >= target) {
                 traced.resize(target - count);
-                if (!traced.empty()) emitted = batch_start + traced.back().path + 1;
+                if (!traced.empty()) emitted = batch_start + traced.back().path + 1 - first;
                 active = false;
             }
             count += traced.size();
@@ -96,6 +98,16 @@ struct MapBuilder {
             }
         });
         for (const double sum : sums) flux_sum += sum;  // in chunk order: the same on every run
+    }
+
+    /// Photons emitted for this map when `total` have been emitted in all.
+    uint64_t emitted_of(uint64_t total) const { return total - first; }
+    /// Drops the photons collected so far: the map counts from emission `at` on.
+    void restart(uint64_t at) {
+        count = 0;
+        flux_sum = 0.0;
+        photons.clear();
+        first = at;
     }
 
     /// Calls f(photon) for every stride-th photon in emission order (the 0th, the stride-th, ...).
@@ -121,9 +133,11 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
     // Whole paths: for the global or the volume map; else only caustic paths are wanted.
     const bool whole_paths = want_global || want_volume;
     const LightSet& lights = !whole_paths && sky_gathered ? *rs.lights_with_sky_peaks : *rs.lights;
-    // Photons for the caustic map alone are aimed at its casters when they come from far away.
+    // Photons for the caustic map alone are aimed at its casters (core/light/emission_focus.h).
     const EmissionFocus* focus = !whole_paths && rs.caustic_casters ? &rs.caustic_focus : nullptr;
-    const std::optional<EmissionSample> emission = lights.sample_emission(u_select, u_position, u_direction, focus);
+    // Their choice of a focus sphere draws one more number: whole paths keep their streams.
+    const float u_focus = focus ? rng.next_float() : 0.0f;
+    const std::optional<EmissionSample> emission = lights.sample_emission(u_select, u_position, u_direction, focus, u_focus);
     if (!emission || is_black(emission->flux_weight)) return;
     if (want_caustic && whole_paths && sky_gathered && lights.kind(emission->light) == LightKind::Environment) {
         const EnvironmentLight* peaks = rs.lights_with_sky_peaks->environment();
@@ -420,18 +434,34 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
     bool cancelled = false;
     const RngStreamFamily streams(settings.seed, kPhotonStreamTag);
     std::vector<ChunkOutput> chunks;
+    // The photons emitted, and each map's count, when the maps being collected last changed: a
+    // photon for the caustic map alone is aimed at its casters (core/light/emission_focus.h) and
+    // stores at another rate than one traced along its whole path.
+    uint64_t regime_emitted = 0;
+    std::array<size_t, 3> regime_counts{};
+    std::array<bool, 3> regime_wants{};
     while ((global.active || caustic.active || volume.active) && !cancelled) {
-        // Size the next batch from the store rate so far (deterministic: it depends only on the
-        // maps' contents), within [16K, 1M] photons: enough for the map that fills first, so
+        const std::array<bool, 3> wants{global.active, caustic.active, volume.active};
+        if (wants != regime_wants) {
+            regime_wants = wants;
+            regime_emitted = emitted;
+            regime_counts = {global.count, caustic.count, volume.count};
+        }
+        // Size the next batch from the store rate since then (deterministic: it depends only on
+        // the maps' contents), within [16K, 1M] photons: enough for the map that fills first, so
         // that photons past its fill point are not traced for it (the caustic map usually needs
         // ten times the emissions; after the global map fills, its photons trace cheaply), and
-        // storing at most 1 / kBatchesPerMap of any map.
+        // storing at most 1 / kBatchesPerMap of any map. The first batch of each regime is the
+        // smallest, to measure its rate.
         uint64_t batch = 16384;
-        if (emitted > 0) {
+        if (emitted > regime_emitted) {
             double needed_first = 1048576.0, largest = 1048576.0;
-            for (const MapBuilder* m : {&global, &caustic, &volume}) {
-                if (!m->active || m->count == 0) continue;
-                const double rate = static_cast<double>(m->count) / static_cast<double>(emitted);
+            const std::array<const MapBuilder*, 3> builders{&global, &caustic, &volume};
+            for (size_t i = 0; i < builders.size(); ++i) {
+                const MapBuilder* m = builders[i];
+                const size_t stored = m->count - regime_counts[i];
+                if (!m->active || stored == 0) continue;
+                const double rate = static_cast<double>(stored) / static_cast<double>(emitted - regime_emitted);
                 needed_first = std::min(needed_first, 1.1 * static_cast<double>(m->target - m->count) / rate);
                 largest = std::min(largest, static_cast<double>(m->target) / kBatchesPerMap / rate);
             }
@@ -485,23 +515,31 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
         // A caustic map that carries next to no light is not worth its emissions: stop it.
         if (caustic.active && global.target > 0 && !global.active && global.emitted > 0 && global.flux_sum > 0.0 &&
             caustic.count >= kCausticShareMinPhotons) {
-            const double share = (caustic.flux_sum / static_cast<double>(emitted)) /
+            const double share = (caustic.flux_sum / static_cast<double>(caustic.emitted_of(emitted))) /
                                  (global.flux_sum / static_cast<double>(global.emitted));
             if (share < kNegligibleCausticShare) {
                 caustic.active = false;
                 caustic.complete = false;
-                caustic.emitted = emitted;
+                caustic.emitted = caustic.emitted_of(emitted);
             }
         }
         for (MapBuilder* m : {&global, &caustic, &volume}) {
             // A map that nothing reached after a fair trial will not fill: stop early.
-            const bool hopeless = m->count == 0 && emitted >= std::max<uint64_t>(kEmptyMapTrial, m->target);
-            if (m->active && (emitted >= m->cap || hopeless)) {  // keep what arrived, say so
+            const uint64_t for_map = m->emitted_of(emitted);
+            const bool hopeless = m->count == 0 && for_map >= std::max<uint64_t>(kEmptyMapTrial, m->target);
+            if (m->active && (for_map >= m->cap || hopeless)) {  // keep what arrived, say so
                 m->active = false;
                 m->complete = false;
-                m->emitted = emitted;
+                m->emitted = for_map;
             }
         }
+        // Only the caustic map left, and its photons aimed at the casters from now on: the few
+        // caustic photons whole paths stored each carry a whole share of a light's flux, next to
+        // the many aimed ones that carry a cone's; kept together, those few would stand out as
+        // blotches in its estimates. The map starts again with aimed photons alone.
+        if (caustic.active && caustic.first == 0 && rs.caustic_casters && !global.active && !volume.active &&
+            (global.target > 0 || volume.target > 0))
+            caustic.restart(emitted);
         // The global map full and the caustic map still collecting: build the global one now,
         // and test whether the caustic light would show once the caustic map holds enough
         // photons for estimates of its final radii (photon_tracer.h).
@@ -513,7 +551,7 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
             const uint32_t k = static_cast<uint32_t>(std::clamp<uint64_t>(
                 (uint64_t(kCausticTestPhotons) * caustic.count + caustic.target / 2) / caustic.target,
                 kCausticTestMinPhotons, kCausticTestPhotons));
-            const PhotonMap partial = partial_map(caustic, emitted);
+            const PhotonMap partial = partial_map(caustic, caustic.emitted_of(emitted));
             arena.execute([&] {
                 stats.caustic_peak_ratio =
                     caustic_peak_ratio(partial, *maps.global, caustic_test_sites(caustic), k, settings, scene_radius);
@@ -521,7 +559,7 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
             if (caustic_test_drops(stats)) {
                 caustic.active = false;
                 caustic.complete = false;
-                caustic.emitted = emitted;
+                caustic.emitted = caustic.emitted_of(emitted);
             }
         }
     }

@@ -10,8 +10,10 @@
 // depend on the thread count.
 //
 // Work skipped: batches are sized for the map that fills first, and once only the caustic map
-// is collecting, a photon first casts one ray against the scene's specular triangles
-// (RenderScene::caustic_casters) and ends if it misses them all: it could store nothing. A
+// is collecting, photons are aimed at the scene's specular triangles (RenderScene::
+// caustic_casters; core/light/emission_focus.h) and the map starts again with these alone (the
+// few caustic photons of whole paths would carry far more flux each); each first casts one ray
+// against those triangles and ends if it misses them all: it could store nothing. A
 // caustic map whose photons carry a negligible share of the light that reaches the surfaces
 // (kNegligibleCausticShare of the global map's, measured on the photons stored so far) stops
 // early with what it has: its flux is divided by the photons emitted so far, so it stays

@@ -44,13 +44,7 @@ Expected<std::shared_ptr<const RenderScene>> RenderScene::create(std::shared_ptr
         auto casters = RayTracer::build(device, *scene, &specular);
         if (!casters) return casters.error();
         render_scene->caustic_casters = std::move(casters).value();
-        Bounds3 bounds;
-        for (uint32_t t : specular) {
-            for (uint32_t v : {scene->triangles[t].x, scene->triangles[t].y, scene->triangles[t].z})
-                bounds.extend(scene->positions[v]);
-        }
-        // A little larger than the bounds, so that rounding cannot shave photons off the edges.
-        render_scene->caustic_focus = {bounds.center(), 1.001f * bounds.radius() + 1e-6f * scene->bounds.radius()};
+        render_scene->caustic_focus = focus_on_triangles(*scene, specular);
     }
     return std::shared_ptr<const RenderScene>(std::move(render_scene));
 }

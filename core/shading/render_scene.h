@@ -35,8 +35,8 @@ struct RenderScene {
     /// sharp glossy ones only; null when there are none. Photons emitted for the caustic map alone that miss
     /// all of them are dropped after this one cheap ray instead of a trace through the scene.
     std::unique_ptr<RayTracer> caustic_casters;
-    /// The bounding sphere of those triangles, which parallel photons for the caustic map alone
-    /// are aimed at (LightSet::sample_emission).
+    /// Spheres around those triangles, which photons for the caustic map alone are aimed at
+    /// (core/light/emission_focus.h).
     EmissionFocus caustic_focus;
 
     /// `selection`: how next-event estimation picks lights (photons always leave by power).

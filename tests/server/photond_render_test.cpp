@@ -497,8 +497,9 @@ TEST_F(PhotondRender, ACausticMapThatWouldNotShowIsDroppedAndThePlanSaysSo) {
 }
 
 TEST_F(PhotondRender, IncompletePhotonMapIsAWarningThatSaysWhatToChange) {
-    // One small mirror catches about 1 in 1,400 photons: 2,000 caustic photons need 2.8 M
-    // emissions, beyond the cap of 1,000 per requested photon.
+    // A mirror sends its light up to a small tile that catches about 1 in 4,700 photons: 2,000
+    // caustic photons would need 9 M emissions, beyond the cap of 1,000 per requested photon
+    // (tests/data/gltf/generate.py).
     const auto r = run("render " + (kGltfData / "sparse_caustics.gltf").string() +
                        " --width 16 --height 16 --spp 1 --set photons.caustic=2000"
                        " --set photons.global=2000 --set gather.rays=16 --stats-json " +
