@@ -29,6 +29,7 @@ constexpr size_t kHintBlock = 256;  // sites whose estimates pass the hint on, o
 // A batch stores at most about this share of a map's photons: the chunks' buffers of traced
 // photons (28 bytes each) then stay a small part of the map's memory (photon_series.py's peak).
 constexpr double kBatchesPerMap = 8.0;
+constexpr double kBatchGrowth = 8.0;  // the most a batch grows over the one before
 
 /// A stored photon before its map is complete: packed as the map stores it, but with its flux
 /// not yet divided by the photons emitted for its map (Photon::scale_flux does that once they
@@ -438,6 +439,7 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
     // photon for the caustic map alone is aimed at its casters (core/light/emission_focus.h) and
     // stores at another rate than one traced along its whole path.
     uint64_t regime_emitted = 0;
+    uint64_t last_batch = 0;
     std::array<size_t, 3> regime_counts{};
     std::array<bool, 3> regime_wants{};
     while ((global.active || caustic.active || volume.active) && !cancelled) {
@@ -465,6 +467,8 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
                 needed_first = std::min(needed_first, 1.1 * static_cast<double>(m->target - m->count) / rate);
                 largest = std::min(largest, static_cast<double>(m->target) / kBatchesPerMap / rate);
             }
+            // A rate measured on a handful of photons may be far off: grow by kBatchGrowth at most.
+            largest = std::min(largest, kBatchGrowth * static_cast<double>(last_batch));
             batch = std::clamp<uint64_t>(static_cast<uint64_t>(needed_first), batch,
                                          std::max<uint64_t>(batch, static_cast<uint64_t>(largest)));
         }
@@ -512,6 +516,7 @@ Expected<PhotonMaps> trace_photons(const RenderScene& rs, const PhotonTracingSet
             volume.append(batch_chunks, &ChunkOutput::volume, emitted);
         });
         emitted += batch;
+        last_batch = batch;
         // A caustic map that carries next to no light is not worth its emissions: stop it.
         if (caustic.active && global.target > 0 && !global.active && global.emitted > 0 && global.flux_sum > 0.0 &&
             caustic.count >= kCausticShareMinPhotons) {
