@@ -787,59 +787,19 @@ def blender_lights():
     write("blender_lights.gltf", b.finish())
 
 
-def sparse_caustics(tile=0.3):
-    """A point light over a wide floor beside a tilted 2 x 2 mirror that sends its light straight
-    up, where a small diffuse tile (`tile` wide, facing down, 5 above the mirror) catches about 1
-    in 4,700 of the light's photons: the caustic map cannot fill within the emission cap (1,000 per
-    requested photon), though its light is worth tracing (over 1e-4 of the global map's). The
-    render must report it as a warning. (The light lies inside the mirror's bounding sphere, so
-    photons for the caustic map leave by the light's own distribution.)"""
+def point_light_over_floor(name, mirror_reflectance, add_primitives):
+    """A point light of 683 cd 1 above a wide grey floor (material 0), a mirror material
+    (material 1) and the primitives `add_primitives(b)` returns, seen by one camera."""
     b = Builder()
     b.doc["extensionsUsed"] = ["KHR_lights_punctual"]
     b.doc["materials"] = [
         {"name": "Floor", "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1],
                                                     "metallicFactor": 0}},
-        {"name": "Mirror", "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1],
+        {"name": "Mirror", "pbrMetallicRoughness": {"baseColorFactor": [mirror_reflectance] * 3 + [1],
                                                      "metallicFactor": 1, "roughnessFactor": 0}}]
     floor = mesh_primitive(b, [[-10, 0, -10], [10, 0, -10], [10, 0, 10], [-10, 0, 10]],
                            [[0, 1, 0]] * 4, [0, 2, 1, 0, 3, 2], 0)
-    # The mirror: 2 x 2, centred 1 beside the light at (1.3, 1, 0), facing (-1, 1, 0) / sqrt(2):
-    # light arriving along +x leaves along +y.
-    c, e = 0.7071, 0.7071
-    mirror = mesh_primitive(b, [[1.3 - e, 1 - e, -1], [1.3 + e, 1 + e, -1], [1.3 + e, 1 + e, 1],
-                                [1.3 - e, 1 - e, 1]], [[-c, c, 0]] * 4, [0, 2, 1, 0, 3, 2], 1)
-    h = tile / 2
-    ceiling = mesh_primitive(b, [[1.3 - h, 6, -h], [1.3 + h, 6, -h], [1.3 + h, 6, h], [1.3 - h, 6, h]],
-                             [[0, -1, 0]] * 4, [0, 1, 2, 0, 2, 3], 0)
-    b.doc["meshes"] = [{"name": "Room", "primitives": [floor, mirror, ceiling]}]
-    b.doc["extensions"] = {"KHR_lights_punctual": {"lights": [
-        {"name": "Bulb", "type": "point", "intensity": 683}]}}
-    b.doc["cameras"] = [{"type": "perspective", "perspective": {"yfov": 1.0, "znear": 0.1}}]
-    b.doc["nodes"] = [{"mesh": 0}, {"translation": [0.3, 1, 0],
-                                    "extensions": {"KHR_lights_punctual": {"light": 0}}},
-                      {"camera": 0, "translation": [0, 1.5, 4]}]
-    b.doc["scenes"] = [{"nodes": [0, 1, 2]}]
-    write("sparse_caustics.gltf", b.finish())
-
-
-def faint_caustics(name="faint_caustics.gltf", half_side=0.5, reflectance=0.001):
-    """A point light over a wide floor and a wide mirror of low reflectance above it: the
-    caustic is a thousandth of the light where it lands, so the caustic map is dropped, which the
-    plan must say."""
-    b = Builder()
-    b.doc["extensionsUsed"] = ["KHR_lights_punctual"]
-    b.doc["materials"] = [
-        {"name": "Floor", "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1],
-                                                    "metallicFactor": 0}},
-        {"name": "Mirror", "pbrMetallicRoughness": {"baseColorFactor": [reflectance] * 3 + [1],
-                                                     "metallicFactor": 1, "roughnessFactor": 0}}]
-    floor = mesh_primitive(b, [[-10, 0, -10], [10, 0, -10], [10, 0, 10], [-10, 0, 10]],
-                           [[0, 1, 0]] * 4, [0, 2, 1, 0, 3, 2], 0)
-    # A square mirror (0.1 x 0.1 by default) 1 above the light, facing down.
-    h = half_side
-    mirror = mesh_primitive(b, [[-h, 2, -h], [h, 2, -h], [h, 2, h], [-h, 2, h]], [[0, -1, 0]] * 4,
-                            [0, 1, 2, 0, 2, 3], 1)
-    b.doc["meshes"] = [{"name": "Room", "primitives": [floor, mirror]}]
+    b.doc["meshes"] = [{"name": "Room", "primitives": [floor] + add_primitives(b)}]
     b.doc["extensions"] = {"KHR_lights_punctual": {"lights": [
         {"name": "Bulb", "type": "point", "intensity": 683}]}}
     b.doc["cameras"] = [{"type": "perspective", "perspective": {"yfov": 1.0, "znear": 0.1}}]
@@ -848,6 +808,38 @@ def faint_caustics(name="faint_caustics.gltf", half_side=0.5, reflectance=0.001)
                       {"camera": 0, "translation": [0, 1.5, 4]}]
     b.doc["scenes"] = [{"nodes": [0, 1, 2]}]
     write(name, b.finish())
+
+
+def sparse_caustics(tile=0.3):
+    """A point light over a wide floor beside a tilted 2 x 2 mirror that sends its light straight
+    up, where a small diffuse tile (`tile` wide, facing down, 5 above the mirror) catches about 1
+    in 4,700 of the light's photons: the caustic map cannot fill within the emission cap (1,000 per
+    requested photon), though its light is worth tracing (over 1e-4 of the global map's). The
+    render must report it as a warning. (The light lies inside the mirror's bounding sphere, so
+    photons for the caustic map leave by the light's own distribution.)"""
+    def mirror_and_tile(b):
+        # The mirror: 2 x 2, centred 1 beside the light at (1.3, 1, 0), facing (-1, 1, 0) / sqrt(2):
+        # light arriving along +x leaves along +y.
+        c, e = 0.7071, 0.7071
+        mirror = mesh_primitive(b, [[1.3 - e, 1 - e, -1], [1.3 + e, 1 + e, -1], [1.3 + e, 1 + e, 1],
+                                    [1.3 - e, 1 - e, 1]], [[-c, c, 0]] * 4, [0, 2, 1, 0, 3, 2], 1)
+        h = tile / 2
+        ceiling = mesh_primitive(b, [[1.3 - h, 6, -h], [1.3 + h, 6, -h], [1.3 + h, 6, h],
+                                     [1.3 - h, 6, h]], [[0, -1, 0]] * 4, [0, 1, 2, 0, 2, 3], 0)
+        return [mirror, ceiling]
+    point_light_over_floor("sparse_caustics.gltf", 1, mirror_and_tile)
+
+
+def faint_caustics(half_side=0.5, reflectance=0.001):
+    """A point light over a wide floor and a wide mirror of low reflectance above it: the
+    caustic is a thousandth of the light where it lands, so the caustic map is dropped, which the
+    plan must say."""
+    def mirror(b):
+        # A square mirror 1 above the light, facing down.
+        h = half_side
+        return [mesh_primitive(b, [[-h, 2, -h], [h, 2, -h], [h, 2, h], [-h, 2, h]], [[0, -1, 0]] * 4,
+                               [0, 1, 2, 0, 2, 3], 1)]
+    point_light_over_floor("faint_caustics.gltf", reflectance, mirror)
 
 
 def main():
