@@ -33,7 +33,7 @@ Vec3 centroid(const Scene& scene, uint32_t t) {
 /// One sphere as seen from an emission point: its cone and its weight in the choice.
 struct Cone {
     Vec3 axis{0.0f};
-    float cos_max = -1.0f;  // -1: the point is inside, every direction
+    float cos_max = -1.0f;  // -1: the point is inside, every direction (axis unused)
     float solid_angle = 0.0f;
     float weight = 0.0f;
 };
@@ -44,8 +44,7 @@ Cone cone_of(const FocusSphere& sphere, const EmitterView& emitter) {
     const Vec3 to_center = sphere.center - emitter.origin;
     const float d2 = glm::dot(to_center, to_center);
     const float r2 = sphere.radius * sphere.radius;
-    if (d2 <= r2) {
-        cone.axis = one_sided ? emitter.normal : Vec3(0.0f, 0.0f, 1.0f);
+    if (d2 <= r2) {  // every direction: no axis
         cone.solid_angle = 4.0f * kPi;
         cone.weight = cone.solid_angle;
         return cone;

@@ -9,10 +9,14 @@
 //     casters' bounding sphere (LightSet::sample_emission, `center` and `radius`);
 //   - photons from a position (points, spots, emissive triangles) take a direction in the cone of
 //     one of up to kMaxFocusSpheres spheres that cover the casters (`spheres`), chosen in
-//     proportion to its solid angle, uniform in it, with the mixture's density
+//     proportion to its solid angle times the emitter's largest cosine over it (none behind a
+//     one-sided emitter or outside a spot's cone), uniform in it, with the mixture's density
 //       p(w) = sum_c P_c [w in cone_c] / Omega_c,
 //     and carry the light's own density of w over p(w): unbiased for every path whose first hit
-//     lies in one of the spheres, which is every caustic path.
+//     lies in one of the spheres, which is every caustic path. Where the spheres' weights add
+//     up to as much as the light's own distribution, it emits as usual (FocusOutcome::plain).
+// A light's density over p(w) is at most its weights' total over its measure, so an aimed photon
+// never carries more flux than an unaimed one.
 #pragma once
 
 #include <cstdint>
@@ -58,9 +62,10 @@ struct EmitterView {
     /// chosen. cone_cos = -1: every direction.
     Vec3 cone_axis{0.0f, 0.0f, 1.0f};
     float cone_cos = -1.0f;
-    /// The size of the light's own distribution in the choice's weights: 4 pi for a point, the
-    /// cone's solid angle for a spot, pi for a one-sided emitter (solid angle times cosine), 4 pi
-    /// for a two-sided one.
+    /// The size of the light's own distribution in the choice's weights, one over its largest
+    /// density: 4 pi for a point, the cone's solid angle for a spot, pi for a one-sided emitter
+    /// (weights are solid angle times cosine), 2 pi for a two-sided one (half its photons on each
+    /// side, cosine-weighted).
     float measure = 4.0f * kPi;
 };
 

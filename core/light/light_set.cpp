@@ -495,7 +495,7 @@ std::optional<EmissionSample> LightSet::sample_emission(float u_select, Vec2 u_p
             const FocusOutcome outcome =
                 aimed ? aim({.origin = s.origin,
                              .normal = e.double_sided ? Vec3(0.0f) : e.front_frame.n,
-                             .measure = e.double_sided ? 4.0f * kPi : kPi})
+                             .measure = e.double_sided ? 2.0f * kPi : kPi})
                       : FocusOutcome::plain;
             if (outcome == FocusOutcome::nothing) return s;
             if (outcome == FocusOutcome::aimed) {
