@@ -27,6 +27,10 @@ FinalGatherer::FinalGatherer(std::shared_ptr<const RenderScene> scene, std::shar
 
 namespace {
 
+/// The microfacet lobes of LobeKind::Diffuse (rough glass, metal and layer as rough as diffuse),
+/// without the Lambertian one.
+constexpr LobeMask kRoughLobes = mask_of(LobeKind::Diffuse) | kExcludeLambertian;
+
 /// Photons of an estimate at a gather hit on a normal-mapped surface read as diffuse.
 constexpr uint32_t kBentNormalPhotons = 32;
 
@@ -52,8 +56,8 @@ struct NearestSite {
 /// irradiance times rho / pi where every lobe is diffuse or as rough as the photon passes take
 /// for diffuse (the rough metal and dielectric layer of most glTF materials: read by their
 /// albedo at wo, exact under uniform light, instead of evaluating the BSDF per photon); for rough
-/// glass as rough, the same from both sides (one lobe sample picks the side and carries the
-/// lobe's weight); else the global map's estimate.
+/// glass of any roughness, the same from both sides (one lobe sample picks the side and carries
+/// the lobes' weight); else the global map's estimate.
 /// `exclude_flags`: photons the estimate leaves out (where it falls back to one). `front_site`:
 /// the nearest site on wo's side, when the caller has looked it up already.
 Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si, const Bsdf& bsdf,
@@ -71,11 +75,15 @@ Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si
         if (bsdf.reads_as_diffuse(lobes)) {
             if (front_site ? front_site->found : maps.irradiance->nearest_irradiance(si.p, n, settings.max_radius, &e))
                 return bsdf.diffuse_like_reflectance(wo) * kInvPi * (front_site ? front_site->irradiance : e);
-        } else if (bsdf.reads_as_diffuse_from_both_sides(lobes)) {
+        } else if (bsdf.reads_as_diffuse_from_both_sides(lobes) || (bsdf.transmits_non_delta() && exclude_flags == 0)) {
             // Rough glass: each side's incident light taken as uniform, E_side / pi, exact for
             // uniform light on either side as the albedo read above is. A kNN estimate here
             // evaluated the BSDF for each of k photons, and rough glass's photons lie sparse on
             // small curved solids: most of a glass-heavy scene's gathering time went to them.
+            // Glass rougher than glossy lobes are followed for (max_glossy_bounces) is read so
+            // too: through a sharp lobe, the few photons that line up with it were fireflies
+            // (TransmissionTest's rough yellow sphere, one sample 21 times its pixel's value).
+            // Only without excluded photons, as the sites hold them all.
             const float u_lobe = rng.next_float();
             const Vec2 u = rng.next_vec2();
             const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Radiance, lobes);
@@ -211,6 +219,13 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
                     radiance += photons_or_bounce(si, bsdf, wo, depth, kNonDeltaLobes & ~kGlossy);
                     radiance += radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_, rng, kGlossy,
                                                       photon_flags::kDirect | photon_flags::kCaustic);
+                } else if (bsdf.transmits_non_delta() && glossy_bounces < g.settings_.max_glossy_bounces) {
+                    // Rough glass as rough as diffuse (its lobes of LobeKind::Diffuse) is followed as
+                    // glossy lobes are: read at once, it takes the irradiance on each side of its
+                    // surface, and few photons reach the inside of a small solid
+                    // (TransmissionTest's rough stripes read 7 % dark, and grainy).
+                    radiance += glossy_lobes(si, bsdf, wo, depth, glossy_bounces, false, kRoughLobes);
+                    radiance += photons_or_bounce(si, bsdf, wo, depth, kLambertianLobe);
                 } else {
                     radiance += photons_or_bounce(si, bsdf, wo, depth, kNonDeltaLobes);
                 }
@@ -303,18 +318,18 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
             return g.maps_->caustic->estimate_radiance(si.p, front ? si.surface_normal : -si.surface_normal, bsdf, wo,
                                                        estimate_options_at(options, si, bsdf, front));
         }
-        /// The glossy lobes' reflection at a gather hit, as a path tracer takes it: a light
-        /// sample and a lobe sample, weighted by the power heuristic. In a caustic chain, the
-        /// lobe sample alone, and the chain goes on.
+        /// The glossy lobes' reflection at a gather hit (or `lobes`', rough glass's), as a path
+        /// tracer takes it: a light sample and a lobe sample, weighted by the power heuristic. In
+        /// a caustic chain, the lobe sample alone, and the chain goes on.
         Color glossy_lobes(const SurfaceInteraction& si, const Bsdf& bsdf, const Vec3& wo, int depth,
-                           int glossy_bounces, bool caustic_chain) const {
-            constexpr LobeMask kGlossy = mask_of(LobeKind::Glossy);
+                           int glossy_bounces, bool caustic_chain,
+                           LobeMask lobes = mask_of(LobeKind::Glossy)) const {
             SampleContext context{rng, counters};
             Color radiance(0.0f);
-            if (!caustic_chain) radiance += sample_direct_light(rs, *rs.lights, si, bsdf, wo, context, true, kGlossy);
+            if (!caustic_chain) radiance += sample_direct_light(rs, *rs.lights, si, bsdf, wo, context, true, lobes);
             const float u_lobe = rng.next_float();
             const Vec2 u = rng.next_vec2();
-            const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Radiance, kGlossy);
+            const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Radiance, lobes);
             if (s && s->pdf > 0.0f && !is_black(s->weight)) {
                 const GlossyOrigin origin{si.p, s->pdf};
                 radiance += s->weight * along(spawn_ray(rs, si, s->wi), depth, nullptr, false, glossy_bounces + 1,

@@ -41,8 +41,9 @@ struct PhotonMapIntegratorSettings {
 /// Bump when the irradiance cache's prepass or gathering changes what it stores for the same
 /// inputs: every cached render cache then misses. 2: the light tree (LightSelection); 3: rough
 /// glass at gather hits read from both sides; 4: glossy caustics left to the caustic map; 5: short
-/// gather rays trace a bounce (GatherSettings::short_ray_radii).
-inline constexpr uint32_t kRenderCacheAlgorithmVersion = 5;
+/// gather rays trace a bounce (GatherSettings::short_ray_radii); 6: rough glass followed as glossy
+/// lobes are, and glass of any roughness read from both sides where the rays stop.
+inline constexpr uint32_t kRenderCacheAlgorithmVersion = 6;
 
 /// Nearest volume photons per estimate of the in-scattered light along a gather ray, at most.
 inline constexpr uint32_t kGatherVolumePhotons = 32;
