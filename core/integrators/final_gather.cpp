@@ -27,8 +27,8 @@ FinalGatherer::FinalGatherer(std::shared_ptr<const RenderScene> scene, std::shar
 
 namespace {
 
-/// The microfacet lobes of LobeKind::Diffuse (rough glass, metal and layer as rough as diffuse),
-/// without the Lambertian one.
+/// The microfacet lobes of LobeKind::Diffuse (rough glass, metal, dielectric layer and coat as
+/// rough as diffuse), without the Lambertian one.
 constexpr LobeMask kRoughLobes = mask_of(LobeKind::Diffuse) | kExcludeLambertian;
 
 /// Photons of an estimate at a gather hit on a normal-mapped surface read as diffuse.
@@ -75,22 +75,25 @@ Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si
         if (bsdf.reads_as_diffuse(lobes)) {
             if (front_site ? front_site->found : maps.irradiance->nearest_irradiance(si.p, n, settings.max_radius, &e))
                 return bsdf.diffuse_like_reflectance(wo) * kInvPi * (front_site ? front_site->irradiance : e);
-        } else if (bsdf.reads_as_diffuse_from_both_sides(lobes) || (bsdf.transmits_non_delta() && exclude_flags == 0)) {
+        } else if (bsdf.reads_as_diffuse_from_both_sides(lobes) || (bsdf.transmits_non_delta(lobes) && exclude_flags == 0)) {
             // Rough glass: each side's incident light taken as uniform, E_side / pi, exact for
             // uniform light on either side as the albedo read above is. A kNN estimate here
             // evaluated the BSDF for each of k photons, and rough glass's photons lie sparse on
             // small curved solids: most of a glass-heavy scene's gathering time went to them.
-            // Glass rougher than glossy lobes are followed for (max_glossy_bounces) is read so
-            // too: through a sharp lobe, the few photons that line up with it were fireflies
-            // (TransmissionTest's rough yellow sphere, one sample 21 times its pixel's value).
-            // Only without excluded photons, as the sites hold them all.
+            // Glossy glass is read so too where gather rays stop following it
+            // (max_glossy_bounces): through its sharp lobe, the few photons that line up with it
+            // were fireflies (TransmissionTest's rough yellow sphere, one sample 21 times its
+            // pixel's value). Only without excluded photons, as the sites hold them all. A side
+            // with no site near takes its own estimate: the two-sided one below would count the
+            // other side's photons too.
             const float u_lobe = rng.next_float();
             const Vec2 u = rng.next_vec2();
             const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Radiance, lobes);
             if (!s || !(s->pdf > 0.0f) || is_black(s->weight)) return Color(0.0f);
             const Vec3 side = glm::dot(s->wi, n) >= 0.0f ? n : -n;
-            if (maps.irradiance->nearest_irradiance(si.p, side, settings.max_radius, &e))
-                return s->weight * kInvPi * e;
+            if (!maps.irradiance->nearest_irradiance(si.p, side, settings.max_radius, &e))
+                e = maps.global->estimate_irradiance(si.p, side, settings.k_global, settings.max_radius);
+            return s->weight * kInvPi * e;
         }
     }
     RadianceEstimateOptions options;
@@ -115,8 +118,9 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
                                       FirstHitEmission* emission, bool caustic_chains, int short_ray_bounces) const {
     const RenderScene& rs = *scene_;
     // Walk through ideal specular surfaces; `depth` counts them. At glossy surfaces the glossy
-    // lobes are followed too (up to settings_.max_glossy_bounces): reading them from the photons
-    // would evaluate a sharp lobe per photon, whose rare aligned photons are fireflies.
+    // lobes are followed too, and rough glass (up to settings_.max_glossy_bounces): reading them
+    // from the photons would evaluate a sharp lobe per photon, whose rare aligned photons are
+    // fireflies.
     // While the walk is a caustic chain (`caustic_chains`, and every bounce so far specular or
     // glossy: `from` is null), emitters count nowhere: the caustic map holds that light.
     struct Walker {
@@ -208,10 +212,23 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
                 // A caustic chain's last glossy lobe, where its ray was short, is followed a bounce
                 // more (the short-ray rule) instead of read from the lobe's photons below.
                 NearestSite site;
-                if ((bsdf.lobes() & kGlossy) && (glossy_bounces < g.settings_.max_glossy_bounces ||
-                                                 (caustic_chain && takes_short_ray_bounce(si, wo, &site)))) {
-                    radiance += glossy_lobes(si, bsdf, wo, depth, glossy_bounces, caustic_chain);
-                    radiance += photons_or_bounce(si, bsdf, wo, depth, kNonDeltaLobes & ~kGlossy);
+                // Rough glass, also as rough as diffuse (LobeKind::Diffuse), is followed as glossy
+                // lobes are: read at once, it takes the irradiance on each side of its surface,
+                // and few photons reach the inside of a small solid (TransmissionTest's rough
+                // stripes read 7 % dark, and grainy). Not in a caustic chain, which rough glass
+                // ends.
+                const bool follows = glossy_bounces < g.settings_.max_glossy_bounces;
+                const bool follows_glass = follows && !caustic_chain && bsdf.transmits_non_delta();
+                // The Lambertian lobe where the rough lobes are followed (none on pure glass).
+                const auto lambertian = [&] {
+                    return max_component(bsdf.diffuse_reflectance()) > 0.0f
+                               ? photons_or_bounce(si, bsdf, wo, depth, kLambertianLobe)
+                               : Color(0.0f);
+                };
+                if ((bsdf.lobes() & kGlossy) && (follows || (caustic_chain && takes_short_ray_bounce(si, wo, &site)))) {
+                    radiance += glossy_lobes(si, bsdf, wo, depth, glossy_bounces, caustic_chain,
+                                             follows_glass ? kGlossy | kRoughLobes : kGlossy);
+                    radiance += follows_glass ? lambertian() : photons_or_bounce(si, bsdf, wo, depth, kNonDeltaLobes & ~kGlossy);
                 } else if ((bsdf.lobes() & kGlossy) && caustic_chain) {
                     // The chain's last glossy lobe: the photons that came to it through a diffuse
                     // surface (those straight from the lights or through caustic bounces would
@@ -219,13 +236,9 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
                     radiance += photons_or_bounce(si, bsdf, wo, depth, kNonDeltaLobes & ~kGlossy);
                     radiance += radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_, rng, kGlossy,
                                                       photon_flags::kDirect | photon_flags::kCaustic);
-                } else if (bsdf.transmits_non_delta() && glossy_bounces < g.settings_.max_glossy_bounces) {
-                    // Rough glass as rough as diffuse (its lobes of LobeKind::Diffuse) is followed as
-                    // glossy lobes are: read at once, it takes the irradiance on each side of its
-                    // surface, and few photons reach the inside of a small solid
-                    // (TransmissionTest's rough stripes read 7 % dark, and grainy).
+                } else if (follows_glass) {
                     radiance += glossy_lobes(si, bsdf, wo, depth, glossy_bounces, false, kRoughLobes);
-                    radiance += photons_or_bounce(si, bsdf, wo, depth, kLambertianLobe);
+                    radiance += lambertian();
                 } else {
                     radiance += photons_or_bounce(si, bsdf, wo, depth, kNonDeltaLobes);
                 }

@@ -12,13 +12,16 @@
 // counted twice. Other glossy lobes, and any glossy lobe once a gather ray's path has met a
 // surface of diffuse kind, take light samples and weight the emitters their rays meet by the
 // power heuristic, as a path tracer does. Without a caustic map every glossy lobe does: its
-// light then comes from the gather alone.
+// light then comes from the gather alone. Rough glass, also as rough as diffuse, is followed the
+// same way (outside caustic chains), so that the light inside a small solid comes from outside
+// it rather than from the few photons on its inner side.
 //
 // Jensen's short-ray rule (GatherSettings::short_ray_radii): a hit closer to where its ray left
 // than the photon estimate there is wide is traced a bounce on instead of read from the photons,
 // as a visible point is (a light sample, the caustic map, one lobe sample), so a gather ray's path
 // takes direct light there too; the last glossy lobe of a caustic chain is followed a bounce
-// more there. Still read from the photons, without the rule: rough glass's far side.
+// more there. Still read from the photons, without the rule: rough glass's far side, where gather
+// rays stop following it.
 #pragma once
 
 #include <array>
@@ -31,8 +34,8 @@ namespace photond {
 struct GatherSettings {
     uint32_t rays = 512;         // M x N, N ~ pi M
     int max_specular_depth = 4;  // ideal specular surfaces a gather ray may pass through
-    /// Glossy lobes a gather ray follows by sampling (a light sample and a lobe sample, power
-    /// heuristic) before it reads the photon maps with the lobe; 0 reads them at once.
+    /// Glossy lobes and rough glass a gather ray follows by sampling (a light sample and a lobe
+    /// sample, power heuristic) before it reads the photon maps; 0 reads them at once.
     int max_glossy_bounces = 2;
     uint32_t k_global = 50;      // photons per radiance estimate where no precomputed irradiance fits
     uint32_t k_volume = 100;     // photons per volume-map estimate of the atmosphere's in-scattered light

@@ -249,7 +249,9 @@ bool Bsdf::reads_as_diffuse_from_both_sides(LobeMask lobes) const {
     return !glossy && !rough_coat;
 }
 
-bool Bsdf::transmits_non_delta() const { return photond::transmits_non_delta(*m_); }
+bool Bsdf::transmits_non_delta(LobeMask lobes) const {
+    return photond::transmits_non_delta(*m_) && microfacet_in_mask(lobes, m_->glass_kind);
+}
 
 Color Bsdf::diffuse_like_reflectance(const Vec3& wo) const {
     const float mu = std::min(std::abs(glm::dot(wo, frame_.n)), 1.0f);

@@ -232,8 +232,8 @@ public:
     /// kGlossyRoughness) is allowed among the lobes: light reaches wo from both sides of the
     /// surface, and each side's irradiance may stand for its incident light.
     bool reads_as_diffuse_from_both_sides(LobeMask lobes = kNonDeltaLobes) const;
-    /// Whether light passes through a non-delta lobe (rough transmission).
-    bool transmits_non_delta() const;
+    /// Whether light passes through a non-delta lobe (rough transmission), of `lobes`.
+    bool transmits_non_delta(LobeMask lobes = kNonDeltaLobes) const;
     /// Reflectance towards wo of the lobes of diffuse kind under uniform incident radiance
     /// (Lambert, and the metal and dielectric layer when rough): L_o(wo) = rho(wo) / pi * E,
     /// exact for uniform lighting. For BSDFs that reads_as_diffuse(their lobes).
