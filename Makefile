@@ -61,7 +61,7 @@ ASAN_TESTS := degenerate_geometry_test degenerate_light_test scale_invariance_te
 	final_gather_test exr_io_test png_preview_test environment_light_test material_textures_test alpha_test \
 	clearcoat_test gltf_loader_fuzz_test exr_assemble_test irradiance_cache_io_test caustic_skip_test \
 	light_tree_test irradiance_wave_merge_test preview_renderer_test homogeneous_medium_test atmosphere_test volume_photon_test \
-	radiance_cache_test scattering_solid_test image_metrics_test glossy_gather_test
+	radiance_cache_test scattering_solid_test image_metrics_test glossy_gather_test irradiance_bound_grid_test
 
 .PHONY: asan
 asan: deps

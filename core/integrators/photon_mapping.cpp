@@ -50,6 +50,8 @@ PhotonMapIntegrator::PhotonMapIntegrator(std::shared_ptr<const RenderScene> scen
                 break;
             }
     }
+    if (maps_->caustic_irradiance)
+        caustic_bound_ = IrradianceBoundGrid(*maps_->caustic_irradiance, caustic_options_.max_radius);
     direct_lights_ = gatherer_ && scene_->lights_with_sky_peaks ? scene_->lights_with_sky_peaks.get()
                                                                   : scene_->lights.get();
     if (gatherer_ && settings_.radiance_cache.enabled) {
@@ -251,9 +253,13 @@ bool PhotonMapIntegrator::caustic_may_show(const Vec3& p, const Vec3& normal, co
     const Color rho = !diffuse ? Color(0.0f) : lambertian_only ? bsdf.diffuse_reflectance(wo) : bsdf.diffuse_like_reflectance(wo);
     if (diffuse && is_black(rho)) return false;
     if (!maps_->caustic_irradiance || !diffuse) return true;
+    // First the bound over the sites in reach (luminance(rho E) <= max(rho) luminance(E)): most
+    // points of most scenes are decided without searching the sites.
+    const float threshold = static_cast<float>(kInvisibleCausticRatio) * other;
+    if (!caustic_bound_.empty() && max_component(rho) * kInvPi * caustic_bound_.bound(p) < threshold) return false;
     Color irradiance;
     if (!maps_->caustic_irradiance->nearest_irradiance(p, normal, caustic_options_.max_radius, &irradiance)) return false;
-    return luminance(rho * kInvPi * irradiance) >= static_cast<float>(kInvisibleCausticRatio) * other;
+    return luminance(rho * kInvPi * irradiance) >= threshold;
 }
 
 RadianceParts PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_length,

@@ -18,6 +18,7 @@
 #include "core/integrators/integrator.h"
 #include "core/integrators/irradiance_cache_builder.h"
 #include "core/integrators/radiance_cache.h"
+#include "core/photon/irradiance_bound_grid.h"
 #include "core/photon/photon_tracer.h"
 
 namespace photond {
@@ -133,6 +134,8 @@ private:
     /// Whether the caustic map holds photons of ideal specular paths alone (L S+ D without a
     /// glossy bounce): glossy lobes read only those.
     bool specular_caustics_ = false;
+    /// Bounds the caustic sites' irradiance within caustic_options_.max_radius (caustic_may_show).
+    IrradianceBoundGrid caustic_bound_;
     /// What next-event estimation samples: the scene's lights, or with final gathering under an
     /// environment, the lights with only the sky's peaks (the gather collects the rest).
     const LightSet* direct_lights_ = nullptr;
