@@ -48,7 +48,9 @@ TEST(PreviewRenderer, TheStrideKeepsTheSamplesUnderTheCap) {
             return int64_t((area.width() + stride - 1) / stride) * ((area.height() + stride - 1) / stride);
         };
         EXPECT_LE(blocks(s), cap);
-        if (s > kMinPreviewStride) EXPECT_GT(blocks(s - 1), cap);  // the smallest that fits
+        if (s > kMinPreviewStride) {
+            EXPECT_GT(blocks(s - 1), cap);  // the smallest that fits
+        }
     }
 }
 
