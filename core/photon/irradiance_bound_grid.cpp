@@ -19,9 +19,6 @@ IrradianceBoundGrid::IrradianceBoundGrid(const PhotonMap& sites, float reach) {
         inverse_cell_[a] = extent[a] > 0.0f ? float(counts_[a]) / extent[a] : 0.0f;
     }
     cells_.assign(size_t(counts_.x) * size_t(counts_.y) * size_t(counts_.z), 0.0f);
-    const auto cell_of = [&](const Vec3& p) {
-        return glm::clamp(glm::ivec3(glm::floor((p - bounds_.lower) * inverse_cell_)), glm::ivec3(0), counts_ - 1);
-    };
     for (const Photon& site : photons) {
         const float value = luminance(site.flux());
         const glm::ivec3 lo = cell_of(site.position - Vec3(reach));
@@ -29,10 +26,18 @@ IrradianceBoundGrid::IrradianceBoundGrid(const PhotonMap& sites, float reach) {
         for (int z = lo.z; z <= hi.z; ++z)
             for (int y = lo.y; y <= hi.y; ++y)
                 for (int x = lo.x; x <= hi.x; ++x) {
-                    float& cell = cells_[(size_t(z) * size_t(counts_.y) + size_t(y)) * size_t(counts_.x) + size_t(x)];
+                    float& cell = cells_[index({x, y, z})];
                     cell = std::max(cell, value);
                 }
     }
+}
+
+glm::ivec3 IrradianceBoundGrid::cell_of(const Vec3& p) const {
+    return glm::clamp(glm::ivec3(glm::floor((p - bounds_.lower) * inverse_cell_)), glm::ivec3(0), counts_ - 1);
+}
+
+size_t IrradianceBoundGrid::index(const glm::ivec3& cell) const {
+    return (size_t(cell.z) * size_t(counts_.y) + size_t(cell.y)) * size_t(counts_.x) + size_t(cell.x);
 }
 
 float IrradianceBoundGrid::bound(const Vec3& p) const {
@@ -40,9 +45,7 @@ float IrradianceBoundGrid::bound(const Vec3& p) const {
     if (!(p.x >= bounds_.lower.x && p.x <= bounds_.upper.x && p.y >= bounds_.lower.y && p.y <= bounds_.upper.y &&
           p.z >= bounds_.lower.z && p.z <= bounds_.upper.z))
         return 0.0f;
-    const glm::ivec3 c =
-        glm::clamp(glm::ivec3(glm::floor((p - bounds_.lower) * inverse_cell_)), glm::ivec3(0), counts_ - 1);
-    return cells_[(size_t(c.z) * size_t(counts_.y) + size_t(c.y)) * size_t(counts_.x) + size_t(c.x)];
+    return cells_[index(cell_of(p))];
 }
 
 }  // namespace photond

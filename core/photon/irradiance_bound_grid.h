@@ -30,6 +30,9 @@ public:
     static constexpr int kMaxCellsPerAxis = 32;
 
 private:
+    glm::ivec3 cell_of(const Vec3& p) const;  // clamped into the grid
+    size_t index(const glm::ivec3& cell) const;
+
     Bounds3 bounds_;  // the sites' bounds widened by reach
     Vec3 inverse_cell_{0.0f};
     glm::ivec3 counts_{0};

@@ -57,11 +57,25 @@ Camera glossy_spheres_camera(const std::shared_ptr<const RenderScene>& rs) {
     return Camera::create(rs->scene->cameras.at(0), 48, 32).value();
 }
 
-/// `path` at 1024 spp: the per-pixel reference of a glossy_spheres_camera view.
-Image path_reference(const std::shared_ptr<const RenderScene>& rs, const Camera& camera) {
+/// `path` at `spp` (1024 unless told): the per-pixel reference of a view.
+Image path_reference(const std::shared_ptr<const RenderScene>& rs, const Camera& camera, int spp = 1024) {
     TileSettings tiles;
-    tiles.samples_per_pixel = 1024;
+    tiles.samples_per_pixel = spp;
     return render_tiles(PathIntegrator(rs), camera, tiles).layers.beauty;
+}
+
+/// The scene `builder` holds, seen from `position` towards `look_at` (40 degrees), under a uniform
+/// sky of radiance 1.
+std::shared_ptr<const RenderScene> under_uniform_sky(SceneBuilder& builder, const Vec3& position, const Vec3& look_at,
+                                                     float vfov_deg = 40.0f) {
+    CameraDesc view;
+    view.position = position;
+    view.look_at = look_at;
+    view.vfov_deg = vfov_deg;
+    builder.add_camera(view);
+    Scene scene = builder.build().value();
+    scene.environment = Environment{};  // uniform, radiance 1
+    return make_render_scene(std::move(scene));
 }
 
 /// The photon maps of 100k global and `caustic` caustic photons (empty maps, after a failed
@@ -171,19 +185,10 @@ TEST(GlossyGather, RoughMetalUnderAUniformSkyIsAsSmoothAsPath) {
     metal.roughness = 1.0f;
     const uint32_t m = builder.add_material(metal);
     EXPECT_TRUE(add_mesh(builder, make_quad(Vec3(-1, 0, -1), Vec3(2, 0, 0), Vec3(0, 0, 2), Vec3(0, 1, 0)), m).is_ok());
-    CameraDesc view;
-    view.position = Vec3(0.0f, 1.5f, 1.5f);
-    view.look_at = Vec3(0.0f, 0.0f, 0.0f);
-    view.vfov_deg = 40.0f;
-    builder.add_camera(view);
-    Scene scene = builder.build().value();
-    scene.environment = Environment{};  // uniform, radiance 1
-    const auto rs = make_render_scene(std::move(scene));
+    const auto rs = under_uniform_sky(builder, Vec3(0.0f, 1.5f, 1.5f), Vec3(0.0f));
     ASSERT_TRUE(rs->diffuse_sky) << "a uniform sky is all diffuse sky";
     const Camera camera = Camera::create(rs->scene->cameras.at(0), 32, 32).value();
-    TileSettings path_tiles;
-    path_tiles.samples_per_pixel = 4096;
-    const Image reference = render_tiles(PathIntegrator(rs), camera, path_tiles).layers.beauty;
+    const Image reference = path_reference(rs, camera, 4096);
     TileSettings tiles;
     tiles.samples_per_pixel = 16;
     const Image path16 = render_tiles(PathIntegrator(rs), camera, tiles).layers.beauty;
@@ -213,18 +218,9 @@ TEST(GlossyGather, FloorUnderARoughGlassRoofAgreesWithPath) {
     const uint32_t glass = builder.add_material(frosted);
     EXPECT_TRUE(add_mesh(builder, make_quad(Vec3(-5, 0, -5), Vec3(10, 0, 0), Vec3(0, 0, 10), Vec3(0, 1, 0)), floor).is_ok());
     EXPECT_TRUE(add_mesh(builder, make_quad(Vec3(-2, 1, -2), Vec3(4, 0, 0), Vec3(0, 0, 4), Vec3(0, 1, 0)), glass).is_ok());
-    CameraDesc view;
-    view.position = Vec3(0.0f, 0.8f, 0.8f);
-    view.look_at = Vec3(0.0f, 0.0f, -0.2f);
-    view.vfov_deg = 50.0f;
-    builder.add_camera(view);
-    Scene scene = builder.build().value();
-    scene.environment = Environment{};  // uniform, radiance 1
-    const auto rs = make_render_scene(std::move(scene));
+    const auto rs = under_uniform_sky(builder, Vec3(0.0f, 0.8f, 0.8f), Vec3(0.0f, 0.0f, -0.2f), 50.0f);
     const Camera camera = Camera::create(rs->scene->cameras.at(0), 24, 24).value();
-    TileSettings path_tiles;
-    path_tiles.samples_per_pixel = 1024;
-    const Image reference = render_tiles(PathIntegrator(rs), camera, path_tiles).layers.beauty;
+    const Image reference = path_reference(rs, camera);
     const Image image = render_photon_map(rs, camera, 100000, 128, 16);
     const ImageError error = compare_images(image, reference).value();
     std::printf("floor under a rough glass roof, 24x24 vs path: mean %.4f against %.4f (%+.2f %%), relMSE %.5f\n",
@@ -244,14 +240,7 @@ std::shared_ptr<const RenderScene> rough_glass_ball(float roughness, float trans
     const uint32_t glass = builder.add_material(frosted);
     EXPECT_TRUE(add_mesh(builder, make_quad(Vec3(-5, 0, -5), Vec3(10, 0, 0), Vec3(0, 0, 10), Vec3(0, 1, 0)), floor).is_ok());
     EXPECT_TRUE(add_mesh(builder, make_icosphere(Vec3(0.0f, 0.5f, 0.0f), 0.5f, 5), glass).is_ok());
-    CameraDesc view;
-    view.position = Vec3(0.0f, 0.9f, 1.6f);
-    view.look_at = Vec3(0.0f, 0.45f, 0.0f);
-    view.vfov_deg = 40.0f;
-    builder.add_camera(view);
-    Scene scene = builder.build().value();
-    scene.environment = Environment{};  // uniform, radiance 1
-    return make_render_scene(std::move(scene));
+    return under_uniform_sky(builder, Vec3(0.0f, 0.9f, 1.6f), Vec3(0.0f, 0.45f, 0.0f));
 }
 
 TEST(GlossyGather, ARoughGlassBallAgreesWithPath) {
@@ -271,9 +260,7 @@ TEST(GlossyGather, ARoughGlassBallAgreesWithPath) {
         const float roughness = ball.roughness;
         const auto rs = rough_glass_ball(roughness, ball.transmission);
         const Camera camera = Camera::create(rs->scene->cameras.at(0), 24, 24).value();
-        TileSettings path_tiles;
-        path_tiles.samples_per_pixel = 1024;
-        const Image reference = render_tiles(PathIntegrator(rs), camera, path_tiles).layers.beauty;
+        const Image reference = path_reference(rs, camera);
         const Image image = render_photon_map(rs, camera, 100000, 128, 16);
         const ImageError error = compare_images(image, reference, std::nullopt, 0.01, 1).value();
         std::printf("rough glass ball (roughness %.2f, transmission %.1f), 24x24 vs path: mean %.4f against %.4f "
@@ -346,9 +333,7 @@ TEST(GlossyGather, AGlossySphereReflectsTheShadowItStandsInAsPathDoes) {
             return sum / static_cast<double>(base.size());
         };
 
-        TileSettings path_tiles;
-        path_tiles.samples_per_pixel = 1024;
-        const double reference = base_mean(render_tiles(PathIntegrator(rs), camera, path_tiles).layers.beauty);
+        const double reference = base_mean(path_reference(rs, camera));
         const bool sharp = roughness < kSharpGlossyRoughness;
         const auto maps = trace_maps(rs, sharp ? 20000 : 0);
         ASSERT_TRUE(maps->global && maps->irradiance);
