@@ -154,6 +154,16 @@ bench: build
 	python3 bench/radiance_cache_tradeoff.py --photond $(BUILD)/server/photond
 	$(MAKE) bench-web
 
+# photond against another renderer: the Khronos samples in Blender's Cycles and in photond, same
+# camera, sky and pixel filter (bench/cycles_compare.py; Debian's blender and the python3-numpy
+# its glTF importer needs; about 20 minutes at 1024 spp). Not in `bench`: Blender is a large
+# install.
+CYCLES_SPP ?= 1024
+.PHONY: cycles-compare
+cycles-compare: build
+	$(call install_missing,blender python3-numpy)
+	python3 bench/cycles_compare.py --photond $(BUILD)/server/photond --cycles-spp $(CYCLES_SPP)
+
 # The web page's time goals (README.md, "The web page"): first paint under 200 ms and a live tile
 # within 50 ms of its event, asserted. ctest runs the same test and prints the figures only.
 .PHONY: bench-web

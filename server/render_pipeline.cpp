@@ -174,14 +174,19 @@ std::optional<PassDecision> radiance_cache_decision(const protocol::RenderSettin
 std::optional<protocol::FieldError> material_media_problem(const protocol::Job& job, const Scene& scene) {
     for (const auto& [name, spec] : job.material_media) {
         const std::string path = "material_media." + name;
-        bool found = false;
+        bool found = false, solid = false;
         for (const Material& m : scene.materials) {
             if (m.name != name) continue;
             if (!(m.transmission > 0.0f))
                 return protocol::FieldError{path, "material '" + name + "' is not transmissive (no "
                                                   "KHR_materials_transmission): its surface closes no medium"};
             found = true;
+            solid = solid || !m.thin_walled;
         }
+        if (found && !solid)
+            return protocol::FieldError{path, "material '" + name + "' is only on open meshes, taken as thin walls "
+                                              "(README.md, \"Transmission without KHR_materials_volume\"): "
+                                              "its surface closes no medium"};
         if (!found) {
             std::set<std::string> names;
             std::string transmissive;
@@ -204,13 +209,14 @@ std::string apply_material_media(const protocol::Job& job, Scene& scene) {
         const std::string& name = entry.first;  // a named variable: lambdas may not capture bindings (C++17)
         const auto& spec = entry.second;
         for (Material& m : scene.materials) {
-            if (m.name != name) continue;
+            if (m.name != name || m.thin_walled) continue;  // a thin wall has no inside
             m.scattering = to_vec3(spec.sigma_s);
             m.phase_g = static_cast<float>(spec.g);
             if (spec.sigma_a) m.attenuation = to_vec3(*spec.sigma_a);
         }
-        const auto m = std::find_if(scene.materials.begin(), scene.materials.end(),
-                                    [&](const Material& material) { return material.name == name; });
+        const auto m = std::find_if(scene.materials.begin(), scene.materials.end(), [&](const Material& material) {
+            return material.name == name && !material.thin_walled;
+        });
         applied += std::string(applied.empty() ? "" : "; ") + "'" + name + "': sigma_a " +
                    describe_colour({m->attenuation.x, m->attenuation.y, m->attenuation.z}) + " (" +
                    (spec.sigma_a ? "the job's" : "the file's") + "), sigma_s " + describe_colour(spec.sigma_s) +

@@ -103,10 +103,10 @@ LobeKind slot_kind(int slot, const BsdfMaterial& m) {
 }  // namespace
 
 BsdfMaterial::BsdfMaterial(const Material& material, float metallic_value, float roughness_value,
-                           float clearcoat_value, float clearcoat_roughness_value) {
+                           float transmission_value, float clearcoat_value, float clearcoat_roughness_value) {
     // Clamp to the ranges the glTF spec allows, which is what the energy guarantee needs.
     metallic = std::isfinite(metallic_value) ? std::clamp(metallic_value, 0.0f, 1.0f) : 0.0f;
-    transmission = std::clamp(material.transmission, 0.0f, 1.0f);
+    transmission = std::isfinite(transmission_value) ? std::clamp(transmission_value, 0.0f, 1.0f) : 0.0f;
     roughness = std::isfinite(roughness_value) ? std::clamp(roughness_value, 0.0f, 1.0f) : 1.0f;
     ior = std::isfinite(material.ior) ? std::max(material.ior, 1.0f) : 1.5f;
     const float specular = std::clamp(material.specular, 0.0f, 1.0f);
@@ -121,7 +121,10 @@ BsdfMaterial::BsdfMaterial(const Material& material, float metallic_value, float
     glass_weight = (1.0f - metallic) * transmission;
     smooth = roughness < kDeltaRoughness;
     alpha = std::max(sqr(roughness), kMinAlpha);
-    glass_delta = smooth || ior < 1.0f + kMinIorContrast;
+    thin_walled = material.thin_walled && glass_weight > 0.0f;
+    // ior ~ 1 refracts nothing (and the rough BTDF's half vector degenerates); a thin wall's rough
+    // transmission blurs whatever its ior.
+    glass_delta = smooth || (!thin_walled && ior < 1.0f + kMinIorContrast);
     specular_kind = microfacet_lobe_kind(roughness);
     glass_kind = glass_delta ? LobeKind::Delta : specular_kind;
 
@@ -173,6 +176,18 @@ LobeMask possible_lobes(const Scene& scene, const Material& m, bool* sharp_gloss
             metallic[i] = m.metallic * b[i];
         }
     }
+    // KHR_materials_transmission's texture: its R's extremes.
+    float transmission[2] = {m.transmission, m.transmission};
+    if (m.transmission_texture.present()) {
+        const Texture& t = *scene.textures[static_cast<size_t>(m.transmission_texture.texture)];
+        float r[2] = {1.0f, 0.0f};
+        for (size_t i = 0, n = t.texel_count(); i < n; ++i) {
+            const float v = t.texel(i).x;
+            r[0] = std::min(r[0], v), r[1] = std::max(r[1], v);
+        }
+        if (t.texel_count() == 0) r[0] = r[1] = 1.0f;
+        for (int i = 0; i < 2; ++i) transmission[i] = m.transmission * r[i];
+    }
     const Color colour = m.base_color_texture.present() ? Color(1.0f) : m.base_color;
     // The range's ends, and a sharp and a wider glossy roughness where the range holds them.
     const float sharp = std::clamp(0.5f * (kDeltaRoughness + kSharpGlossyRoughness), roughness[0], roughness[1]);
@@ -188,13 +203,15 @@ LobeMask possible_lobes(const Scene& scene, const Material& m, bool* sharp_gloss
     LobeMask lobes = 0;
     bool any_sharp = false, all_sharp = true;
     for (float mv : metallic) {
-        for (float rv : {roughness[0], roughness[1], sharp, glossy}) {
-            for (float cr : {coat_roughness[0], coat_roughness[1], coat_sharp, coat_glossy}) {
-                const BsdfMaterial constants(m, mv, rv, coat, cr);
-                const LobeMask here = Bsdf(constants, colour, Frame(Vec3(0, 0, 1)), Vec3(0, 0, 1)).lobes();
-                lobes |= here;
-                any_sharp = any_sharp || constants.sharp_glossy;
-                if (here & mask_of(LobeKind::Glossy)) all_sharp = all_sharp && constants.sharp_glossy;
+        for (float tv : transmission) {
+            for (float rv : {roughness[0], roughness[1], sharp, glossy}) {
+                for (float cr : {coat_roughness[0], coat_roughness[1], coat_sharp, coat_glossy}) {
+                    const BsdfMaterial constants(m, mv, rv, tv, coat, cr);
+                    const LobeMask here = Bsdf(constants, colour, Frame(Vec3(0, 0, 1)), Vec3(0, 0, 1)).lobes();
+                    lobes |= here;
+                    any_sharp = any_sharp || constants.sharp_glossy;
+                    if (here & mask_of(LobeKind::Glossy)) all_sharp = all_sharp && constants.sharp_glossy;
+                }
             }
         }
     }
@@ -353,6 +370,17 @@ Color Bsdf::eval_base_local(const Vec3& wo, const Vec3& wi, bool outside, Transp
             }
         }
     } else if (wi.z < 0.0f && !m_->glass_delta && m_->glass_weight > 0.0f && microfacet_in_mask(mask, m_->glass_kind)) {
+        if (m_->thin_walled) {
+            // A thin wall: the reflection lobe mirrored through the surface, weighted by what the
+            // Fresnel term lets through and tinted by the base colour (glTF's
+            // KHR_materials_transmission). Reciprocal, and no 1/eta^2: air on both sides.
+            const Vec3 mirrored(wi.x, wi.y, -wi.z);
+            const Vec3 h = glm::normalize(wo + mirrored);
+            const float value = (1.0f - fresnel_dielectric(glm::dot(wo, h), m_->ior)) * ggx.d(h) *
+                                ggx.g2(wo, mirrored) / (4.0f * wo.z * mirrored.z);
+            f += m_->glass_weight * value * base_color_;
+            return f;
+        }
         // Rough dielectric transmission (Walter et al. 2007, eq. 21) with the generalized half
         // vector h ~ wo + eta wi, eta = n_i / n_o (wi's side over wo's side).
         const float eta = relative_ior(outside);
@@ -401,6 +429,13 @@ float Bsdf::pdf_base_local(const Vec3& wo, const Vec3& wi, bool outside,
                 pdf += p_glass * fresnel_dielectric(cos_oh, relative_ior(outside)) * reflect_pdf;
             }
         }
+    } else if (wi.z < 0.0f && p_glass > 0.0f && m_->thin_walled) {
+        // The mirrored reflection lobe: the reflection's density at the mirrored direction.
+        const Vec3 mirrored(wi.x, wi.y, -wi.z);
+        const Vec3 h = glm::normalize(wo + mirrored);
+        const float cos_oh = glm::dot(wo, h);
+        pdf += p_glass * (1.0f - fresnel_dielectric(cos_oh, m_->ior)) * ggx.visible_normal_pdf(wo, h) /
+               (4.0f * cos_oh);
     } else if (wi.z < 0.0f && p_glass > 0.0f) {
         // Refraction: dh/dwi = eta^2 |wi.h| / (wo.h + eta wi.h)^2 (Walter et al. 2007, eq. 17).
         const float eta = relative_ior(outside);
@@ -491,13 +526,18 @@ std::optional<BsdfSample> Bsdf::sample_lobes(const Vec3& wo, float u_lobe, const
                 probability += slots[kSlotCoat];
             }
         } else {
-            if (!refract(o, Vec3(0, 0, 1), eta, &i)) return std::nullopt;
+            // A thin wall lets light straight through, unbent and unscaled.
+            if (m_->thin_walled) {
+                i = -o;
+            } else if (!refract(o, Vec3(0, 0, 1), eta, &i)) {
+                return std::nullopt;
+            }
             reflectance = m_->glass_weight * (1.0f - f_glass) * base_color_;
             if (m_->coat > 0.0f && outside) reflectance *= coat_o * coat_through(std::abs(i.z));
-            if (mode == TransportMode::Radiance) reflectance /= eta * eta;
+            if (mode == TransportMode::Radiance && !m_->thin_walled) reflectance /= eta * eta;
             probability = slots[kSlotGlass] * (1.0f - f_glass);
             s.is_transmission = true;
-            s.eta = eta;
+            s.eta = m_->thin_walled ? 1.0f : eta;
         }
         if (!(probability > 0.0f) || is_black(reflectance)) return std::nullopt;
         s.weight = reflectance / probability;
@@ -516,6 +556,9 @@ std::optional<BsdfSample> Bsdf::sample_lobes(const Vec3& wo, float u_lobe, const
                 slot == kSlotSpecular || u_choice < fresnel_dielectric(glm::dot(o, h), eta);
             if (reflection) {
                 i = reflect(o, h);
+            } else if (m_->thin_walled) {
+                i = reflect(o, h);  // mirrored through the wall
+                i.z = -i.z;
             } else if (!refract(o, h, eta, &i)) {
                 return std::nullopt;
             }
@@ -529,7 +572,7 @@ std::optional<BsdfSample> Bsdf::sample_lobes(const Vec3& wo, float u_lobe, const
         s.pdf = pdf;
         s.kind = slot_kind(slot, *m_);
         s.is_transmission = i.z < 0.0f;
-        s.eta = s.is_transmission ? eta : 1.0f;
+        s.eta = s.is_transmission && !m_->thin_walled ? eta : 1.0f;
     }
     if (!outside) i.z = -i.z;
     s.wi = frame_.to_world(i);
@@ -566,17 +609,18 @@ int Bsdf::delta_lobes(const Vec3& wo, std::array<BsdfSample, 2>& out, TransportM
         if (geometry_agrees(wo, s.wi, true)) out[count++] = s;
     }
     Vec3 i;
+    // A thin wall lets light straight through, unbent and unscaled.
     if (m_->glass_delta && m_->glass_weight > 0.0f && f_glass < 1.0f &&
-        refract(o, Vec3(0, 0, 1), eta, &i)) {
+        (m_->thin_walled ? (i = -o, true) : refract(o, Vec3(0, 0, 1), eta, &i))) {
         BsdfSample s;
         s.wi = to_world(i);
         s.weight = m_->glass_weight * (1.0f - f_glass) * base_color_;
         if (m_->coat > 0.0f && outside) s.weight *= coat_o * coat_through(std::abs(i.z));
-        if (mode == TransportMode::Radiance) s.weight /= eta * eta;
+        if (mode == TransportMode::Radiance && !m_->thin_walled) s.weight /= eta * eta;
         s.pdf = 1.0f;
         s.kind = LobeKind::Delta;
         s.is_transmission = true;
-        s.eta = eta;
+        s.eta = m_->thin_walled ? 1.0f : eta;
         if (!is_black(s.weight) && geometry_agrees(wo, s.wi, false)) out[count++] = s;
     }
     return count;

@@ -69,11 +69,11 @@ struct BsdfSample {
 /// and the frames: deriving it at every hit was a tenth of a photon bounce.
 struct BsdfMaterial {
     explicit BsdfMaterial(const Material& material)
-        : BsdfMaterial(material, material.metallic, material.roughness, material.clearcoat,
-                       material.clearcoat_roughness) {}
-    /// With metallic, roughness and the clearcoat's factor and roughness read from the
-    /// material's textures at one point.
-    BsdfMaterial(const Material& material, float metallic, float roughness, float clearcoat,
+        : BsdfMaterial(material, material.metallic, material.roughness, material.transmission,
+                       material.clearcoat, material.clearcoat_roughness) {}
+    /// With metallic, roughness, transmission and the clearcoat's factor and roughness read from
+    /// the material's textures at one point.
+    BsdfMaterial(const Material& material, float metallic, float roughness, float transmission, float clearcoat,
                  float clearcoat_roughness);
 
     Color specular_f0;       // dielectric layer F0 (from ior and KHR_materials_specular)
@@ -87,6 +87,9 @@ struct BsdfMaterial {
     float ior;
     bool smooth;             // roughness < kDeltaRoughness: reflection/transmission are delta
     bool glass_delta;        // smooth, or ior ~ 1 (no refraction): the dielectric is delta
+    /// Material::thin_walled: transmission passes straight through (smooth) or by the
+    /// reflection lobe mirrored through the surface (rough), with no 1/eta^2 and no inside.
+    bool thin_walled = false;
     LobeKind specular_kind;  // kind of the metal/layer reflection lobe
     LobeKind glass_kind;     // kind of the dielectric reflection/transmission lobe
     LobeMask other_lobes = 0;  // the lobes other than the Lambertian one
@@ -109,7 +112,7 @@ struct BsdfMaterial {
 };
 
 /// The lobe kinds a material can have anywhere on its surface: with a metallicRoughnessTexture,
-/// the union over its texels' extremes of metallic and roughness (the base colour taken as
+/// the union over its texels' extremes of metallic, roughness and transmission (the base colour taken as
 /// white, so a texture can only remove lobes). For the render plan and the caustic casters.
 /// `sharp_glossy`, when given, tells whether every glossy lobe the surface has anywhere is sharp
 /// (BsdfMaterial::sharp_glossy), and it has one somewhere.
@@ -268,7 +271,8 @@ private:
     Color layer_albedo_towards(float cos_theta) const;
     Color lambert_albedo(float cos_theta) const;
     Color specular_albedo(float cos_theta) const;
-    float relative_ior(bool outside) const { return outside ? m_->ior : 1.0f / m_->ior; }
+    /// A thin wall has air on both sides: light meets it from outside whichever side it comes.
+    float relative_ior(bool outside) const { return outside || m_->thin_walled ? m_->ior : 1.0f / m_->ior; }
     bool geometry_agrees(const Vec3& wo, const Vec3& wi, bool local_reflection) const {
         // pbrt-v3 style: the geometric normal decides reflection vs transmission.
         const bool geometric_reflection =

@@ -26,7 +26,8 @@ MediumSpan span_in_bounds(const Bounds3& bounds, const Ray& ray, float t_end);
 
 /// Whether the ray segment that ends at `si` ran inside a closed transmissive solid.
 inline bool segment_inside_solid(const Scene& scene, const SurfaceInteraction& si) {
-    return !si.front_face && scene.materials[si.material].transmission > 0.0f;
+    const Material& m = scene.materials[si.material];
+    return !si.front_face && m.transmission > 0.0f && !m.thin_walled;
 }
 
 /// The atmosphere's span of a camera or path ray (unit direction) that ends at the hit `si`

@@ -174,8 +174,23 @@ Expected<uint32_t> GltfSceneReader::scene_material(int material_index) {
         if (!read) return read.error();
         m = std::move(read).value();
     }
+    material_values_.emplace(material_index, m);
     const uint32_t index = builder_.add_material(std::move(m));
     materials_.emplace(material_index, index);
+    return index;
+}
+
+uint32_t GltfSceneReader::thin_walled_material(int material_index, uint32_t solid) {
+    if (const auto it = thin_materials_.find(material_index); it != thin_materials_.end()) return it->second;
+    const auto value = material_values_.find(material_index);
+    if (value == material_values_.end()) return solid;
+    Material m = value->second;
+    m.thin_walled = true;
+    // A thin wall has no inside: nothing to attenuate or scatter in.
+    m.attenuation = Color(0.0f);
+    m.scattering = Color(0.0f);
+    const uint32_t index = builder_.add_material(std::move(m));
+    thin_materials_.emplace(material_index, index);
     return index;
 }
 
@@ -276,7 +291,7 @@ Status GltfSceneReader::read_material_textures(const tinygltf::Material& g, int 
 }
 
 /// KHR_materials_clearcoat (clearcoatNormalTexture is not applied: the coat shares the base's
-/// shading normal) and KHR_materials_volume (attenuation inside the solid; thicknessFactor is for
+/// shading normal), KHR_materials_transmission's texture and KHR_materials_volume (attenuation inside the solid; thicknessFactor is for
 /// rasterisers that do not trace the solid).
 Status GltfSceneReader::read_clearcoat_and_volume(const tinygltf::Material& g, int material_index,
                                                   const std::string& context, Material& m) {
@@ -295,8 +310,21 @@ Status GltfSceneReader::read_clearcoat_and_volume(const tinygltf::Material& g, i
     }
     m.clearcoat = std::isfinite(*coat) ? std::clamp(float(*coat), 0.0f, 1.0f) : 0.0f;
     m.clearcoat_roughness = std::isfinite(*coat_roughness) ? std::clamp(float(*coat_roughness), 0.0f, 1.0f) : 0.0f;
-    if (const auto it = ext.find("KHR_materials_clearcoat"); it != ext.end() && it->second.IsObject()) {
-        if (Status st = read_clearcoat_textures(it->second, material_index, context, m); !st) return st;
+    if (const auto it = ext.find("KHR_materials_clearcoat"); it != ext.end()) {
+        for (const auto& [key, target] : {std::pair<const char*, TextureRef*>{"clearcoatTexture", &m.clearcoat_texture},
+                                          {"clearcoatRoughnessTexture", &m.clearcoat_roughness_texture}}) {
+            if (Status st = read_extension_texture(it->second, "KHR_materials_clearcoat", key, material_index, context,
+                                                   *target);
+                !st)
+                return st;
+        }
+    }
+    // KHR_materials_transmission: R of transmissionTexture multiplies transmissionFactor.
+    if (const auto it = ext.find("KHR_materials_transmission"); it != ext.end() && m.transmission > 0.0f) {
+        if (Status st = read_extension_texture(it->second, "KHR_materials_transmission", "transmissionTexture",
+                                               material_index, context, m.transmission_texture);
+            !st)
+            return st;
     }
     // sigma = -ln(attenuationColor) / attenuationDistance (KHR_materials_volume), only in
     // transmissive solids (an opaque surface has no inside that light crosses).
@@ -310,31 +338,29 @@ Status GltfSceneReader::read_clearcoat_and_volume(const tinygltf::Material& g, i
     return Status::ok();
 }
 
-Status GltfSceneReader::read_clearcoat_textures(const tinygltf::Value& clearcoat, int material_index,
-                                                const std::string& context, Material& m) {
-    std::vector<int>& sets = texcoord_sets_[material_index];
-    for (const auto& [key, target] : {std::pair<const char*, TextureRef*>{"clearcoatTexture", &m.clearcoat_texture},
-                                      {"clearcoatRoughnessTexture", &m.clearcoat_roughness_texture}}) {
-        if (!clearcoat.Has(key)) continue;
-        const tinygltf::Value& info = clearcoat.Get(key);
-        if (!info.IsObject() || !info.Has("index") || !info.Get("index").IsNumber())
-            return fail(context + "KHR_materials_clearcoat." + key + " has no texture index");
-        const std::optional<int> index = int_value(info.Get("index"));
-        if (!index) return fail(context + "KHR_materials_clearcoat." + key + " has no texture index");
-        const std::optional<int> tex_coord = info.Has("texCoord") && info.Get("texCoord").IsNumber()
-                                                 ? int_value(info.Get("texCoord"))
-                                                 : std::optional<int>(0);
-        if (!tex_coord)
-            return fail(context + "KHR_materials_clearcoat." + key + ".texCoord is not a TEXCOORD_ set");
-        tinygltf::ExtensionMap info_extensions;
-        if (info.Has("extensions") && info.Get("extensions").IsObject()) {
-            const tinygltf::Value& e = info.Get("extensions");
-            for (const std::string& name : e.Keys()) info_extensions[name] = e.Get(name);
-        }
-        Expected<TextureRef> ref = texture_ref(*index, *tex_coord, info_extensions, context, key, false, sets);
-        if (!ref) return ref.error();
-        *target = *ref;
+Status GltfSceneReader::read_extension_texture(const tinygltf::Value& extension, const char* extension_name,
+                                              const char* key, int material_index, const std::string& context,
+                                              TextureRef& target) {
+    if (!extension.IsObject() || !extension.Has(key)) return Status::ok();
+    const std::string what = context + extension_name + "." + key;
+    const tinygltf::Value& info = extension.Get(key);
+    if (!info.IsObject() || !info.Has("index") || !info.Get("index").IsNumber())
+        return fail(what + " has no texture index");
+    const std::optional<int> index = int_value(info.Get("index"));
+    if (!index) return fail(what + " has no texture index");
+    const std::optional<int> tex_coord = info.Has("texCoord") && info.Get("texCoord").IsNumber()
+                                             ? int_value(info.Get("texCoord"))
+                                             : std::optional<int>(0);
+    if (!tex_coord) return fail(what + ".texCoord is not a TEXCOORD_ set");
+    tinygltf::ExtensionMap info_extensions;
+    if (info.Has("extensions") && info.Get("extensions").IsObject()) {
+        const tinygltf::Value& e = info.Get("extensions");
+        for (const std::string& name : e.Keys()) info_extensions[name] = e.Get(name);
     }
+    Expected<TextureRef> ref =
+        texture_ref(*index, *tex_coord, info_extensions, context, key, false, texcoord_sets_[material_index]);
+    if (!ref) return ref.error();
+    target = *ref;
     return Status::ok();
 }
 

@@ -2,6 +2,10 @@
 // where a normal map needs them.
 #include "core/scene/gltf_reader.h"
 
+#include <algorithm>
+#include <array>
+#include <map>
+#include <set>
 #include <type_traits>
 
 #include "core/math/frame.h"
@@ -128,6 +132,28 @@ void generate_tangents(DecodedPrimitive& prim, int slot) {
     assign_tangents(prim, sums);
 }
 
+/// Whether the triangles of `parts` together close a volume: every edge (vertices welded by
+/// position, across the parts) is shared by exactly two triangles.
+bool is_closed_surface(const std::vector<const DecodedPrimitive*>& parts) {
+    std::map<std::array<float, 3>, uint32_t> welded;
+    std::map<std::pair<uint32_t, uint32_t>, int> edges;
+    size_t triangles = 0;
+    for (const DecodedPrimitive* part : parts) {
+        std::vector<uint32_t> vertex(part->positions.size());
+        for (size_t i = 0; i < part->positions.size(); ++i) {
+            const Vec3& p = part->positions[i];
+            vertex[i] = welded.emplace(std::array<float, 3>{p.x, p.y, p.z}, static_cast<uint32_t>(welded.size()))
+                            .first->second;
+        }
+        for (const glm::uvec3& t : part->triangles) {
+            const uint32_t v[3] = {vertex[t.x], vertex[t.y], vertex[t.z]};
+            for (int k = 0; k < 3; ++k) ++edges[std::minmax(v[k], v[(k + 1) % 3])];
+        }
+        triangles += part->triangles.size();
+    }
+    return triangles > 0 && std::all_of(edges.begin(), edges.end(), [](const auto& e) { return e.second == 2; });
+}
+
 bool is_point_or_line_mode(int mode) {
     return mode == TINYGLTF_MODE_POINTS || mode == TINYGLTF_MODE_LINE ||
            mode == TINYGLTF_MODE_LINE_LOOP || mode == TINYGLTF_MODE_LINE_STRIP;
@@ -138,6 +164,7 @@ bool is_point_or_line_mode(int mode) {
 Status GltfSceneReader::load_mesh(int mesh_index) {
     const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(mesh_index)];
     std::vector<DecodedPrimitive> decoded;
+    std::vector<int> gltf_materials;  // each decoded primitive's glTF material
     for (size_t p = 0; p < mesh.primitives.size(); ++p) {
         const tinygltf::Primitive& prim = mesh.primitives[p];
         const std::string context = "mesh " + std::to_string(mesh_index) + quoted(mesh.name) +
@@ -154,8 +181,37 @@ Status GltfSceneReader::load_mesh(int mesh_index) {
         Expected<DecodedPrimitive> out = decode_primitive(prim, context);
         if (!out) return out.error();
         decoded.push_back(std::move(out).value());
+        gltf_materials.push_back(prim.material);
     }
+    if (Status st = assign_thin_walls(decoded, gltf_materials); !st) return st;
     meshes_[static_cast<size_t>(mesh_index)] = std::move(decoded);
+    return Status::ok();
+}
+
+Status GltfSceneReader::assign_thin_walls(std::vector<DecodedPrimitive>& decoded,
+                                          const std::vector<int>& gltf_materials) {
+    for (const int material_index : std::set<int>(gltf_materials.begin(), gltf_materials.end())) {
+        const auto value = material_values_.find(material_index);
+        if (value == material_values_.end() || !(value->second.transmission > 0.0f)) continue;
+        // KHR_materials_volume with a thickness says the surface bounds a solid; without the
+        // extension, or with thicknessFactor 0, the specification means a thin wall.
+        const auto& ext = model_.materials[static_cast<size_t>(material_index)].extensions;
+        const Expected<double> thickness = extension_number(ext, "KHR_materials_volume", "thicknessFactor", 0.0);
+        if (!thickness) return fail("material " + std::to_string(material_index) + ": " + thickness.error().message);
+        const bool has_volume = ext.count("KHR_materials_volume") > 0;
+        if (has_volume && *thickness > 0.0) continue;
+        std::vector<const DecodedPrimitive*> parts;
+        for (size_t p = 0; p < decoded.size(); ++p)
+            if (gltf_materials[p] == material_index) parts.push_back(&decoded[p]);
+        if (is_closed_surface(parts)) {
+            // A closed mesh stays a solid that refracts (as its author most likely meant it).
+            if (!has_volume) solid_transmission_materials_.insert(material_index);
+            continue;
+        }
+        const uint32_t thin = thin_walled_material(material_index, decoded[0].material);
+        for (size_t p = 0; p < decoded.size(); ++p)
+            if (gltf_materials[p] == material_index) decoded[p].material = thin;
+    }
     return Status::ok();
 }
 
@@ -199,7 +255,7 @@ Expected<DecodedPrimitive> GltfSceneReader::decode_primitive(const tinygltf::Pri
     Expected<std::vector<glm::uvec3>> triangles = assemble_triangles(prim.mode, *indices, context);
     if (!triangles) return triangles.error();
     out.triangles = std::move(triangles).value();
-    note_dropped_primitive_features(prim, out.positions, out.triangles);
+    note_dropped_primitive_features(prim);
     if (normal_slot >= 0 && out.tangents.empty()) generate_tangents(out, normal_slot);
     return out;
 }

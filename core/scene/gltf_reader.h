@@ -209,8 +209,10 @@ private:
                                   Material& m);
     Status read_clearcoat_and_volume(const tinygltf::Material& g, int material_index, const std::string& context,
                                      Material& m);
-    Status read_clearcoat_textures(const tinygltf::Value& clearcoat, int material_index,
-                                   const std::string& context, Material& m);
+    /// The textureInfo `key` of an extension's object (absent: `target` unchanged), read as
+    /// data (not sRGB).
+    Status read_extension_texture(const tinygltf::Value& extension, const char* extension_name, const char* key,
+                                  int material_index, const std::string& context, TextureRef& target);
     /// The scene texture of glTF texture texture_index read as sRGB colour or as data: its index,
     /// given now; the image is decoded by decode_textures() once the whole file was accepted.
     Expected<int> scene_texture(int texture_index, const std::string& context, const std::string& role,
@@ -227,9 +229,15 @@ private:
     Status visit_node(int node_index, const Mat4& parent, int depth);
     Status add_camera(const tinygltf::Node& node, int node_index, const Mat4& world);
     void add_cameras();
-    void note_dropped_primitive_features(const tinygltf::Primitive& prim,
-                                         const std::vector<Vec3>& positions,
-                                         const std::vector<glm::uvec3>& triangles);
+    void note_dropped_primitive_features(const tinygltf::Primitive& prim);
+    /// Transmissive surfaces of a mesh as solids or thin walls (Material::thin_walled): the
+    /// primitives of one glTF material (`gltf_materials`, parallel to `decoded`) that together
+    /// close no volume are thin walls, where the material has no KHR_materials_volume (or one of
+    /// thicknessFactor 0, the specification's thin wall); closed ones stay solids, noted for
+    /// add_feature_warnings where the file gives no volume.
+    Status assign_thin_walls(std::vector<DecodedPrimitive>& decoded, const std::vector<int>& gltf_materials);
+    /// The thin-walled copy of glTF material material_index's scene material.
+    uint32_t thin_walled_material(int material_index, uint32_t solid);
     void add_feature_warnings();
     Status add_light(const tinygltf::Node& node, int node_index, const Mat4& world);
     Expected<Mat4> local_transform(const tinygltf::Node& node, int node_index) const;
@@ -243,6 +251,8 @@ private:
     bool quantized_ = false;  // KHR_mesh_quantization declared: integer attributes allowed
     std::vector<std::optional<std::vector<DecodedPrimitive>>> meshes_;
     std::map<int, uint32_t> materials_;  // glTF material (-1: default) -> scene material
+    std::map<int, Material> material_values_;  // glTF material -> what was added as scene material
+    std::map<int, uint32_t> thin_materials_;   // glTF material -> its thin-walled scene material
     /// (glTF image, sampler, sRGB) -> scene texture
     std::map<std::tuple<int, int, bool>, int> textures_;
     /// A scene texture handed out and not yet decoded: its image, sampler, curve, and the first

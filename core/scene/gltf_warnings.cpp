@@ -7,26 +7,6 @@
 namespace photond::gltf {
 namespace {
 
-// Every edge of the triangles (vertices welded by position) is shared by exactly two of them.
-bool is_closed_surface(const std::vector<Vec3>& positions,
-                       const std::vector<glm::uvec3>& triangles) {
-    if (triangles.empty()) return false;
-    std::map<std::array<float, 3>, uint32_t> welded;
-    std::vector<uint32_t> vertex(positions.size());
-    for (size_t i = 0; i < positions.size(); ++i)
-        vertex[i] = welded.emplace(std::array<float, 3>{positions[i].x, positions[i].y,
-                                                        positions[i].z},
-                                   static_cast<uint32_t>(welded.size()))
-                        .first->second;
-    std::map<std::pair<uint32_t, uint32_t>, int> edges;
-    for (const glm::uvec3& t : triangles) {
-        const uint32_t v[3] = {vertex[t.x], vertex[t.y], vertex[t.z]};
-        for (int k = 0; k < 3; ++k)
-            ++edges[std::minmax(v[k], v[(k + 1) % 3])];
-    }
-    return std::all_of(edges.begin(), edges.end(), [](const auto& e) { return e.second == 2; });
-}
-
 // "'A', 'B' and 3 more" for a warning naming the materials (or other things) involved.
 std::string name_list(const std::vector<std::string>& names) {
     constexpr size_t kShown = 3;
@@ -39,9 +19,7 @@ std::string name_list(const std::vector<std::string>& names) {
 
 }  // namespace
 
-void GltfSceneReader::note_dropped_primitive_features(const tinygltf::Primitive& prim,
-                                                      const std::vector<Vec3>& positions,
-                                                      const std::vector<glm::uvec3>& triangles) {
+void GltfSceneReader::note_dropped_primitive_features(const tinygltf::Primitive& prim) {
     for (const auto& [name, accessor] : prim.attributes) {
         // COLOR_0 multiplies the base colour; further colour sets are read by nothing.
         if ((name.rfind("COLOR_", 0) == 0 && name != "COLOR_0") || name.rfind("JOINTS_", 0) == 0 ||
@@ -49,17 +27,6 @@ void GltfSceneReader::note_dropped_primitive_features(const tinygltf::Primitive&
             ignored_attributes_.insert(name.substr(0, name.find('_')));
     }
     if (!prim.targets.empty()) ignored_attributes_.insert("morph targets");
-    if (prim.material < 0 || static_cast<size_t>(prim.material) >= model_.materials.size()) return;
-    // KHR_materials_transmission without KHR_materials_volume is thin-walled by the glTF
-    // specification; the renderer takes every transmissive surface as the boundary of a solid
-    // dielectric (as Blender's exporter means a glass sphere). Where that differs (a closed mesh
-    // is solid glass, not a thin shell), say so.
-    const auto& ext = model_.materials[static_cast<size_t>(prim.material)].extensions;
-    const Expected<double> transmission =
-        extension_number(ext, "KHR_materials_transmission", "transmissionFactor", 0.0);
-    if (transmission && *transmission > 0.0 && !ext.count("KHR_materials_volume") &&
-        is_closed_surface(positions, triangles))
-        solid_transmission_materials_.insert(prim.material);
 }
 
 void GltfSceneReader::add_feature_warnings() {

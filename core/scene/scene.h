@@ -99,6 +99,7 @@ struct Material {
     float normal_scale = 1.0f;
     float ior = 1.5f;
     float transmission = 0.0f;   // KHR_materials_transmission factor: solid dielectric
+    TextureRef transmission_texture;  // R multiplies transmission
     float specular = 1.0f;       // KHR_materials_specular factor
     Color specular_color{1.0f};  // KHR_materials_specular colour factor
     Color emission{0.0f};        // emitted radiance: emissiveFactor * emissive_strength
@@ -118,11 +119,15 @@ struct Material {
     AlphaMode alpha_mode = AlphaMode::Opaque;
     float alpha_cutoff = 0.5f;   // MASK: covered where alpha >= cutoff
     bool double_sided = false;   // emits from both faces when true (else the front face only)
+    /// The transmissive surface is a thin wall, not the boundary of a solid (the glTF
+    /// specification's reading of KHR_materials_transmission without a volume; the glTF loader
+    /// gives it to open meshes): light passes straight through, no refraction, no inside.
+    bool thin_walled = false;
 
     bool is_emissive() const { return max_component(emission) > 0.0f; }
     /// Metallic, roughness or the clearcoat vary over the surface: BSDF constants per hit.
     bool varying_bsdf() const {
-        return metallic_roughness_texture.present() || clearcoat_texture.present() ||
+        return metallic_roughness_texture.present() || transmission_texture.present() || clearcoat_texture.present() ||
                clearcoat_roughness_texture.present();
     }
     bool has_volume() const { return max_component(attenuation) > 0.0f; }
@@ -130,7 +135,9 @@ struct Material {
     /// the Beer-Lambert factor of volume_transmittance. Only `path` renders such a solid (a job's
     /// material_media; the protocol refuses it for the other integrators, which take only its
     /// absorption).
-    bool interior_scatters() const { return transmission > 0.0f && max_component(scattering) > 0.0f; }
+    bool interior_scatters() const {
+        return transmission > 0.0f && !thin_walled && max_component(scattering) > 0.0f;
+    }
     /// The medium inside its solid: absorption `attenuation`, scattering, asymmetry.
     HomogeneousMedium interior_medium() const { return {attenuation, scattering, phase_g}; }
     /// Rays may pass its surface (MASK or BLEND): its triangles get Embree's alpha filter.
@@ -139,7 +146,8 @@ struct Material {
     bool textured() const {
         return base_color_texture.present() || metallic_roughness_texture.present() ||
                normal_texture.present() || emissive_texture.present() ||
-               clearcoat_texture.present() || clearcoat_roughness_texture.present();
+               clearcoat_texture.present() || clearcoat_roughness_texture.present() ||
+               transmission_texture.present();
     }
 };
 
@@ -149,6 +157,7 @@ struct MaterialPoint {
     float alpha = 1.0f;
     float metallic = 0.0f;
     float roughness = 1.0f;
+    float transmission = 0.0f;
     float clearcoat = 0.0f;
     float clearcoat_roughness = 0.0f;
 };

@@ -8,7 +8,7 @@ namespace {
 
 // These fire when a field is added to a struct the hashes read: hash the new field (if it affects
 // light transport) in scene_content_hash, then update the size here.
-static_assert(sizeof(Material) == sizeof(std::string) + 304,
+static_assert(sizeof(Material) == sizeof(std::string) + 336,
               "Material changed: hash the new field in scene_content_hash");
 static_assert(sizeof(PunctualLight) == sizeof(std::string) + 56,
               "PunctualLight changed: hash the new field in scene_content_hash");
@@ -100,6 +100,10 @@ Sha256Digest scene_content_hash(const Scene& scene) {
         hash_float(hasher, m.roughness);
         hash_float(hasher, m.ior);
         hash_float(hasher, m.transmission);
+        // Only where present: the hashes of scenes without one stay what they were.
+        if (m.transmission_texture.present()) hash_ref(m.transmission_texture);
+        // Only where set: the hashes of scenes without thin walls stay what they were.
+        if (m.thin_walled) hasher.update_string("thin-walled");
         hash_float(hasher, m.specular);
         hash_vec3(hasher, m.specular_color);
         hash_vec3(hasher, m.emission);

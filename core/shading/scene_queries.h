@@ -50,12 +50,13 @@ inline Ray spawn_ray(const RenderScene& rs, const SurfaceInteraction& si, const 
     return Ray{rs.tracer->offset_origin(si.p, si.geometric_normal, direction), direction};
 }
 
-/// The BSDF at a hit seen from direction wo. Opaque materials are shaded two-sided (normals turned
-/// towards wo); transmissive ones keep the mesh's orientation, so the outside is the front side.
+/// The BSDF at a hit seen from direction wo. Opaque materials and thin walls are shaded two-sided
+/// (normals turned towards wo); transmissive solids keep the mesh's orientation, so the outside is
+/// the front side.
 inline Bsdf make_bsdf(const RenderScene& rs, const SurfaceInteraction& si, const Vec3& wo) {
     const Material& material = rs.scene->materials[si.material];
     Vec3 ng = si.geometric_normal, ns = si.shading_normal;
-    if (material.transmission <= 0.0f && glm::dot(wo, ng) < 0.0f) {
+    if ((material.transmission <= 0.0f || material.thin_walled) && glm::dot(wo, ng) < 0.0f) {
         ng = -ng;
         ns = -ns;
     }
@@ -64,8 +65,9 @@ inline Bsdf make_bsdf(const RenderScene& rs, const SurfaceInteraction& si, const
     const MaterialPoint mp = rs.scene->material_point(si.material, si.tex);
     if (!material.varying_bsdf())
         return Bsdf(rs.bsdf_materials[si.material], mp.base_color, Frame(ns), ng);
-    // Metallic, roughness or the clearcoat vary over the surface: the constants are derived here.
-    BsdfMaterial constants(material, mp.metallic, mp.roughness, mp.clearcoat, mp.clearcoat_roughness);
+    // Metallic, roughness, transmission or the clearcoat vary over the surface: the constants are
+    // derived here.
+    BsdfMaterial constants(material, mp.metallic, mp.roughness, mp.transmission, mp.clearcoat, mp.clearcoat_roughness);
     // Glossy caustics come only off materials sharp all over (RenderScene::sharp_glossy_materials).
     constants.sharp_glossy = constants.sharp_glossy && rs.sharp_glossy_materials[si.material];
     return Bsdf(std::move(constants), mp.base_color, Frame(ns), ng);

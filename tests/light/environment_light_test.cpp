@@ -275,6 +275,57 @@ TEST(EnvironmentLight, ConvexLambertianUnderUniformSkyIsAlbedoTimesRadiance) {
     }
 }
 
+TEST(EnvironmentLight, ThinWallsUnderAUniformSkyKeepItsRadiance) {
+    // White thin walls (Material::thin_walled: air on both sides) reflect F of the sky and pass
+    // the rest of it straight through: L = F L + (1 - F) L whatever they are crossed at. Two
+    // panes one behind the other, smooth and rough (GGX alpha 0.04: its mirrored lobe loses
+    // under 0.1 %). As solids that never closed (refraction into glass with 1/eta^2 at each
+    // crossing) they were 0.44 L and darker behind each other.
+    Environment sky;
+    sky.color = Color(0.5f, 1.0f, 2.0f);
+    SceneBuilder builder("thin walls under a sky");
+    for (const auto& [z, roughness] : {std::pair{0.0f, 0.0f}, std::pair{-1.0f, 0.2f}}) {
+        Material wall;
+        wall.base_color = Color(1.0f);
+        wall.metallic = 0.0f;
+        wall.roughness = roughness;
+        wall.transmission = 1.0f;
+        wall.ior = 1.5f;
+        wall.thin_walled = true;
+        const uint32_t m = builder.add_material(wall);
+        const Vec3 positions[4] = {{-2, -2, z}, {2, -2, z}, {2, 2, z}, {-2, 2, z}};
+        const glm::uvec3 triangles[2] = {{0, 1, 2}, {0, 2, 3}};
+        ASSERT_TRUE(builder.add_mesh(positions, {}, {}, triangles, m).is_ok());
+    }
+    Scene scene = builder.build().value();
+    scene.environment = sky;
+    auto rs = make_render_scene(std::move(scene));
+
+    // Not `direct`: its shadow rays stop at glass, so the rough pane's lobes see no sky through
+    // the other pane.
+    const PathIntegrator path(rs);
+    PhotonTracingSettings tracing;
+    tracing.global_photons = 20000;
+    tracing.caustic_photons = 20000;
+    auto maps = trace_photons(*rs, tracing);
+    ASSERT_TRUE(maps) << maps.error().message;
+    PhotonMapIntegratorSettings settings;
+    settings.use_irradiance_cache = false;
+    settings.gather.rays = 64;
+    const PhotonMapIntegrator photon_map(rs, std::make_shared<const PhotonMaps>(std::move(maps).value()), settings);
+    for (const Integrator* integrator : std::initializer_list<const Integrator*>{&path, &photon_map}) {
+        for (const Vec3 eye : {Vec3(0, 0, 5), Vec3(2, 1, 3), Vec3(-0.5f, 0.3f, -4)}) {
+            CameraRay ray;
+            ray.origin = eye;
+            ray.direction = glm::normalize(Vec3(0.1f, 0.2f, -0.5f) - eye);
+            const Color L = mean_radiance(*integrator, ray, 4000, 5);
+            for (int c = 0; c < 3; ++c)
+                EXPECT_NEAR(L[c] / sky.color[c], 1.0, 0.01) << integrator->name() << " from " << eye.x << ","
+                                                            << eye.y << "," << eye.z << " channel " << c;
+        }
+    }
+}
+
 /// A 200 x 200 plane at y = 0 facing +y, albedo rho.
 Scene plane_scene(float rho) {
     SceneBuilder builder("plane");

@@ -36,6 +36,12 @@ Material make_material(float metallic, float roughness, float transmission = 0.0
     return m;
 }
 
+/// m as a thin wall (Material::thin_walled).
+Material thin(Material m) {
+    m.thin_walled = true;
+    return m;
+}
+
 /// A Bsdf of m; its BsdfMaterial is kept for the rest of the test program (a Bsdf refers to it).
 /// For the single-threaded test bodies only.
 Bsdf make_bsdf(const Material& m, const Color& c, const Vec3& n = Vec3(0, 0, 1)) {
@@ -105,6 +111,12 @@ const Chi2Case kChi2Cases[] = {
     {"MixtureGlossyMask", make_material(0.5f, 0.3f, 0.5f, 1.5f), Color(0.8f, 0.5f, 0.3f), 60.0,
      TransportMode::Radiance, mask_of(LobeKind::Glossy)},
     {"SmoothPlasticWithDelta", make_material(0.0f, 0.0f), Color(0.6f), 60.0,
+     TransportMode::Radiance, kAllLobes},
+    {"ThinRoughWallFromFront", thin(make_material(0.0f, 0.3f, 1.0f, 1.5f)), Color(0.9f, 0.6f, 0.3f), 40.0,
+     TransportMode::Radiance, kAllLobes},
+    {"ThinRoughWallFromBack", thin(make_material(0.0f, 0.5f, 1.0f, 1.5f)), Color(1.0f), 180.0 - 60.0,
+     TransportMode::Importance, kAllLobes},
+    {"ThinMixture", thin(make_material(0.3f, 0.45f, 0.6f, 1.33f)), Color(0.8f, 0.5f, 0.3f), 70.0,
      TransportMode::Radiance, kAllLobes},
 };
 constexpr int kChi2CaseCount = static_cast<int>(std::size(kChi2Cases));
@@ -307,8 +319,11 @@ TEST(BsdfFurnace, NoDirectionReflectsMoreThanItReceives) {
                 for (float specular : {0.0f, 1.0f}) {
                     for (float ior : {1.0f, 1.5f, 3.0f}) {
                         for (Color specular_color : {Color(1.0f), Color(3.0f, 1.0f, 0.2f)}) {
-                            const Material m = make_material(metallic, roughness, transmission, ior,
-                                                             specular, specular_color);
+                          for (bool thin_wall : {false, true}) {
+                            if (thin_wall && !(transmission > 0.0f)) continue;
+                            Material m = make_material(metallic, roughness, transmission, ior,
+                                                       specular, specular_color);
+                            m.thin_walled = thin_wall;
                             const Bsdf bsdf = make_bsdf(m, Color(1.0f));
                             std::vector<double> angles = {0.0, 45.0, 75.0, 88.0};
                             if (transmission > 0.0f) {
@@ -321,7 +336,8 @@ TEST(BsdfFurnace, NoDirectionReflectsMoreThanItReceives) {
                                 std::vector<TransportMode> modes = {TransportMode::Importance};
                                 // Radiance mode only scales refraction into wo's side by
                                 // (n_o / n_i)^2 <= 1 from outside; from inside it exceeds 1.
-                                if (theta < 90.0) modes.push_back(TransportMode::Radiance);
+                                // A thin wall has air on both sides: no scaling.
+                                if (theta < 90.0 || thin_wall) modes.push_back(TransportMode::Radiance);
                                 for (TransportMode mode : modes) {
                                     const Albedo a =
                                         estimate_albedo(bsdf, wo, mode, 2000, ++stream);
@@ -332,10 +348,12 @@ TEST(BsdfFurnace, NoDirectionReflectsMoreThanItReceives) {
                                             << transmission << " roughness " << roughness
                                             << " specular " << specular << " ior " << ior
                                             << " specular_color.x " << specular_color.x
-                                            << " theta_o " << theta << " channel " << ch;
+                                            << " theta_o " << theta << " thin " << thin_wall
+                                            << " channel " << ch;
                                     }
                                 }
                             }
+                          }
                         }
                     }
                 }
@@ -453,11 +471,12 @@ TEST(BsdfFurnace, RoughLobesReadAsDiffuseReflectTheirAlbedo) {
 
 TEST(BsdfReciprocity, ReflectionIsSymmetricAndTransmissionAdjoint) {
     Rng rng = Rng::for_stream(42, 0);
-    int reflections = 0, transmissions = 0;
+    int reflections = 0, transmissions = 0, thin_transmissions = 0;
     for (int trial = 0; trial < 20000; ++trial) {
-        const Material m = make_material(rng.next_float(), 0.05f + 0.95f * rng.next_float(),
-                                         rng.next_float() < 0.5f ? 0.0f : rng.next_float(),
-                                         1.0f + 2.0f * rng.next_float(), rng.next_float());
+        Material m = make_material(rng.next_float(), 0.05f + 0.95f * rng.next_float(),
+                                   rng.next_float() < 0.5f ? 0.0f : rng.next_float(),
+                                   1.0f + 2.0f * rng.next_float(), rng.next_float());
+        m.thin_walled = rng.next_float() < 0.3f;
         const Color c(rng.next_float(), rng.next_float(), rng.next_float());
         // A shading normal tilted away from the geometric one.
         const Vec3 ng(0, 0, 1);
@@ -487,10 +506,18 @@ TEST(BsdfReciprocity, ReflectionIsSymmetricAndTransmissionAdjoint) {
             for (int ch = 0; ch < 3; ++ch) {
                 ASSERT_NEAR(f[ch], g[ch], 1e-3f * std::max(f[ch], 1.0f)) << "trial " << trial;
             }
+            // A thin wall's transmission is symmetric too: air on both sides.
+            if (m.thin_walled && m.transmission > 0.0f && m.metallic < 1.0f) {
+                const Color h = bsdf.eval(wi, wo, TransportMode::Radiance);
+                for (int ch = 0; ch < 3; ++ch)
+                    ASSERT_NEAR(f[ch], h[ch], 1e-3f * std::max(f[ch], 1.0f)) << "trial " << trial;
+                ++thin_transmissions;
+            }
         }
     }
     EXPECT_GT(reflections, 1000);
     EXPECT_GT(transmissions, 100);
+    EXPECT_GT(thin_transmissions, 100);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -584,6 +611,53 @@ TEST(BsdfSmoothDielectric, TintAndIndexOneArePassThrough) {
     EXPECT_TRUE(lobes[0].is_transmission);
     EXPECT_NEAR(glm::length(lobes[0].wi + wo), 0.0f, 1e-5f);
     EXPECT_NEAR(glm::length(lobes[0].weight - c), 0.0f, 1e-5f);
+}
+
+TEST(BsdfThinWall, SmoothWallPassesLightStraightThroughByFresnel) {
+    // Air on both sides: the mirror takes F(theta) for a 1 -> ior interface from either side
+    // (no total internal reflection), the rest passes unbent, tinted, and with no 1/eta^2.
+    constexpr double kIor = 1.5;
+    const Color c(0.9f, 0.5f, 0.2f);
+    const Bsdf wall = make_bsdf(thin(make_material(0.0f, 0.0f, 1.0f, kIor)), c);
+    EXPECT_EQ(wall.lobes(), mask_of(LobeKind::Delta));
+    for (double theta : {0.0, 50.0, 80.0, 180.0 - 30.0, 180.0 - 70.0}) {
+        SCOPED_TRACE(testing::Message() << "theta " << theta);
+        const Vec3 wo = direction(theta, 0.4);
+        const double fresnel = exact_fresnel(std::abs(std::cos(theta * kPiD / 180.0)), 1.0, kIor);
+        for (TransportMode mode : {TransportMode::Radiance, TransportMode::Importance}) {
+            std::array<BsdfSample, 2> lobes;
+            ASSERT_EQ(wall.delta_lobes(wo, lobes, mode), 2);
+            EXPECT_NEAR(lobes[0].weight.x, fresnel, 1e-5);
+            const BsdfSample& t = lobes[1];
+            EXPECT_TRUE(t.is_transmission);
+            EXPECT_EQ(t.eta, 1.0f);
+            EXPECT_NEAR(glm::length(t.wi + wo), 0.0f, 1e-5f);  // straight through
+            for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(t.weight[ch], (1.0 - fresnel) * c[ch], 1e-5);
+        }
+    }
+}
+
+TEST(BsdfThinWall, RoughWallSendsWhatTheMirrorLobeWouldThroughTheWall) {
+    // A rough thin wall of ior 1 reflects nothing: it transmits the whole GGX lobe mirrored
+    // through the surface, so its albedo equals that of a rough metal of F0 = 1 (the same lobe,
+    // Fresnel 1), from either side; at ior 1.5 reflection and transmission together hold as
+    // much, the split set by Fresnel.
+    for (float roughness : {0.2f, 0.5f, 0.9f}) {
+        const Bsdf mirror_lobe = make_bsdf(make_material(1.0f, roughness), Color(1.0f));
+        const Bsdf clear_wall = make_bsdf(thin(make_material(0.0f, roughness, 1.0f, 1.0f)), Color(1.0f));
+        const Bsdf glass_wall = make_bsdf(thin(make_material(0.0f, roughness, 1.0f, 1.5f)), Color(1.0f));
+        for (double theta : {10.0, 60.0}) {
+            SCOPED_TRACE(testing::Message() << "roughness " << roughness << " theta " << theta);
+            const Albedo metal = estimate_albedo(mirror_lobe, direction(theta, 0.3), TransportMode::Radiance, 20000, 7);
+            for (double side : {theta, 180.0 - theta}) {
+                const Albedo clear = estimate_albedo(clear_wall, direction(side, 0.3), TransportMode::Radiance, 20000, 8);
+                const Albedo glass = estimate_albedo(glass_wall, direction(side, 0.3), TransportMode::Radiance, 20000, 9);
+                EXPECT_NEAR(clear.mean.x, metal.mean.x, 3.0f * (clear.sigma.x + metal.sigma.x) + 1e-3f);
+                EXPECT_NEAR(glass.mean.x, metal.mean.x, 3.0f * (glass.sigma.x + metal.sigma.x) + 1e-3f);
+                EXPECT_GT(clear.mean.x, 0.4f);  // not nothing: GGX alone at alpha 0.81 keeps 0.42
+            }
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -294,9 +294,30 @@ TEST(GltfLoader, UnsupportedFeaturesAreWarnedAboutByName) {
 TEST(GltfLoader, ClosedTransmissiveMeshWithoutVolumeIsWarnedAbout) {
     const Scene scene = load_ok("transmission.gltf");
     EXPECT_TRUE(has_warning(scene, "KHR_materials_transmission without KHR_materials_volume on a "
-                                   "closed mesh (material 'BoxGlass')"))
+                                   "closed mesh (materials 'BoxGlass' and 'SplitGlass')"))
         << all_warnings(scene);
     EXPECT_FALSE(has_warning(scene, "PaneGlass")) << all_warnings(scene);  // an open pane
+}
+
+TEST(GltfLoader, OpenTransmissiveMeshesAreThinWalls) {
+    // The materials of transmission.gltf's triangles, by mesh: 12 of the box, 2 of the pane, 12
+    // of the box split into two primitives (closed together), 2 of the pane whose volume has
+    // thicknessFactor 0.
+    const Scene scene = load_ok("transmission.gltf");
+    ASSERT_EQ(scene.triangles.size(), 28u);
+    const auto material_of = [&](size_t triangle) { return scene.materials[scene.triangle_materials[triangle]]; };
+    for (size_t t = 0; t < 28; ++t) {
+        const Material& m = material_of(t);
+        SCOPED_TRACE(testing::Message() << "triangle " << t << " material '" << m.name << "'");
+        EXPECT_FLOAT_EQ(m.transmission, 1.0f);
+        const bool thin = (t >= 12 && t < 14) || t >= 26;
+        EXPECT_EQ(m.thin_walled, thin);
+        EXPECT_EQ(m.name, t < 12 ? "BoxGlass" : t < 14 ? "PaneGlass" : t < 26 ? "SplitGlass" : "ThinVolumePane");
+        // A thin wall has no inside to attenuate in.
+        if (thin) {
+            EXPECT_FALSE(m.has_volume());
+        }
+    }
 }
 
 TEST(GltfLoader, PhotometricLightsAsBlenderWritesThem) {
@@ -352,10 +373,12 @@ TEST(GltfLoader, MeshoptCompressedCopiesHoldTheSameGeometry) {
 TEST(GltfLoader, MaterialsWithExtensionsAndDefaults) {
     const Scene scene = load_ok("materials.gltf");
     ASSERT_EQ(scene.triangles.size(), 3u);
-    ASSERT_EQ(scene.materials.size(), 3u);
+    // The three, and the thin-walled copy of the transmissive one, whose triangle is open.
+    ASSERT_EQ(scene.materials.size(), 4u);
 
     const Material& m = scene.materials[scene.triangle_materials[0]];
     EXPECT_EQ(m.name, "Everything");
+    EXPECT_TRUE(m.thin_walled);
     expect_vec_near(m.base_color, {0.5f, 0.25f, 0.125f});
     EXPECT_FLOAT_EQ(m.metallic, 0.3f);
     EXPECT_FLOAT_EQ(m.roughness, 0.7f);

@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "core/integrators/integrator.h"
+#include "core/material/fresnel.h"
 #include "core/scene/gltf_loader.h"
 #include "tests/support/render_fixtures.h"
 
@@ -236,6 +237,33 @@ TEST(EightBitTexels, ReadThroughTheirCurveAndMipLikeTheirFloatTwin) {
             for (const float lod : {0.0f, 0.4f, 1.0f, 2.5f}) EXPECT_EQ(packed.sample_rgba(uv, lod), twin.sample_rgba(uv, lod));
         }
     }
+}
+
+TEST(TransmissionTexture, RedTimesTheFactorDecidesWhereLightPassesThrough) {
+    auto rs = test_support::make_render_scene(load("transmission_texture.gltf"));
+    const Scene& scene = *rs->scene;
+    ASSERT_TRUE(scene.materials[scene.triangle_materials[0]].transmission_texture.present());
+    EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.front();
+    // Left texel R 255: transmission 0.8; right texel R 0: an opaque smooth plastic.
+    const SurfaceInteraction clear = hit_at(*rs, 0.25f, 0.5f), opaque = hit_at(*rs, 0.75f, 0.5f);
+    EXPECT_NEAR(scene.material_point(clear.material, clear.tex).transmission, 0.8f, 1e-6f);
+    EXPECT_NEAR(scene.material_point(opaque.material, opaque.tex).transmission, 0.0f, 1e-6f);
+    const Vec3 wo = glm::normalize(Vec3(0.2f, 0.1f, 1.0f));
+    std::array<BsdfSample, 2> lobes;
+    const Bsdf through = make_bsdf(*rs, clear, wo), solid = make_bsdf(*rs, opaque, wo);
+    ASSERT_EQ(through.delta_lobes(wo, lobes), 2);
+    EXPECT_TRUE(lobes[1].is_transmission);
+    // 0.8 of the dielectric passes (1 - F) of the light, tinted by the base colour 0.5.
+    // An open quad: a thin wall, no 1/eta^2.
+    EXPECT_NEAR(lobes[1].weight.x, 0.8f * 0.5f * (1.0f - fresnel_dielectric(wo.z, 1.5f)), 1e-5f);
+    EXPECT_TRUE(through.lobes() & mask_of(LobeKind::Diffuse));  // the other 0.2: plastic
+    ASSERT_EQ(solid.delta_lobes(wo, lobes), 1);
+    EXPECT_FALSE(lobes[0].is_transmission);
+    EXPECT_TRUE(solid.lobes() & mask_of(LobeKind::Diffuse));
+    // The plan's lobes hold both texels' kinds.
+    const LobeMask possible = possible_lobes(scene, scene.materials[scene.triangle_materials[0]]);
+    EXPECT_TRUE(possible & mask_of(LobeKind::Delta));
+    EXPECT_TRUE(possible & mask_of(LobeKind::Diffuse));
 }
 
 TEST(Extensions, ClearcoatAndVolumeAreRead) {

@@ -357,6 +357,24 @@ def material_textures():
     single_mesh_scene(b, [{"attributes": {"POSITION": pos, "NORMAL": nrm, "TEXCOORD_0": uv},
                            "indices": idx, "material": 0}], "MetalRoughQuad")
     write("metallic_roughness.gltf", b.finish())
+    # KHR_materials_transmission's transmissionTexture: R multiplies transmissionFactor 0.8, stored
+    # linearly; left texel clear (R 255), right texel opaque (R 0); smooth, on an open quad.
+    b = Builder()
+    pos = b.floats(QUAD_POSITIONS, "VEC3")
+    nrm = b.floats([0, 0, 1] * 4, "VEC3")
+    uv = b.floats(QUAD_UVS, "VEC2")
+    idx = b.indices(QUAD_INDICES, U16)
+    b.doc["extensionsUsed"] = ["KHR_materials_transmission"]
+    b.doc["images"] = [{"uri": png_data_uri(png_rgba(2, 1, [[(255, 0, 0, 255), (0, 255, 255, 255)]]))}]
+    b.doc["samplers"] = [{"magFilter": 9728}]  # NEAREST
+    b.doc["textures"] = [{"source": 0, "sampler": 0}]
+    b.doc["materials"] = [{"name": "PartlyClear", "pbrMetallicRoughness": {
+        "baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0.0, "roughnessFactor": 0.0},
+        "extensions": {"KHR_materials_transmission": {"transmissionFactor": 0.8,
+                                                      "transmissionTexture": {"index": 0}}}}]
+    single_mesh_scene(b, [{"attributes": {"POSITION": pos, "NORMAL": nrm, "TEXCOORD_0": uv},
+                           "indices": idx, "material": 0}], "PartlyClearQuad")
+    write("transmission_texture.gltf", b.finish())
 
     # KHR_texture_transform (required) on a 2x2 colour texture; the second material reads
     # TEXCOORD_1 through the extension's texCoord override, with CLAMP_TO_EDGE / MIRRORED_REPEAT.
@@ -729,21 +747,35 @@ def warnings_file():
 
 
 def transmission():
-    """A closed glass box and an open glass pane, both KHR_materials_transmission without
-    KHR_materials_volume: only the box is worth a warning (solid glass, not thin-walled)."""
+    """KHR_materials_transmission surfaces as solids or thin walls: a closed glass box and an open
+    glass pane without KHR_materials_volume (the box is solid glass, worth a warning; the pane a
+    thin wall), a box split into two primitives of one material (closed together: solid), and an
+    open pane with KHR_materials_volume of thicknessFactor 0 (the specification's thin wall: its
+    attenuation has no inside to act in)."""
     b = Builder()
-    b.doc["extensionsUsed"] = ["KHR_materials_transmission"]
+    b.doc["extensionsUsed"] = ["KHR_materials_transmission", "KHR_materials_volume"]
     glass = {"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "roughnessFactor": 0},
              "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1}}}
-    b.doc["materials"] = [dict(glass, name="BoxGlass"), dict(glass, name="PaneGlass")]
+    thin_volume = {"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "roughnessFactor": 0},
+                   "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1},
+                                  "KHR_materials_volume": {"thicknessFactor": 0, "attenuationDistance": 1,
+                                                           "attenuationColor": [0.5, 0.5, 0.5]}}}
+    b.doc["materials"] = [dict(glass, name="BoxGlass"), dict(glass, name="PaneGlass"),
+                          dict(glass, name="SplitGlass"), dict(thin_volume, name="ThinVolumePane")]
     bp, bn, bi = box_mesh()
     box = mesh_primitive(b, bp, bn, bi, 0)
     pane = mesh_primitive(b, [[0, 0, 2], [1, 0, 2], [1, 1, 2], [0, 1, 2]], [[0, 0, 1]] * 4,
                           QUAD_INDICES, 1)
+    moved = [[x + 3, y, z] for x, y, z in bp]
+    halves = [mesh_primitive(b, moved, bn, bi[:18], 2), mesh_primitive(b, moved, bn, bi[18:], 2)]
+    thin_pane = mesh_primitive(b, [[0, 0, 4], [1, 0, 4], [1, 1, 4], [0, 1, 4]], [[0, 0, 1]] * 4,
+                               QUAD_INDICES, 3)
     b.doc["meshes"] = [{"name": "GlassBox", "primitives": [box]},
-                       {"name": "GlassPane", "primitives": [pane]}]
-    b.doc["nodes"] = [{"mesh": 0}, {"mesh": 1}]
-    b.doc["scenes"] = [{"nodes": [0, 1]}]
+                       {"name": "GlassPane", "primitives": [pane]},
+                       {"name": "SplitBox", "primitives": halves},
+                       {"name": "ThinVolumePane", "primitives": [thin_pane]}]
+    b.doc["nodes"] = [{"mesh": 0}, {"mesh": 1}, {"mesh": 2}, {"mesh": 3}]
+    b.doc["scenes"] = [{"nodes": [0, 1, 2, 3]}]
     write("transmission.gltf", b.finish())
 
 

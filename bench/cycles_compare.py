@@ -1,0 +1,141 @@
+#!/usr/bin/env python3
+"""photond against another renderer: every Khronos sample model of tests/data/gltf-samples
+rendered by Blender's Cycles (bench/cycles_render.py, Debian's `blender`) and by photond with the
+same camera, the same uniform sky of radiance 1 and the same pixel filter, 256 x 256; photond's
+`final` (photon-map) and a `path` render, each compared with Cycles: the image mean's bias, the
+relMSE, and the 32 x 32 blocks' relMSE (which shows where the images differ, not only how much).
+
+    python3 bench/cycles_compare.py --photond build/server/photond [--cycles-spp 1024]
+        [--path-spp 256] [--models A,B] [--out DIR] [--keep DIR]
+
+Writes DIR/cycles_compare.md and .csv (default bench/results) and prints the table. Needs
+`blender` (Debian 12's 3.4) and python3-numpy, which its glTF importer imports; `make
+cycles-compare` installs both. The two renderers take the glTF material each its own way (Cycles
+through the importer's Principled BSDF: a Disney diffuse, its own clearcoat and sheen; photond
+as the glTF specification writes it), so a few percent apart is agreement; a model far apart, or
+one block far apart, is a place to look.
+"""
+import argparse
+import csv
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SAMPLES = os.path.join(ROOT, "tests", "data", "gltf-samples")
+CYCLES_SCRIPT = os.path.join(ROOT, "bench", "cycles_render.py")
+SIZE = 256
+
+
+def run(command, env=None):
+    start = time.monotonic()
+    result = subprocess.run(command, capture_output=True, text=True, env=env)
+    if result.returncode != 0:
+        sys.exit(f"{' '.join(command)} failed:\n{result.stdout[-4000:]}{result.stderr[-4000:]}")
+    return time.monotonic() - start
+
+
+def cycles(blender, scene, exr, camera_json, spp, seed):
+    # Blender's Python takes its prefix from the first python3.x on the PATH: the system's, next
+    # to blender, and not a python3 of another installation (pyenv, a virtualenv) without numpy.
+    env = dict(os.environ, PATH=os.path.dirname(os.path.realpath(blender)) + os.pathsep + os.environ.get("PATH", ""))
+    return run([blender, "-b", "--factory-startup", "-noaudio", "--python-exit-code", "1", "-P", CYCLES_SCRIPT, "--",
+                scene, exr, camera_json, "--size", str(SIZE), "--spp", str(spp), "--seed", str(seed), "--sky", "1"],
+               env=env)
+
+
+def photond_render(photond, scene, exr, job, extra):
+    return run([photond, "render", scene, "--job", job, "--width", str(SIZE), "--height", str(SIZE), "--quiet",
+                "--set", "output.pixel_type=float", "-o", exr] + extra)
+
+
+def compare(photond, exr, reference, block=None):
+    command = [photond, "compare", "--json", exr, reference]
+    if block:
+        command += ["--block", str(block)]
+    result = subprocess.run(command, capture_output=True, text=True)
+    if result.returncode != 0:
+        sys.exit(f"compare failed: {result.stdout}{result.stderr}")
+    return json.loads(result.stdout)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--photond", default=os.path.join(ROOT, "build", "server", "photond"))
+    parser.add_argument("--blender", default=shutil.which("blender") or "blender")
+    parser.add_argument("--cycles-spp", type=int, default=1024)
+    parser.add_argument("--path-spp", type=int, default=256)
+    parser.add_argument("--models", default="", help="comma-separated model names (default: all)")
+    parser.add_argument("--out", default=os.path.join(ROOT, "bench", "results"))
+    parser.add_argument("--keep", default="", help="keep the EXRs and cameras in this directory")
+    args = parser.parse_args()
+
+    names = sorted(d for d in os.listdir(SAMPLES) if os.path.isdir(os.path.join(SAMPLES, d)))
+    if args.models:
+        names = [n for n in names if n in args.models.split(",")]
+    work = args.keep or tempfile.mkdtemp(prefix="cycles_compare_")
+    os.makedirs(work, exist_ok=True)
+    rows = []
+    for name in names:
+        scene = os.path.join(SAMPLES, name, "glTF", name + ".gltf")
+        camera = os.path.join(work, name + ".camera.json")
+        with open(camera, "w") as f:
+            json.dump({"auto": True}, f)  # cycles_render.py frames the bounds and writes the camera
+        reference = os.path.join(work, name + ".cycles.exr")
+        cycles_s = cycles(args.blender, scene, reference, camera, args.cycles_spp, 1)
+        with open(camera) as f:
+            # The sky is given, not left to the default: a model with lights of its own renders
+            # without the default sky, and Cycles' world is there in every render.
+            job = {"camera": json.load(f), "environment": {"color": [1, 1, 1]}}
+        job_path = os.path.join(work, name + ".job.json")
+        with open(job_path, "w") as f:
+            json.dump(job, f)
+        final_exr = os.path.join(work, name + ".final.exr")
+        final_s = photond_render(args.photond, scene, final_exr, job_path, ["--preset", "final"])
+        path_exr = os.path.join(work, name + ".path.exr")
+        path_s = photond_render(args.photond, scene, path_exr, job_path,
+                                ["--integrator", "path", "--spp", str(args.path_spp)])
+        row = {"model": name, "cycles_spp": args.cycles_spp, "cycles_s": round(cycles_s, 1),
+               "final_s": round(final_s, 2), "path_s": round(path_s, 1)}
+        for tag, exr in (("final", final_exr), ("path", path_exr)):
+            pixels = compare(args.photond, exr, reference)
+            blocks = compare(args.photond, exr, reference, block=32)
+            row[f"{tag}_bias_pct"] = round(100.0 * pixels["bias"], 2)
+            row[f"{tag}_relmse"] = float(f"{pixels['relmse']:.3g}")
+            row[f"{tag}_block_relmse"] = float(f"{blocks['relmse']:.3g}")
+        row["cycles_mean"] = float(f"{pixels['reference_mean']:.4g}")
+        rows.append(row)
+        print(json.dumps(row), flush=True)
+
+    os.makedirs(args.out, exist_ok=True)
+    with open(os.path.join(args.out, "cycles_compare.csv"), "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+        writer.writeheader()
+        writer.writerows(rows)
+    lines = [f"photond against Cycles (Blender {blender_version(args.blender)}, {args.cycles_spp} spp), "
+             f"{SIZE}x{SIZE}, uniform sky of radiance 1, measured {time.strftime('%Y-%m-%d %H:%M')}",
+             "",
+             "| model | Cycles mean | final: bias | relMSE | 32² blocks' relMSE | path "
+             f"{args.path_spp} spp: bias | relMSE | 32² blocks' relMSE |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        lines.append(f"| {r['model']} | {r['cycles_mean']} | {r['final_bias_pct']:+.2f} % | {r['final_relmse']} | "
+                     f"{r['final_block_relmse']} | {r['path_bias_pct']:+.2f} % | {r['path_relmse']} | "
+                     f"{r['path_block_relmse']} |")
+    with open(os.path.join(args.out, "cycles_compare.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
+def blender_version(blender):
+    result = subprocess.run([blender, "--version"], capture_output=True, text=True)
+    first = result.stdout.splitlines()[0] if result.stdout else "?"
+    return first.replace("Blender ", "").strip()
+
+
+if __name__ == "__main__":
+    main()
