@@ -2,6 +2,9 @@
 // pixel-footprint-based spacing (irradiance cache, photon radii).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
+
 #include "core/math/vec.h"
 #include "core/scene/scene.h"
 #include "core/util/expected.h"
@@ -20,7 +23,18 @@ struct CameraRay {
     /// for an orthographic camera. A pixel's footprint at distance t is about
     /// pixel_width + t * (spread of the direction differentials).
     float pixel_width = 0.0f;
+    /// The share of the pixel's footprint a texture lookup filters over (mip-map level): the
+    /// pixel's n samples, spread over it, average the texture themselves, so each takes
+    /// max(1/8, 1/sqrt(n)) of the footprint (as pbrt-v4 scales its ray differentials); a
+    /// whole-pixel footprint under 16 samples blurred textures about twice a pixel wide. Set
+    /// by the tile renderer; 1 for one sample.
+    float texture_footprint_scale = 1.0f;
 };
+
+/// CameraRay::texture_footprint_scale for a pixel of `spp` samples.
+inline float texture_footprint_scale(int spp) {
+    return spp > 1 ? std::max(0.125f, 1.0f / std::sqrt(static_cast<float>(spp))) : 1.0f;
+}
 
 class Camera {
 public:

@@ -8,7 +8,7 @@ DirectIntegrator::DirectIntegrator(std::shared_ptr<const RenderScene> scene, int
     : scene_(std::move(scene)), max_specular_depth_(max_specular_depth) {}
 
 RadianceParts DirectIntegrator::radiance_parts(const CameraRay& ray, SampleContext& context) const {
-    return radiance_along(primary_ray(ray), 0, context, 0.0f, pixel_spread(ray));
+    return radiance_along(primary_ray(ray), 0, context, 0.0f, pixel_spread(ray) * ray.texture_footprint_scale);
 }
 
 RadianceParts DirectIntegrator::radiance_along(const Ray& ray, int depth, SampleContext& context,

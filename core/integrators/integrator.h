@@ -115,10 +115,15 @@ inline float pixel_spread(const CameraRay& ray) {
 struct RayFootprint {
     float width = 0.0f;
     float spread = 0.0f;
+    float texture_scale = 1.0f;  // CameraRay::texture_footprint_scale
     float at(float distance) const { return width + distance * spread; }
+    /// The footprint a texture lookup filters over there.
+    float texture_at(float distance) const { return texture_scale * at(distance); }
 };
 
-inline RayFootprint camera_footprint(const CameraRay& ray) { return {ray.pixel_width, pixel_spread(ray)}; }
+inline RayFootprint camera_footprint(const CameraRay& ray) {
+    return {ray.pixel_width, pixel_spread(ray), ray.texture_footprint_scale};
+}
 
 /// The ray of a camera sample: from the camera itself, which RayTracer::intersect puts on the front
 /// side of a surface it lies on (so a camera on a floor sees the room, and the floor below it).

@@ -25,7 +25,7 @@ RadianceParts PathIntegrator::radiance_parts(const CameraRay& camera_ray, Sample
     Vec3 previous_point = camera_ray.origin;
     // The camera's ray cone picks texture levels along the camera ray and ideal specular bounces
     // after it; after a rough bounce the path is an integral over directions, textures at level 0.
-    const float spread = pixel_spread(camera_ray);
+    const float spread = pixel_spread(camera_ray) * camera_ray.texture_footprint_scale;
     float cone_length = 0.0f;
     bool cone_alive = true;
 

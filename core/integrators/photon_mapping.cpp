@@ -268,7 +268,7 @@ RadianceParts PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, flo
     const std::optional<Hit> hit = trace_ray(rs, ray, context.counters);
     std::optional<SurfaceInteraction> hit_point;
     // The camera's ray cone, widened along ideal specular bounces, picks the texture level.
-    if (hit) hit_point = make_interaction(*rs.scene, *hit, ray.direction, footprint.at(path_length + hit->t));
+    if (hit) hit_point = make_interaction(*rs.scene, *hit, ray.direction, footprint.texture_at(path_length + hit->t));
     RadianceParts radiance = surface_radiance(ray, hit_point ? &*hit_point : nullptr, depth, path_length, footprint, context);
     // Inside a solid that scatters, all its light comes from the volume map (light samples from
     // inside are blocked by its surface); surface_radiance attenuated what lies beyond.

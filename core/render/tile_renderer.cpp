@@ -35,6 +35,7 @@ TileRenderResult render_tiles(const Integrator& integrator, const Camera& camera
     const PixelRect area = settings.region ? settings.region->intersect(frame) : frame;
     const std::vector<PixelRect> tiles = make_tiles(area, settings.tile_size);
     const int spp = std::max(settings.samples_per_pixel, 1);
+    const float texture_scale = texture_footprint_scale(spp);
 
     TileRenderResult result;
     ImageLayers& layers = result.layers;
@@ -64,8 +65,9 @@ TileRenderResult render_tiles(const Integrator& integrator, const Camera& camera
                     Rng rng = Rng::for_stream(settings.seed, pixel, static_cast<uint64_t>(s));
                     SampleContext context{rng, local, pattern_seed, static_cast<uint32_t>(s)};
                     const Vec2 jitter = context.next_2d();
-                    const CameraRay ray = camera.generate_ray(static_cast<float>(x) + jitter.x,
-                                                              static_cast<float>(y) + jitter.y);
+                    CameraRay ray = camera.generate_ray(static_cast<float>(x) + jitter.x,
+                                                        static_cast<float>(y) + jitter.y);
+                    ray.texture_footprint_scale = texture_scale;
                     const RadianceParts parts = integrator.radiance_parts(ray, context);
                     const Color& L = parts.total;
                     // A non-finite sample (a numerical failure) is dropped rather than poisoning

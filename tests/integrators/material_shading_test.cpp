@@ -13,6 +13,7 @@
 #include "core/integrators/direct.h"
 #include "core/integrators/photon_mapping.h"
 #include "core/math/rng.h"
+#include "core/render/tile_renderer.h"
 #include "core/scene/gltf_loader.h"
 #include "core/scene/shapes.h"
 #include "tests/support/render_fixtures.h"
@@ -220,6 +221,45 @@ TEST(MipMaps, ReduceTheErrorOfADistantCheckerboard) {
         "distant checkerboard, 1 spp against 256: squared error %.3f with mip-maps, %.3f without\n",
         error_mip, error_flat);
     EXPECT_LT(error_mip, 0.25 * error_flat) << error_mip << " vs " << error_flat;
+}
+
+TEST(MipMaps, ManySamplesPerPixelKeepTexturesSharp) {
+    // Stripes one pixel wide, each 4 texels of a 64 x 64 emissive texture, seen straight on by a
+    // distant camera (a narrow perspective one: its ray cones pick the level): the box-filtered
+    // truth is 1 and 0 in alternate columns. A pixel's 64
+    // samples average it themselves; were each to filter a whole pixel's footprint too (mip level
+    // 2, the stripes' own size, bilinear), the columns would blur to 0.75 and 0.25.
+    SceneBuilder builder("stripes");
+    Texture t;
+    t.width = 64;
+    t.height = 64;
+    for (int y = 0; y < t.height; ++y)
+        for (int x = 0; x < t.width; ++x) t.texels.push_back(Color(float((x / 4) % 2)));
+    t.wrap_s = t.wrap_t = TextureWrap::ClampToEdge;
+    Material m = lambertian(Color(0.0f));
+    m.emission = Color(1.0f);
+    m.emissive_texture.texture = static_cast<int>(builder.add_texture(std::move(t)));
+    const uint32_t material = builder.add_material(m);
+    const MeshData q = make_quad(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0));
+    ASSERT_TRUE(builder.add_mesh(q.positions, q.normals, q.uvs, q.triangles, material).is_ok());
+    const auto rs = make_render_scene(builder.build().value());
+    CameraDesc desc;
+    desc.position = Vec3(0.5f, 0.5f, 50.0f);
+    desc.look_at = Vec3(0.5f, 0.5f, 0.0f);
+    desc.vfov_deg = static_cast<float>(2.0 * std::atan(0.5 / 50.0) * 180.0 / 3.14159265358979323846);
+    const int size = 16;
+    const Camera camera = Camera::create(desc, size, size).value();
+    const DirectIntegrator integrator(rs);
+    TileSettings settings;
+    settings.samples_per_pixel = 64;
+    settings.tile_size = size;
+    const TileRenderResult result = render_tiles(integrator, camera, settings);
+    float worst = 0.0f;
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x)
+            worst = std::max(worst, std::abs(result.layers.beauty.at(x, y).x - float(x % 2)));
+    std::printf("one-pixel stripes at 64 spp: largest error against the box filter %.3f\n", worst);
+    EXPECT_LT(worst, 0.1f);
 }
 
 }  // namespace
