@@ -39,12 +39,21 @@ def run(command, env=None):
     return time.monotonic() - start
 
 
-def cycles(blender, scene, exr, camera_json, spp, seed):
+def has_own_lights(scene):
+    """Whether the glTF file lights itself: KHR_lights_punctual lights or emissive materials."""
+    with open(scene) as f:
+        doc = json.load(f)
+    lights = doc.get("extensions", {}).get("KHR_lights_punctual", {}).get("lights", [])
+    emissive = any(any(c > 0 for c in m.get("emissiveFactor", [0, 0, 0])) for m in doc.get("materials", []))
+    return bool(lights) or emissive
+
+
+def cycles(blender, scene, exr, camera_json, spp, seed, sky=1.0):
     # Blender's Python takes its prefix from the first python3.x on the PATH: the system's, next
     # to blender, and not a python3 of another installation (pyenv, a virtualenv) without numpy.
     env = dict(os.environ, PATH=os.path.dirname(os.path.realpath(blender)) + os.pathsep + os.environ.get("PATH", ""))
     return run([blender, "-b", "--factory-startup", "-noaudio", "--python-exit-code", "1", "-P", CYCLES_SCRIPT, "--",
-                scene, exr, camera_json, "--size", str(SIZE), "--spp", str(spp), "--seed", str(seed), "--sky", "1"],
+                scene, exr, camera_json, "--size", str(SIZE), "--spp", str(spp), "--seed", str(seed), "--sky", str(sky)],
                env=env)
 
 
@@ -88,28 +97,37 @@ def main():
         reference = os.path.join(work, name + ".cycles.exr")
         cycles_s = cycles(args.blender, scene, reference, camera, args.cycles_spp, 1)
         with open(camera) as f:
-            # The sky is given, not left to the default: a model with lights of its own renders
-            # without the default sky, and Cycles' world is there in every render.
-            job = {"camera": json.load(f), "environment": {"color": [1, 1, 1]}}
-        job_path = os.path.join(work, name + ".job.json")
-        with open(job_path, "w") as f:
-            json.dump(job, f)
-        final_exr = os.path.join(work, name + ".final.exr")
-        final_s = photond_render(args.photond, scene, final_exr, job_path, ["--preset", "final"])
-        path_exr = os.path.join(work, name + ".path.exr")
-        path_s = photond_render(args.photond, scene, path_exr, job_path,
-                                ["--integrator", "path", "--spp", str(args.path_spp)])
-        row = {"model": name, "cycles_spp": args.cycles_spp, "cycles_s": round(cycles_s, 1),
-               "final_s": round(final_s, 2), "path_s": round(path_s, 1)}
-        for tag, exr in (("final", final_exr), ("path", path_exr)):
-            pixels = compare(args.photond, exr, reference)
-            blocks = compare(args.photond, exr, reference, block=32)
-            row[f"{tag}_bias_pct"] = round(100.0 * pixels["bias"], 2)
-            row[f"{tag}_relmse"] = float(f"{pixels['relmse']:.3g}")
-            row[f"{tag}_block_relmse"] = float(f"{blocks['relmse']:.3g}")
-        row["cycles_mean"] = float(f"{pixels['reference_mean']:.4g}")
-        rows.append(row)
-        print(json.dumps(row), flush=True)
+            view = json.load(f)
+        # The sky is given, not left to the default: a model with lights of its own renders
+        # without the default sky, and Cycles' world is there in every render. Such a model is
+        # compared once more by its own lights alone (KHR_lights_punctual's units, emission).
+        variants = [("", {"color": [1, 1, 1]}, 1.0)]
+        if has_own_lights(scene):
+            variants.append((" (own lights only)", None, 0.0))
+        for suffix, environment, sky in variants:
+            tag = name + (".dark" if suffix else "")
+            if suffix:
+                reference = os.path.join(work, tag + ".cycles.exr")
+                cycles_s = cycles(args.blender, scene, reference, camera, args.cycles_spp, 1, sky)
+            job_path = os.path.join(work, tag + ".job.json")
+            with open(job_path, "w") as f:
+                json.dump({"camera": view, "environment": environment}, f)
+            final_exr = os.path.join(work, tag + ".final.exr")
+            final_s = photond_render(args.photond, scene, final_exr, job_path, ["--preset", "final"])
+            path_exr = os.path.join(work, tag + ".path.exr")
+            path_s = photond_render(args.photond, scene, path_exr, job_path,
+                                    ["--integrator", "path", "--spp", str(args.path_spp)])
+            row = {"model": name + suffix, "cycles_spp": args.cycles_spp, "cycles_s": round(cycles_s, 1),
+                   "final_s": round(final_s, 2), "path_s": round(path_s, 1)}
+            for kind, exr in (("final", final_exr), ("path", path_exr)):
+                pixels = compare(args.photond, exr, reference)
+                blocks = compare(args.photond, exr, reference, block=32)
+                row[f"{kind}_bias_pct"] = round(100.0 * pixels["bias"], 2)
+                row[f"{kind}_relmse"] = float(f"{pixels['relmse']:.3g}")
+                row[f"{kind}_block_relmse"] = float(f"{blocks['relmse']:.3g}")
+            row["cycles_mean"] = float(f"{pixels['reference_mean']:.4g}")
+            rows.append(row)
+            print(json.dumps(row), flush=True)
 
     os.makedirs(args.out, exist_ok=True)
     with open(os.path.join(args.out, "cycles_compare.csv"), "w", newline="") as f:
@@ -117,7 +135,8 @@ def main():
         writer.writeheader()
         writer.writerows(rows)
     lines = [f"photond against Cycles (Blender {blender_version(args.blender)}, {args.cycles_spp} spp), "
-             f"{SIZE}x{SIZE}, uniform sky of radiance 1, measured {time.strftime('%Y-%m-%d %H:%M')}",
+             f"{SIZE}x{SIZE}, uniform sky of radiance 1 (own lights only: none), measured "
+             f"{time.strftime('%Y-%m-%d %H:%M')}",
              "",
              "| model | Cycles mean | final: bias | relMSE | 32² blocks' relMSE | path "
              f"{args.path_spp} spp: bias | relMSE | 32² blocks' relMSE |",
