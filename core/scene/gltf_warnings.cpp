@@ -55,6 +55,27 @@ void GltfSceneReader::add_feature_warnings() {
         const std::string& name = model_.materials[static_cast<size_t>(index)].name;
         return name.empty() ? "material " + std::to_string(index) : name;
     };
+    // Textures of supported extensions that are not applied: the factors alone are.
+    struct IgnoredTexture {
+        const char* extension;
+        const char* texture;
+        const char* instead;
+    };
+    for (const IgnoredTexture& t :
+         {IgnoredTexture{"KHR_materials_clearcoat", "clearcoatNormalTexture", "the coat shares the base's shading normal"},
+          IgnoredTexture{"KHR_materials_specular", "specularTexture", "specularFactor alone is used"},
+          IgnoredTexture{"KHR_materials_specular", "specularColorTexture", "specularColorFactor alone is used"}}) {
+        std::vector<std::string> names;
+        for (const auto& [index, scene_index] : materials_) {
+            if (index < 0) continue;
+            const auto& ext = model_.materials[static_cast<size_t>(index)].extensions;
+            const auto it = ext.find(t.extension);
+            if (it != ext.end() && it->second.IsObject() && it->second.Has(t.texture)) names.push_back(material_name(index));
+        }
+        if (!names.empty())
+            builder_.add_warning(std::string(t.extension) + "'s " + t.texture + " is not applied (material" +
+                                 (names.size() > 1 ? "s " : " ") + name_list(names) + "): " + t.instead);
+    }
     if (!solid_transmission_materials_.empty()) {
         std::vector<std::string> names;
         for (int index : solid_transmission_materials_) names.push_back(material_name(index));

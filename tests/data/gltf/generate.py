@@ -720,7 +720,8 @@ def warnings_file():
     """Features the loader ignores, each of which must come back as a warning."""
     b = Builder()
     b.doc["extensionsUsed"] = ["KHR_lights_punctual", "KHR_materials_sheen",
-                               "KHR_materials_iridescence", "KHR_materials_anisotropy"]
+                               "KHR_materials_iridescence", "KHR_materials_anisotropy",
+                               "KHR_materials_clearcoat", "KHR_materials_specular"]
     data = png(2, 2, TEXTURE_ROWS)
     b.doc["images"] = [{"uri": png_data_uri(data)}]
     b.doc["samplers"] = [{"wrapS": 33071, "wrapT": 33071}]
@@ -730,11 +731,16 @@ def warnings_file():
          "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}},
          "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1]},
                         "KHR_materials_iridescence": {"iridescenceFactor": 1},
-                        "KHR_materials_anisotropy": {"anisotropyStrength": 0.5}}}]
+                        "KHR_materials_anisotropy": {"anisotropyStrength": 0.5}}},
+        {"name": "Lacquer", "extensions": {
+            "KHR_materials_clearcoat": {"clearcoatFactor": 1, "clearcoatNormalTexture": {"index": 0}},
+            "KHR_materials_specular": {"specularTexture": {"index": 0},
+                                       "specularColorTexture": {"index": 0}}}}]
     attrs = triangle(b)
     attrs["COLOR_0"] = b.floats([1, 0, 0, 0, 1, 0, 0, 0, 1], "VEC3")
     b.doc["meshes"] = [{"name": "Tri", "primitives": [{"attributes": attrs, "material": 0},
-                                                      {"attributes": triangle(b), "mode": 1}]}]
+                                                      {"attributes": triangle(b), "mode": 1},
+                                                      {"attributes": triangle(b), "material": 1}]}]
     b.doc["extensions"] = {"KHR_lights_punctual": {"lights": [
         {"name": "Ranged", "type": "point", "intensity": 100, "range": 5}]}}
     b.doc["cameras"] = [{"name": "Nowhere", "type": "perspective",
