@@ -102,19 +102,22 @@ LobeKind slot_kind(int slot, const BsdfMaterial& m) {
 
 }  // namespace
 
-BsdfMaterial::BsdfMaterial(const Material& material, float metallic_value, float roughness_value,
-                           float transmission_value, float clearcoat_value, float clearcoat_roughness_value) {
+BsdfMaterial::BsdfMaterial(const Material& material, const MaterialPoint& point) {
+    const float metallic_value = point.metallic, roughness_value = point.roughness,
+                transmission_value = point.transmission, clearcoat_value = point.clearcoat,
+                clearcoat_roughness_value = point.clearcoat_roughness;
     // Clamp to the ranges the glTF spec allows, which is what the energy guarantee needs.
     metallic = std::isfinite(metallic_value) ? std::clamp(metallic_value, 0.0f, 1.0f) : 0.0f;
     transmission = std::isfinite(transmission_value) ? std::clamp(transmission_value, 0.0f, 1.0f) : 0.0f;
     roughness = std::isfinite(roughness_value) ? std::clamp(roughness_value, 0.0f, 1.0f) : 1.0f;
     ior = std::isfinite(material.ior) ? std::max(material.ior, 1.0f) : 1.5f;
-    const float specular = std::clamp(material.specular, 0.0f, 1.0f);
+    const float specular = std::isfinite(point.specular) ? std::clamp(point.specular, 0.0f, 1.0f) : 1.0f;
+    const Color specular_colour = is_finite(point.specular_color) ? point.specular_color : Color(1.0f);
 
     // KHR_materials_specular: F0 = min(F0(ior) * specular_color, 1) * specular, F90 = specular.
     // Note F0 <= F90, so the layer albedo F0 total + (F90 - F0) schlick stays <= F90 <= 1.
     const float f0_from_ior = sqr((ior - 1.0f) / (ior + 1.0f));
-    specular_f0 = glm::min(f0_from_ior * glm::max(material.specular_color, Color(0.0f)), Color(1.0f)) * specular;
+    specular_f0 = glm::min(f0_from_ior * glm::max(specular_colour, Color(0.0f)), Color(1.0f)) * specular;
     specular_f90 = specular;
 
     layer_weight = (1.0f - metallic) * (1.0f - transmission);
@@ -188,6 +191,18 @@ LobeMask possible_lobes(const Scene& scene, const Material& m, bool* sharp_gloss
         if (t.texel_count() == 0) r[0] = r[1] = 1.0f;
         for (int i = 0; i < 2; ++i) transmission[i] = m.transmission * r[i];
     }
+    // KHR_materials_specular's texture: its A's extremes (the colour switches no lobe).
+    float specular[2] = {m.specular, m.specular};
+    if (m.specular_texture.present()) {
+        const Texture& t = *scene.textures[static_cast<size_t>(m.specular_texture.texture)];
+        float a[2] = {1.0f, 0.0f};
+        for (size_t i = 0, n = t.texel_count(); i < n; ++i) {
+            const float v = t.texel(i).w;
+            a[0] = std::min(a[0], v), a[1] = std::max(a[1], v);
+        }
+        if (t.texel_count() == 0) a[0] = a[1] = 1.0f;
+        for (int i = 0; i < 2; ++i) specular[i] = m.specular * a[i];
+    }
     const Color colour = m.base_color_texture.present() ? Color(1.0f) : m.base_color;
     // The range's ends, and a sharp and a wider glossy roughness where the range holds them.
     const float sharp = std::clamp(0.5f * (kDeltaRoughness + kSharpGlossyRoughness), roughness[0], roughness[1]);
@@ -202,15 +217,21 @@ LobeMask possible_lobes(const Scene& scene, const Material& m, bool* sharp_gloss
     const float coat = m.clearcoat > 0.0f ? m.clearcoat : 0.0f;
     LobeMask lobes = 0;
     bool any_sharp = false, all_sharp = true;
+    MaterialPoint point = factor_point(m);
+    point.clearcoat = coat;
     for (float mv : metallic) {
         for (float tv : transmission) {
-            for (float rv : {roughness[0], roughness[1], sharp, glossy}) {
-                for (float cr : {coat_roughness[0], coat_roughness[1], coat_sharp, coat_glossy}) {
-                    const BsdfMaterial constants(m, mv, rv, tv, coat, cr);
-                    const LobeMask here = Bsdf(constants, colour, Frame(Vec3(0, 0, 1)), Vec3(0, 0, 1)).lobes();
-                    lobes |= here;
-                    any_sharp = any_sharp || constants.sharp_glossy;
-                    if (here & mask_of(LobeKind::Glossy)) all_sharp = all_sharp && constants.sharp_glossy;
+            for (float sv : specular) {
+                for (float rv : {roughness[0], roughness[1], sharp, glossy}) {
+                    for (float cr : {coat_roughness[0], coat_roughness[1], coat_sharp, coat_glossy}) {
+                        point.metallic = mv, point.transmission = tv, point.specular = sv;
+                        point.roughness = rv, point.clearcoat_roughness = cr;
+                        const BsdfMaterial constants(m, point);
+                        const LobeMask here = Bsdf(constants, colour, Frame(Vec3(0, 0, 1)), Vec3(0, 0, 1)).lobes();
+                        lobes |= here;
+                        any_sharp = any_sharp || constants.sharp_glossy;
+                        if (here & mask_of(LobeKind::Glossy)) all_sharp = all_sharp && constants.sharp_glossy;
+                    }
                 }
             }
         }

@@ -68,13 +68,11 @@ struct BsdfSample {
 /// per material (RenderScene::bsdf_materials), so that a Bsdf at a hit only adds the base colour
 /// and the frames: deriving it at every hit was a tenth of a photon bounce.
 struct BsdfMaterial {
-    explicit BsdfMaterial(const Material& material)
-        : BsdfMaterial(material, material.metallic, material.roughness, material.transmission,
-                       material.clearcoat, material.clearcoat_roughness) {}
-    /// With metallic, roughness, transmission and the clearcoat's factor and roughness read from
-    /// the material's textures at one point.
-    BsdfMaterial(const Material& material, float metallic, float roughness, float transmission, float clearcoat,
-                 float clearcoat_roughness);
+    explicit BsdfMaterial(const Material& material) : BsdfMaterial(material, factor_point(material)) {}
+    /// With metallic, roughness, transmission, specular (factor and colour) and the clearcoat's
+    /// factor and roughness as the material's textures give them at one point (its base colour
+    /// and alpha are not read here).
+    BsdfMaterial(const Material& material, const MaterialPoint& point);
 
     Color specular_f0;       // dielectric layer F0 (from ior and KHR_materials_specular)
     float specular_f90;      // dielectric layer F90 (the specular factor)
@@ -112,7 +110,7 @@ struct BsdfMaterial {
 };
 
 /// The lobe kinds a material can have anywhere on its surface: with a metallicRoughnessTexture,
-/// the union over its texels' extremes of metallic, roughness and transmission (the base colour taken as
+/// the union over its texels' extremes of metallic, roughness, transmission and specular (the base colour taken as
 /// white, so a texture can only remove lobes). For the render plan and the caustic casters.
 /// `sharp_glossy`, when given, tells whether every glossy lobe the surface has anywhere is sharp
 /// (BsdfMaterial::sharp_glossy), and it has one somewhere.

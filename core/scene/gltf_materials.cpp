@@ -291,7 +291,7 @@ Status GltfSceneReader::read_material_textures(const tinygltf::Material& g, int 
 }
 
 /// KHR_materials_clearcoat (clearcoatNormalTexture is not applied: the coat shares the base's
-/// shading normal), KHR_materials_transmission's texture and KHR_materials_volume (attenuation inside the solid; thicknessFactor is for
+/// shading normal), the textures of KHR_materials_transmission and _specular, and KHR_materials_volume (attenuation inside the solid; thicknessFactor is for
 /// rasterisers that do not trace the solid).
 Status GltfSceneReader::read_clearcoat_and_volume(const tinygltf::Material& g, int material_index,
                                                   const std::string& context, Material& m) {
@@ -319,6 +319,18 @@ Status GltfSceneReader::read_clearcoat_and_volume(const tinygltf::Material& g, i
                 return st;
         }
     }
+    // KHR_materials_specular: A of specularTexture multiplies specularFactor, RGB of
+    // specularColorTexture (sRGB) specularColorFactor.
+    if (const auto it = ext.find("KHR_materials_specular"); it != ext.end()) {
+        if (Status st = read_extension_texture(it->second, "KHR_materials_specular", "specularTexture", material_index,
+                                               context, m.specular_texture);
+            !st)
+            return st;
+        if (Status st = read_extension_texture(it->second, "KHR_materials_specular", "specularColorTexture",
+                                               material_index, context, m.specular_color_texture, true);
+            !st)
+            return st;
+    }
     // KHR_materials_transmission: R of transmissionTexture multiplies transmissionFactor.
     if (const auto it = ext.find("KHR_materials_transmission"); it != ext.end() && m.transmission > 0.0f) {
         if (Status st = read_extension_texture(it->second, "KHR_materials_transmission", "transmissionTexture",
@@ -340,7 +352,7 @@ Status GltfSceneReader::read_clearcoat_and_volume(const tinygltf::Material& g, i
 
 Status GltfSceneReader::read_extension_texture(const tinygltf::Value& extension, const char* extension_name,
                                               const char* key, int material_index, const std::string& context,
-                                              TextureRef& target) {
+                                              TextureRef& target, bool srgb) {
     if (!extension.IsObject() || !extension.Has(key)) return Status::ok();
     const std::string what = context + extension_name + "." + key;
     const tinygltf::Value& info = extension.Get(key);
@@ -358,7 +370,7 @@ Status GltfSceneReader::read_extension_texture(const tinygltf::Value& extension,
         for (const std::string& name : e.Keys()) info_extensions[name] = e.Get(name);
     }
     Expected<TextureRef> ref =
-        texture_ref(*index, *tex_coord, info_extensions, context, key, false, texcoord_sets_[material_index]);
+        texture_ref(*index, *tex_coord, info_extensions, context, key, srgb, texcoord_sets_[material_index]);
     if (!ref) return ref.error();
     target = *ref;
     return Status::ok();

@@ -209,10 +209,11 @@ private:
                                   Material& m);
     Status read_clearcoat_and_volume(const tinygltf::Material& g, int material_index, const std::string& context,
                                      Material& m);
-    /// The textureInfo `key` of an extension's object (absent: `target` unchanged), read as
-    /// data (not sRGB).
+    /// The textureInfo `key` of an extension's object (absent: `target` unchanged), read as sRGB
+    /// colour or as data.
     Status read_extension_texture(const tinygltf::Value& extension, const char* extension_name, const char* key,
-                                  int material_index, const std::string& context, TextureRef& target);
+                                  int material_index, const std::string& context, TextureRef& target,
+                                  bool srgb = false);
     /// The scene texture of glTF texture texture_index read as sRGB colour or as data: its index,
     /// given now; the image is decoded by decode_textures() once the whole file was accepted.
     Expected<int> scene_texture(int texture_index, const std::string& context, const std::string& role,

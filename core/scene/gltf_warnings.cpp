@@ -55,16 +55,14 @@ void GltfSceneReader::add_feature_warnings() {
         const std::string& name = model_.materials[static_cast<size_t>(index)].name;
         return name.empty() ? "material " + std::to_string(index) : name;
     };
-    // Textures of supported extensions that are not applied: the factors alone are.
+    // Textures of supported extensions that are not applied.
     struct IgnoredTexture {
         const char* extension;
         const char* texture;
         const char* instead;
     };
     for (const IgnoredTexture& t :
-         {IgnoredTexture{"KHR_materials_clearcoat", "clearcoatNormalTexture", "the coat shares the base's shading normal"},
-          IgnoredTexture{"KHR_materials_specular", "specularTexture", "specularFactor alone is used"},
-          IgnoredTexture{"KHR_materials_specular", "specularColorTexture", "specularColorFactor alone is used"}}) {
+         {IgnoredTexture{"KHR_materials_clearcoat", "clearcoatNormalTexture", "the coat shares the base's shading normal"}}) {
         std::vector<std::string> names;
         for (const auto& [index, scene_index] : materials_) {
             if (index < 0) continue;

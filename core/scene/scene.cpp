@@ -187,9 +187,12 @@ Vec4 Scene::sample(const TextureRef& ref, const TexturePoint& tp) const {
 
 MaterialPoint Scene::material_point(uint32_t material, const TexturePoint& tp) const {
     const Material& m = materials[material];
-    MaterialPoint mp{m.base_color, m.base_alpha, m.metallic, m.roughness, m.transmission, m.clearcoat, m.clearcoat_roughness};
+    MaterialPoint mp = factor_point(m);
     // KHR_materials_transmission: R of transmissionTexture.
     if (m.transmission_texture.present()) mp.transmission *= sample(m.transmission_texture, tp).x;
+    // KHR_materials_specular: A of specularTexture, RGB of specularColorTexture.
+    if (m.specular_texture.present()) mp.specular *= sample(m.specular_texture, tp).w;
+    if (m.specular_color_texture.present()) mp.specular_color *= Color(sample(m.specular_color_texture, tp));
     // KHR_materials_clearcoat: R of clearcoatTexture, G of clearcoatRoughnessTexture.
     if (m.clearcoat_texture.present()) mp.clearcoat *= sample(m.clearcoat_texture, tp).x;
     if (m.clearcoat_roughness_texture.present())

@@ -102,6 +102,8 @@ struct Material {
     TextureRef transmission_texture;  // R multiplies transmission
     float specular = 1.0f;       // KHR_materials_specular factor
     Color specular_color{1.0f};  // KHR_materials_specular colour factor
+    TextureRef specular_texture;        // A multiplies specular
+    TextureRef specular_color_texture;  // RGB multiplies specular_color
     Color emission{0.0f};        // emitted radiance: emissiveFactor * emissive_strength
     TextureRef emissive_texture;  // multiplies emission
     /// KHR_materials_clearcoat: a GGX dielectric layer (F0 0.04) over the whole material.
@@ -127,7 +129,8 @@ struct Material {
     bool is_emissive() const { return max_component(emission) > 0.0f; }
     /// Metallic, roughness or the clearcoat vary over the surface: BSDF constants per hit.
     bool varying_bsdf() const {
-        return metallic_roughness_texture.present() || transmission_texture.present() || clearcoat_texture.present() ||
+        return metallic_roughness_texture.present() || transmission_texture.present() || specular_texture.present() ||
+               specular_color_texture.present() || clearcoat_texture.present() ||
                clearcoat_roughness_texture.present();
     }
     bool has_volume() const { return max_component(attenuation) > 0.0f; }
@@ -147,7 +150,7 @@ struct Material {
         return base_color_texture.present() || metallic_roughness_texture.present() ||
                normal_texture.present() || emissive_texture.present() ||
                clearcoat_texture.present() || clearcoat_roughness_texture.present() ||
-               transmission_texture.present();
+               transmission_texture.present() || specular_texture.present() || specular_color_texture.present();
     }
 };
 
@@ -158,9 +161,26 @@ struct MaterialPoint {
     float metallic = 0.0f;
     float roughness = 1.0f;
     float transmission = 0.0f;
+    float specular = 1.0f;
+    Color specular_color{1.0f};
     float clearcoat = 0.0f;
     float clearcoat_roughness = 0.0f;
 };
+
+/// A material's factors as a MaterialPoint: what a point reads where no texture changes them.
+inline MaterialPoint factor_point(const Material& m) {
+    MaterialPoint p;
+    p.base_color = m.base_color;
+    p.alpha = m.base_alpha;
+    p.metallic = m.metallic;
+    p.roughness = m.roughness;
+    p.transmission = m.transmission;
+    p.specular = m.specular;
+    p.specular_color = m.specular_color;
+    p.clearcoat = m.clearcoat;
+    p.clearcoat_roughness = m.clearcoat_roughness;
+    return p;
+}
 
 /// Where a surface point lies in texture space: both TEXCOORD slots, the vertex colour, and the
 /// ray footprint's width in texture coordinates (0: the finest level) for mip-mapping.

@@ -8,7 +8,7 @@ namespace {
 
 // These fire when a field is added to a struct the hashes read: hash the new field (if it affects
 // light transport) in scene_content_hash, then update the size here.
-static_assert(sizeof(Material) == sizeof(std::string) + 336,
+static_assert(sizeof(Material) == sizeof(std::string) + 400,
               "Material changed: hash the new field in scene_content_hash");
 static_assert(sizeof(PunctualLight) == sizeof(std::string) + 56,
               "PunctualLight changed: hash the new field in scene_content_hash");
@@ -102,6 +102,8 @@ Sha256Digest scene_content_hash(const Scene& scene) {
         hash_float(hasher, m.transmission);
         // Only where present: the hashes of scenes without one stay what they were.
         if (m.transmission_texture.present()) hash_ref(m.transmission_texture);
+        if (m.specular_texture.present()) hash_ref(m.specular_texture);
+        if (m.specular_color_texture.present()) hash_ref(m.specular_color_texture);
         // Only where set: the hashes of scenes without thin walls stay what they were.
         if (m.thin_walled) hasher.update_string("thin-walled");
         hash_float(hasher, m.specular);

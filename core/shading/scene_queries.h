@@ -65,9 +65,9 @@ inline Bsdf make_bsdf(const RenderScene& rs, const SurfaceInteraction& si, const
     const MaterialPoint mp = rs.scene->material_point(si.material, si.tex);
     if (!material.varying_bsdf())
         return Bsdf(rs.bsdf_materials[si.material], mp.base_color, Frame(ns), ng);
-    // Metallic, roughness, transmission or the clearcoat vary over the surface: the constants are
-    // derived here.
-    BsdfMaterial constants(material, mp.metallic, mp.roughness, mp.transmission, mp.clearcoat, mp.clearcoat_roughness);
+    // Metallic, roughness, transmission, specular or the clearcoat vary over the surface: the
+    // constants are derived here.
+    BsdfMaterial constants(material, mp);
     // Glossy caustics come only off materials sharp all over (RenderScene::sharp_glossy_materials).
     constants.sharp_glossy = constants.sharp_glossy && rs.sharp_glossy_materials[si.material];
     return Bsdf(std::move(constants), mp.base_color, Frame(ns), ng);

@@ -266,6 +266,30 @@ TEST(TransmissionTexture, RedTimesTheFactorDecidesWhereLightPassesThrough) {
     EXPECT_TRUE(possible & mask_of(LobeKind::Diffuse));
 }
 
+TEST(SpecularTextures, AlphaScalesTheLayerAndColourTintsItsF0) {
+    auto rs = test_support::make_render_scene(load("specular_texture.gltf"));
+    const Scene& scene = *rs->scene;
+    EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.front();
+    const SurfaceInteraction left = hit_at(*rs, 0.25f, 0.5f), right = hit_at(*rs, 0.75f, 0.5f);
+    const MaterialPoint a = scene.material_point(left.material, left.tex);
+    const MaterialPoint b = scene.material_point(right.material, right.tex);
+    EXPECT_FLOAT_EQ(a.specular, 1.0f);
+    EXPECT_FLOAT_EQ(b.specular, 0.0f);
+    EXPECT_NEAR(glm::length(a.specular_color - Color(1, 0, 0)), 0.0f, 1e-6f);
+    // Seen straight on, the smooth layer's mirror reflects F0 = 0.04 x specularColor x specular.
+    const Vec3 wo(0, 0, 1);
+    std::array<BsdfSample, 2> lobes;
+    ASSERT_EQ(make_bsdf(*rs, left, wo).delta_lobes(wo, lobes), 1);
+    EXPECT_NEAR(lobes[0].weight.x, 0.04f, 1e-4f);
+    EXPECT_NEAR(lobes[0].weight.y, 0.0f, 1e-6f);
+    // specular 0: no layer; the Lambertian lobe takes the whole base colour.
+    const Bsdf plain = make_bsdf(*rs, right, wo);
+    EXPECT_EQ(plain.delta_lobes(wo, lobes), 0);
+    EXPECT_NEAR(plain.diffuse_reflectance().x, 0.5f, 1e-5f);
+    const LobeMask possible = possible_lobes(scene, scene.materials[scene.triangle_materials[0]]);
+    EXPECT_TRUE(possible & mask_of(LobeKind::Delta));
+}
+
 TEST(Extensions, ClearcoatAndVolumeAreRead) {
     const Scene scene = load("coat_volume.gltf");  // both extensions required
     ASSERT_EQ(scene.materials.size(), 3u);

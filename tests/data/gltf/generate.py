@@ -375,6 +375,26 @@ def material_textures():
     single_mesh_scene(b, [{"attributes": {"POSITION": pos, "NORMAL": nrm, "TEXCOORD_0": uv},
                            "indices": idx, "material": 0}], "PartlyClearQuad")
     write("transmission_texture.gltf", b.finish())
+    # KHR_materials_specular's textures: specularTexture's A multiplies specularFactor (left texel
+    # 255, right 0), specularColorTexture's RGB (sRGB) specularColorFactor (left red, right white);
+    # a smooth plastic of base colour 0.5 on an open quad.
+    b = Builder()
+    pos = b.floats(QUAD_POSITIONS, "VEC3")
+    nrm = b.floats([0, 0, 1] * 4, "VEC3")
+    uv = b.floats(QUAD_UVS, "VEC2")
+    idx = b.indices(QUAD_INDICES, U16)
+    b.doc["extensionsUsed"] = ["KHR_materials_specular"]
+    b.doc["images"] = [{"uri": png_data_uri(png_rgba(2, 1, [[(0, 0, 0, 255), (0, 0, 0, 0)]]))},
+                       {"uri": png_data_uri(png_rgba(2, 1, [[(255, 0, 0, 255), (255, 255, 255, 255)]]))}]
+    b.doc["samplers"] = [{"magFilter": 9728}]  # NEAREST
+    b.doc["textures"] = [{"source": 0, "sampler": 0}, {"source": 1, "sampler": 0}]
+    b.doc["materials"] = [{"name": "SpecularMapped", "pbrMetallicRoughness": {
+        "baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0.0, "roughnessFactor": 0.0},
+        "extensions": {"KHR_materials_specular": {"specularTexture": {"index": 0},
+                                                  "specularColorTexture": {"index": 1}}}}]
+    single_mesh_scene(b, [{"attributes": {"POSITION": pos, "NORMAL": nrm, "TEXCOORD_0": uv},
+                           "indices": idx, "material": 0}], "SpecularQuad")
+    write("specular_texture.gltf", b.finish())
 
     # KHR_texture_transform (required) on a 2x2 colour texture; the second material reads
     # TEXCOORD_1 through the extension's texCoord override, with CLAMP_TO_EDGE / MIRRORED_REPEAT.
