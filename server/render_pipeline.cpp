@@ -174,14 +174,18 @@ std::optional<PassDecision> radiance_cache_decision(const protocol::RenderSettin
 std::optional<protocol::FieldError> material_media_problem(const protocol::Job& job, const Scene& scene) {
     for (const auto& [name, spec] : job.material_media) {
         const std::string path = "material_media." + name;
+        // Solids among the materials some triangle uses: a material all of whose primitives are
+        // open keeps an unused solid original beside its thin-walled copy (the glTF loader).
+        const std::vector<bool> used = scene.materials_in_use();
         bool found = false, solid = false;
-        for (const Material& m : scene.materials) {
+        for (size_t i = 0; i < scene.materials.size(); ++i) {
+            const Material& m = scene.materials[i];
             if (m.name != name) continue;
             if (!(m.transmission > 0.0f))
                 return protocol::FieldError{path, "material '" + name + "' is not transmissive (no "
                                                   "KHR_materials_transmission): its surface closes no medium"};
             found = true;
-            solid = solid || !m.thin_walled;
+            solid = solid || (used[i] && !m.thin_walled);
         }
         if (found && !solid)
             return protocol::FieldError{path, "material '" + name + "' is only on open meshes, taken as thin walls "
@@ -205,18 +209,25 @@ std::optional<protocol::FieldError> material_media_problem(const protocol::Job& 
 /// account of it, one entry per name; empty without entries.
 std::string apply_material_media(const protocol::Job& job, Scene& scene) {
     std::string applied;
+    const std::vector<bool> used = scene.materials_in_use();
     for (const auto& entry : job.material_media) {
         const std::string& name = entry.first;  // a named variable: lambdas may not capture bindings (C++17)
         const auto& spec = entry.second;
-        for (Material& m : scene.materials) {
-            if (m.name != name || m.thin_walled) continue;  // a thin wall has no inside
+        for (size_t i = 0; i < scene.materials.size(); ++i) {
+            Material& m = scene.materials[i];
+            // A thin wall has no inside; an unused material (a thin wall's solid original) none
+            // that shows.
+            if (m.name != name || m.thin_walled || !used[i]) continue;
             m.scattering = to_vec3(spec.sigma_s);
             m.phase_g = static_cast<float>(spec.g);
             if (spec.sigma_a) m.attenuation = to_vec3(*spec.sigma_a);
         }
-        const auto m = std::find_if(scene.materials.begin(), scene.materials.end(), [&](const Material& material) {
-            return material.name == name && !material.thin_walled;
-        });
+        // material_media_problem found a solid of that name in use.
+        size_t first = 0;
+        while (first + 1 < scene.materials.size() &&
+               (scene.materials[first].name != name || scene.materials[first].thin_walled || !used[first]))
+            ++first;
+        const Material* m = &scene.materials[first];
         applied += std::string(applied.empty() ? "" : "; ") + "'" + name + "': sigma_a " +
                    describe_colour({m->attenuation.x, m->attenuation.y, m->attenuation.z}) + " (" +
                    (spec.sigma_a ? "the job's" : "the file's") + "), sigma_s " + describe_colour(spec.sigma_s) +

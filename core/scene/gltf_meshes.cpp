@@ -147,6 +147,9 @@ bool is_closed_surface(const std::vector<const DecodedPrimitive*>& parts) {
         }
         for (const glm::uvec3& t : part->triangles) {
             const uint32_t v[3] = {vertex[t.x], vertex[t.y], vertex[t.z]};
+            // A triangle with a repeated corner has no area and closes nothing: it would count an
+            // edge twice and read a closed mesh as open.
+            if (v[0] == v[1] || v[1] == v[2] || v[2] == v[0]) continue;
             for (int k = 0; k < 3; ++k) ++edges[std::minmax(v[k], v[(k + 1) % 3])];
         }
         triangles += part->triangles.size();
@@ -208,7 +211,7 @@ Status GltfSceneReader::assign_thin_walls(std::vector<DecodedPrimitive>& decoded
             if (!has_volume) solid_transmission_materials_.insert(material_index);
             continue;
         }
-        const uint32_t thin = thin_walled_material(material_index, decoded[0].material);
+        const uint32_t thin = thin_walled_material(material_index, materials_.at(material_index));
         for (size_t p = 0; p < decoded.size(); ++p)
             if (gltf_materials[p] == material_index) decoded[p].material = thin;
     }

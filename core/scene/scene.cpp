@@ -287,8 +287,10 @@ Status Scene::validate() const {
                          " uses a material out of range"};
     }
     for (const Material& m : materials) {
-        for (const TextureRef* ref : {&m.base_color_texture, &m.metallic_roughness_texture,
-                                      &m.normal_texture, &m.emissive_texture}) {
+        for (const TextureRef* ref : {&m.base_color_texture, &m.metallic_roughness_texture, &m.normal_texture,
+                                      &m.emissive_texture, &m.transmission_texture, &m.specular_texture,
+                                      &m.specular_color_texture, &m.clearcoat_texture,
+                                      &m.clearcoat_roughness_texture}) {
             if (ref->texture >= static_cast<int>(textures.size()) || ref->slot > 1)
                 return Error{"scene '" + name + "': material '" + m.name +
                              "' uses a texture out of range"};

@@ -101,9 +101,19 @@ Sha256Digest scene_content_hash(const Scene& scene) {
         hash_float(hasher, m.ior);
         hash_float(hasher, m.transmission);
         // Only where present: the hashes of scenes without one stay what they were.
-        if (m.transmission_texture.present()) hash_ref(m.transmission_texture);
-        if (m.specular_texture.present()) hash_ref(m.specular_texture);
-        if (m.specular_color_texture.present()) hash_ref(m.specular_color_texture);
+        // Each tagged: one image may serve as two of them.
+        if (m.transmission_texture.present()) {
+            hasher.update_string("transmission-texture");
+            hash_ref(m.transmission_texture);
+        }
+        if (m.specular_texture.present()) {
+            hasher.update_string("specular-texture");
+            hash_ref(m.specular_texture);
+        }
+        if (m.specular_color_texture.present()) {
+            hasher.update_string("specular-color-texture");
+            hash_ref(m.specular_color_texture);
+        }
         // Only where set: the hashes of scenes without thin walls stay what they were.
         if (m.thin_walled) hasher.update_string("thin-walled");
         hash_float(hasher, m.specular);

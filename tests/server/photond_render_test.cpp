@@ -518,6 +518,19 @@ TEST_F(PhotondRender, IncompletePhotonMapIsAWarningThatSaysWhatToChange) {
     EXPECT_FALSE(contains_warning(stats.at("warnings"), "the global map")) << stats.dump();
 }
 
+TEST_F(PhotondRender, MaterialMediaOnAThinWallIsRefused) {
+    // transmission.gltf: PaneGlass is only on an open pane (a thin wall, no inside), BoxGlass on
+    // a closed box (a solid).
+    const std::string scene = (kGltfData / "transmission.gltf").string();
+    const auto thin = run("render " + scene + " --integrator path --width 8 --height 8 --spp 1 --quiet " +
+                          "--set 'material_media={\"PaneGlass\": {\"sigma_s\": 1}}' -o " + (dir_ / "t.exr").string());
+    EXPECT_NE(thin.exit_code, 0) << thin.output;
+    EXPECT_NE(thin.output.find("material 'PaneGlass' is only on open meshes"), std::string::npos) << thin.output;
+    const auto solid = run("render " + scene + " --integrator path --width 8 --height 8 --spp 1 --quiet " +
+                           "--set 'material_media={\"BoxGlass\": {\"sigma_s\": 1}}' -o " + (dir_ / "s.exr").string());
+    EXPECT_EQ(solid.exit_code, 0) << solid.output;
+}
+
 TEST_F(PhotondRender, IgnoredGltfFeaturesAreWarningsEvenWhenQuiet) {
     const auto r = run("render " + (kGltfData / "warnings.gltf").string() +
                        " --integrator direct --width 8 --height 8 --spp 1 --quiet --stats-json " +
