@@ -163,46 +163,31 @@ BsdfMaterial::BsdfMaterial(const Material& material, const MaterialPoint& point)
     lambertian_only = metallic <= 0.0f && glass_weight <= 0.0f && specular_f90 <= 0.0f && coat <= 0.0f;
 }
 
+namespace {
+
+/// factor times the smallest and the largest of one channel of a texture's texels (factor
+/// alone without a texture, or for a texture without texels).
+std::array<float, 2> factor_range(const Scene& scene, const TextureRef& ref, int channel, float factor) {
+    if (!ref.present()) return {factor, factor};
+    const Texture& t = *scene.textures[static_cast<size_t>(ref.texture)];
+    if (t.texel_count() == 0) return {factor, factor};
+    float lo = 1.0f, hi = 0.0f;
+    for (size_t i = 0, n = t.texel_count(); i < n; ++i) {
+        const float v = t.texel(i)[channel];
+        lo = std::min(lo, v), hi = std::max(hi, v);
+    }
+    return {factor * lo, factor * hi};
+}
+
+}  // namespace
+
 LobeMask possible_lobes(const Scene& scene, const Material& m, bool* sharp_glossy) {
-    float metallic[2] = {m.metallic, m.metallic}, roughness[2] = {m.roughness, m.roughness};
-    if (m.metallic_roughness_texture.present()) {
-        const Texture& t = *scene.textures[static_cast<size_t>(m.metallic_roughness_texture.texture)];
-        float g[2] = {1.0f, 0.0f}, b[2] = {1.0f, 0.0f};
-        for (size_t i = 0, n = t.texel_count(); i < n; ++i) {
-            const Vec4 c = t.texel(i);
-            g[0] = std::min(g[0], c.y), g[1] = std::max(g[1], c.y);
-            b[0] = std::min(b[0], c.z), b[1] = std::max(b[1], c.z);
-        }
-        if (t.texel_count() == 0) g[0] = g[1] = b[0] = b[1] = 1.0f;
-        for (int i = 0; i < 2; ++i) {
-            roughness[i] = m.roughness * g[i];
-            metallic[i] = m.metallic * b[i];
-        }
-    }
-    // KHR_materials_transmission's texture: its R's extremes.
-    float transmission[2] = {m.transmission, m.transmission};
-    if (m.transmission_texture.present()) {
-        const Texture& t = *scene.textures[static_cast<size_t>(m.transmission_texture.texture)];
-        float r[2] = {1.0f, 0.0f};
-        for (size_t i = 0, n = t.texel_count(); i < n; ++i) {
-            const float v = t.texel(i).x;
-            r[0] = std::min(r[0], v), r[1] = std::max(r[1], v);
-        }
-        if (t.texel_count() == 0) r[0] = r[1] = 1.0f;
-        for (int i = 0; i < 2; ++i) transmission[i] = m.transmission * r[i];
-    }
-    // KHR_materials_specular's texture: its A's extremes (the colour switches no lobe).
-    float specular[2] = {m.specular, m.specular};
-    if (m.specular_texture.present()) {
-        const Texture& t = *scene.textures[static_cast<size_t>(m.specular_texture.texture)];
-        float a[2] = {1.0f, 0.0f};
-        for (size_t i = 0, n = t.texel_count(); i < n; ++i) {
-            const float v = t.texel(i).w;
-            a[0] = std::min(a[0], v), a[1] = std::max(a[1], v);
-        }
-        if (t.texel_count() == 0) a[0] = a[1] = 1.0f;
-        for (int i = 0; i < 2; ++i) specular[i] = m.specular * a[i];
-    }
+    // The textures' extremes: metallicRoughnessTexture's G and B, transmissionTexture's R,
+    // specularTexture's A (the specular colour switches no lobe).
+    const std::array<float, 2> roughness = factor_range(scene, m.metallic_roughness_texture, 1, m.roughness);
+    const std::array<float, 2> metallic = factor_range(scene, m.metallic_roughness_texture, 2, m.metallic);
+    const std::array<float, 2> transmission = factor_range(scene, m.transmission_texture, 0, m.transmission);
+    const std::array<float, 2> specular = factor_range(scene, m.specular_texture, 3, m.specular);
     const Color colour = m.base_color_texture.present() ? Color(1.0f) : m.base_color;
     // The range's ends, and a sharp and a wider glossy roughness where the range holds them.
     const float sharp = std::clamp(0.5f * (kDeltaRoughness + kSharpGlossyRoughness), roughness[0], roughness[1]);
