@@ -63,6 +63,50 @@ def scene_bounds():
     return lo, hi
 
 
+def configure_cycles(scene, options, out_path):
+    """Cycles as the reference: `spp` samples without adaptive sampling, denoising or clamping,
+    `bounces` (default 64; 0: direct light only) bounces of every kind, a box pixel filter of one pixel (photond's), `size` x `size`
+    pixels, linear radiance into a 32-bit float EXR at `out_path`."""
+    scene.render.engine = "CYCLES"
+    cycles = scene.cycles
+    cycles.device = "CPU"
+    cycles.samples = options["spp"]
+    cycles.use_adaptive_sampling = False
+    cycles.use_denoising = False
+    cycles.seed = options["seed"]
+    bounces = options.get("bounces", 64)
+    cycles.max_bounces = bounces
+    cycles.diffuse_bounces = bounces
+    cycles.glossy_bounces = bounces
+    cycles.transmission_bounces = bounces
+    cycles.transparent_max_bounces = 64  # alpha-masked texels are seen through, not bounced off
+    cycles.volume_bounces = min(bounces, 16)
+    cycles.sample_clamp_direct = 0.0
+    cycles.sample_clamp_indirect = 0.0
+    cycles.blur_glossy = 0.0
+    cycles.caustics_reflective = True
+    cycles.caustics_refractive = True
+    cycles.filter_type = "BOX"
+    cycles.filter_width = 1.0
+    cycles.pixel_filter_type = "BOX"
+    scene.render.filter_size = 1.0
+    scene.render.threads_mode = "FIXED"
+    scene.render.threads = options["threads"]
+    scene.render.resolution_x = options["size"]
+    scene.render.resolution_y = options["size"]
+    scene.render.resolution_percentage = 100
+    scene.render.film_transparent = False
+    scene.view_settings.view_transform = "Standard"
+    scene.view_settings.look = "None"
+    scene.view_settings.exposure = 0.0
+    scene.view_settings.gamma = 1.0
+    settings = scene.render.image_settings
+    settings.file_format = "OPEN_EXR"
+    settings.color_depth = "32"
+    settings.exr_codec = "ZIP"
+    scene.render.filepath = out_path
+
+
 def main():
     scene_path, out_path, camera_path, options = parse_arguments()
     bpy.ops.wm.read_factory_settings(use_empty=True)
@@ -111,44 +155,9 @@ def main():
     background.inputs["Strength"].default_value = options["sky"]
     scene.world = world
 
-    scene.render.engine = "CYCLES"
-    cycles = scene.cycles
-    cycles.device = "CPU"
-    cycles.samples = options["spp"]
-    cycles.use_adaptive_sampling = False
-    cycles.use_denoising = False
-    cycles.seed = options["seed"]
-    cycles.max_bounces = 64
-    cycles.diffuse_bounces = 64
-    cycles.glossy_bounces = 64
-    cycles.transmission_bounces = 64
-    cycles.transparent_max_bounces = 64
-    cycles.volume_bounces = 16
-    cycles.sample_clamp_direct = 0.0
-    cycles.sample_clamp_indirect = 0.0
-    cycles.blur_glossy = 0.0
-    cycles.caustics_reflective = True
-    cycles.caustics_refractive = True
-    cycles.filter_type = "BOX"
-    cycles.filter_width = 1.0
-    cycles.pixel_filter_type = "BOX"
-    scene.render.filter_size = 1.0
-    scene.render.threads_mode = "FIXED"
-    scene.render.threads = options["threads"]
-    scene.render.resolution_x = options["size"]
-    scene.render.resolution_y = options["size"]
-    scene.render.resolution_percentage = 100
-    scene.render.film_transparent = False
-    scene.view_settings.view_transform = "Standard"
-    scene.view_settings.look = "None"
-    scene.view_settings.exposure = 0.0
-    scene.view_settings.gamma = 1.0
-    settings = scene.render.image_settings
-    settings.file_format = "OPEN_EXR"
-    settings.color_depth = "32"
-    settings.exr_codec = "ZIP"
-    scene.render.filepath = out_path
+    configure_cycles(scene, options, out_path)
     bpy.ops.render.render(write_still=True)
 
 
-main()
+if __name__ == "__main__":
+    main()
