@@ -6,7 +6,7 @@ exported files through its `gltf_camera` under the world's uniform sky, and each
 with Cycles': the image mean's bias, the relMSE and the 32 x 32 blocks' relMSE.
 
     python3 bench/blender_authored.py --photond build/server/photond [--cycles-spp 1024]
-        [--path-spp 256] [--scenes A,B] [--principled] [--out DIR] [--keep DIR]
+        [--path-spp 256] [--scenes A,B] [--principled] [--out DIR] [--keep DIR [--reuse]]
 
 Cycles renders each scene with its materials rebuilt as the glTF BRDF in Cycles' closures
 (blender_scene.py, gltf_materials_in_cycles), once with every bounce (against photond's `final`
@@ -56,7 +56,11 @@ def main():
                         help="also compare with Cycles rendering Blender's Principled BSDF")
     parser.add_argument("--out", default=os.path.join(ROOT, "bench", "results"))
     parser.add_argument("--keep", default="", help="keep the scenes and EXRs in this directory")
+    parser.add_argument("--reuse", action="store_true",
+                        help="take the exported scenes and Cycles' renders already in --keep DIR (photond alone runs)")
     args = parser.parse_args()
+    if args.reuse and not args.keep:
+        sys.exit("--reuse needs --keep DIR")
 
     work = os.path.abspath(args.keep or tempfile.mkdtemp(prefix="blender_authored_"))
     os.makedirs(work, exist_ok=True)
@@ -70,7 +74,12 @@ def main():
     for name in args.scenes.split(","):
         cycles_s = {}
         for materials, bounces, _ in variants:
-            if (materials, bounces) not in cycles_s:
+            reference = os.path.join(work, f"{name}.cycles-{materials}{'-direct' if bounces == 0 else ''}.exr")
+            if (materials, bounces) in cycles_s:
+                continue
+            if args.reuse and os.path.exists(reference):
+                cycles_s[materials, bounces] = float("nan")  # rendered before
+            else:
                 cycles_s[materials, bounces] = blender_scene(args.blender, name, work, args.cycles_spp, materials, bounces)
         scene = os.path.join(work, name, name + ".gltf")
         with open(os.path.join(work, name + ".world.json")) as f:

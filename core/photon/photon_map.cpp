@@ -22,12 +22,32 @@ KnnResult& thread_scratch() {
     return scratch;
 }
 
-/// The squared radius of the disc the photons were gathered from: the farthest photon's when k
-/// were found, else the whole search ball (fewer than k photons within max_radius means the
-/// density is known over the full ball, not only up to the farthest photon).
-double estimate_radius2(const KnnResult& found, uint32_t k, float max_radius) {
-    if (found.size() < k && std::isfinite(max_radius)) return static_cast<double>(max_radius) * max_radius;
-    return static_cast<double>(found.radius2);
+/// The disc (or ball) an estimate's photons were gathered from.
+///
+/// Its squared radius: the farthest photon's when k were found, else the whole search ball (fewer
+/// than k photons within max_radius means the density is known over the full ball, not only up
+/// to the farthest photon). Where the farthest photon sets the radius it lies on the edge, not
+/// inside, and is left out of the sum (`edge`): the photons inside a disc whose radius is the k-th
+/// nearest distance number k - 1, and over a Poisson density lambda, E[(k - 1) / (pi r_k^2)] =
+/// lambda, while the k photons over the same area are k / (k - 1) too many on average (+2 % at
+/// k = 50, the same in a ball; Loftsgaarden & Quesenberry 1965). Rooms lit by photon-map
+/// estimates came out that much brighter than `path`.
+struct EstimateSupport {
+    double radius2 = 0.0;
+    int edge = -1;  // index into KnnResult::neighbors of the photon on the edge, or -1
+};
+
+EstimateSupport estimate_support(const KnnResult& found, uint32_t k, float max_radius) {
+    if (found.size() < k && std::isfinite(max_radius)) return {static_cast<double>(max_radius) * max_radius, -1};
+    if (found.empty()) return {};
+    // The farthest by (dist2, index): the max-heap's top once k were found; else a scan.
+    const auto farthest = found.size() >= k ? found.neighbors.begin()
+                                            : std::max_element(found.neighbors.begin(), found.neighbors.end(),
+                                                               [](const KnnNeighbor& a, const KnnNeighbor& b) {
+                                                                   return a.dist2 < b.dist2 ||
+                                                                          (a.dist2 == b.dist2 && a.index < b.index);
+                                                               });
+    return {static_cast<double>(found.radius2), static_cast<int>(farthest - found.neighbors.begin())};
 }
 
 /// Whether a photon may count in an estimate at a surface point with unit normal n (on the side
@@ -54,14 +74,16 @@ Color PhotonMap::estimate_radiance(const Vec3& p, const Vec3& normal, const Bsdf
     tree_.k_nearest_in_disc(p, normal, kPhotonDiscFlattening, options.k, max_radius, found);
     // The estimate's own radius decides (a pile of photons at p inside a finite search ball has
     // one); zero only when k photons sit exactly at p, where the density is undefined.
-    const double radius2 = estimate_radius2(found, options.k, max_radius);
-    if (found.size() < kMinPhotonsPerEstimate || !(radius2 > 0.0)) return Color(0.0f);
-    const double r = std::sqrt(radius2);
+    const EstimateSupport support = estimate_support(found, options.k, max_radius);
+    if (found.size() < kMinPhotonsPerEstimate || !(support.radius2 > 0.0)) return Color(0.0f);
+    const double r = std::sqrt(support.radius2);
     // Cone filter weight w = 1 - d / (k_cone r), normalised by 1 - 2 / (3 k_cone) (Jensen 2001).
     constexpr double kCone = 1.1;
     DVec3 sum(0.0);
     const bool bent = glm::dot(options.shading_normal, options.shading_normal) > 0.0f;
-    for (const KnnNeighbor& n : found.neighbors) {
+    for (size_t i = 0; i < found.neighbors.size(); ++i) {
+        if (static_cast<int>(i) == support.edge) continue;
+        const KnnNeighbor& n = found.neighbors[i];
         const Photon& photon = tree_.photon(n.index);
         if (photon.user_flags() & options.exclude_flags) continue;
         if (!(options.both_sides ? photon_counts_either_side(photon, normal) : photon_counts(photon, normal)))
@@ -96,15 +118,17 @@ Color PhotonMap::estimate_irradiance(const Vec3& p, const Vec3& normal, uint32_t
     if (hinted) tree_.k_nearest_in_disc(p, normal, kPhotonDiscFlattening, k, *radius_hint, found);
     if (!hinted || found.size() < k) tree_.k_nearest_in_disc(p, normal, kPhotonDiscFlattening, k, max_radius, found);
     if (radius_hint) *radius_hint = found.size() >= k && k > 0 ? std::sqrt(found.radius2) : 0.0f;
-    const double radius2 = estimate_radius2(found, k, max_radius);  // see estimate_radiance
-    if (found.size() < kMinPhotonsPerEstimate || !(radius2 > 0.0)) return Color(0.0f);
+    const EstimateSupport support = estimate_support(found, k, max_radius);
+    if (found.size() < kMinPhotonsPerEstimate || !(support.radius2 > 0.0)) return Color(0.0f);
     DVec3 sum(0.0);
-    for (const KnnNeighbor& n : found.neighbors) {
-        const Photon& photon = tree_.photon(n.index);
-        if ((photon.user_flags() & exclude_flags) || !photon_counts(photon, normal)) continue;
+    for (size_t i = 0; i < found.neighbors.size(); ++i) {
+        const Photon& photon = tree_.photon(found.neighbors[i].index);
+        if (static_cast<int>(i) == support.edge || (photon.user_flags() & exclude_flags) ||
+            !photon_counts(photon, normal))
+            continue;
         sum += DVec3(photon.flux());
     }
-    return Color(sum / (kPiDouble * radius2));
+    return Color(sum / (kPiDouble * support.radius2));
 }
 
 namespace {
@@ -128,16 +152,16 @@ Color PhotonMap::estimate_in_scattering(const Vec3& x, const Vec3& wo, float g, 
         tree_.k_nearest_flagged(x, k, max_radius, photon_flags::kInterior, 0, found);
     else
         tree_.k_nearest_flagged(x, k, max_radius, 0, photon_flags::kInterior, found);
-    const double radius2 = estimate_radius2(found, k, max_radius);  // see estimate_radiance
-    if (found.size() < kMinPhotonsPerEstimate || !(radius2 > 0.0)) return Color(0.0f);
+    const EstimateSupport support = estimate_support(found, k, max_radius);
+    if (found.size() < kMinPhotonsPerEstimate || !(support.radius2 > 0.0)) return Color(0.0f);
     DVec3 sum(0.0);
-    for (const KnnNeighbor& n : found.neighbors) {
-        const Photon& photon = tree_.photon(n.index);
-        if (photon.user_flags() & exclude_flags) continue;
+    for (size_t i = 0; i < found.neighbors.size(); ++i) {
+        const Photon& photon = tree_.photon(found.neighbors[i].index);
+        if (static_cast<int>(i) == support.edge || (photon.user_flags() & exclude_flags)) continue;
         sum += static_cast<double>(henyey_greenstein(g, wo, -photon.direction())) * DVec3(photon.flux());
     }
-    const double r = std::sqrt(radius2);
-    double volume = 4.0 / 3.0 * kPiDouble * radius2 * r;
+    const double r = std::sqrt(support.radius2);
+    double volume = 4.0 / 3.0 * kPiDouble * support.radius2 * r;
     if (medium_bounds && !medium_bounds->empty()) {
         // Each face the sphere crosses cuts off a cap of height h: pi h^2 (3 r - h) / 3 (caps of
         // two faces overlap only near the box's edges, which the floor below covers).

@@ -81,7 +81,10 @@ public:
     /// Adopts a built tree (e.g. PhotonKdTree::from_tree_order of a cached map).
     PhotonMap(PhotonKdTree tree, uint64_t emitted);
 
-    /// Reflected radiance at p towards wo; `normal` is the shading normal on wo's side. Photons
+    /// Reflected radiance at p towards wo; `normal` is the shading normal on wo's side. The k
+    /// nearest photons (in a disc: PhotonKdTree::k_nearest_in_disc) set the radius; the farthest,
+    /// on the disc's edge, is not counted: k - 1 photons over the disc's area is the unbiased
+    /// density of a uniform distribution, k of them 1 / (k - 1) too much. Photons
     /// arriving from behind the surface (dot(-direction, normal) <= 0) are skipped, and so are
     /// photons stored with a surface normal that disagrees with `normal` (cosine <=
     /// kPhotonNormalCosine): those on the other side of a thin wall or on another surface.
@@ -103,9 +106,9 @@ public:
 
     /// In a volume map (PhotonMaps::volume): the in-scattered radiance source at x towards wo,
     /// sigma_s times the phase-weighted integral of the radiance arriving there (Jensen &
-    /// Christensen 1998): the sum over the k nearest photons of HG(g, wo, -direction) times their
-    /// flux (stored with the event's albedo), over the volume (4/3) pi r^3 of the sphere they
-    /// fill. Photons with any of exclude_flags are skipped (photon_flags::kDirect: the single
+    /// Christensen 1998): the sum over the k nearest photons, but the farthest on the sphere's
+    /// edge (as in estimate_radiance), of HG(g, wo, -direction) times their flux (stored with the
+    /// event's albedo), over the volume (4/3) pi r^3 of the sphere they fill. Photons with any of exclude_flags are skipped (photon_flags::kDirect: the single
     /// scattering a ray march takes by light samples). Zero with fewer than
     /// kMinPhotonsPerEstimate photons. With `medium_bounds` (the box the medium fills), the
     /// sphere's caps beyond its faces are left out of the volume: no photon can lie there, and a

@@ -197,5 +197,48 @@ TEST(PhotonMap, ARadiusHintGivesExactlyTheEstimateWithoutOne) {
     EXPECT_EQ(hint, 0.0f);
 }
 
+// Over a uniform density the estimates are unbiased: the k nearest photons set the radius and
+// the k - 1 inside it count (k of them over the same area average k / (k - 1) too much: +2 % at
+// k = 50, which lit closed rooms 2 % brighter than `path`). Photons uniform on the unit square
+// y = 0 (N of them, flux F each: E = N F), and in the unit cube for the volume estimate
+// (isotropic: N F / (4 pi)); estimates averaged over points away from the edges.
+TEST(PhotonMap, EstimatesOfAUniformDensityAreUnbiased) {
+    constexpr int kPhotons = 1000000, kQueries = 20000;
+    constexpr float kFlux = 1e-3f;
+    const Vec3 up(0, 1, 0);
+    Rng rng(21, 22);
+    std::vector<Photon> surface, volume;
+    for (int i = 0; i < kPhotons; ++i) {
+        const Vec3 travel = glm::normalize(Vec3(rng.next_float() - 0.5f, -1.0f, rng.next_float() - 0.5f));
+        surface.push_back(make_photon(Vec3(rng.next_float(), 0.0f, rng.next_float()), travel, Color(kFlux), 0, up));
+        volume.push_back(make_photon(Vec3(rng.next_float(), rng.next_float(), rng.next_float()), travel, Color(kFlux)));
+    }
+    const PhotonMap surface_map(std::move(surface), kPhotons);
+    const PhotonMap volume_map(std::move(volume), kPhotons);
+    const Material white = white_material();
+    const BsdfMaterial constants(white);
+    const Bsdf bsdf(constants, white.base_color, Frame(up), up);
+    double irradiance = 0.0, radiance = 0.0, cone = 0.0, in_scattering = 0.0;
+    for (int i = 0; i < kQueries; ++i) {
+        const Vec3 p(0.2f + 0.6f * rng.next_float(), 0.0f, 0.2f + 0.6f * rng.next_float());
+        irradiance += surface_map.estimate_irradiance(p, up, 50, 0.0f).x;
+        RadianceEstimateOptions options;
+        options.k = 50;
+        radiance += surface_map.estimate_radiance(p, up, bsdf, up, options).x;
+        options.cone_filter = true;
+        cone += surface_map.estimate_radiance(p, up, bsdf, up, options).x;
+        const Vec3 x(0.2f + 0.6f * rng.next_float(), 0.2f + 0.6f * rng.next_float(), 0.2f + 0.6f * rng.next_float());
+        in_scattering += volume_map.estimate_in_scattering(x, up, 0.0f, 50, 0.0f).x;
+    }
+    const double e = double(kPhotons) * kFlux;
+    const double rho_over_pi = white.base_color.x / 3.14159265358979;
+    // The means' noise is mostly the photons' count in the queried region (1 / sqrt(360,000) on
+    // the square, 1 / sqrt(216,000) in the cube: 0.2 %); the old estimator's +2 % is far off.
+    EXPECT_NEAR(irradiance / kQueries / e, 1.0, 0.008);
+    EXPECT_NEAR(radiance / kQueries / (rho_over_pi * e), 1.0, 0.008);
+    EXPECT_NEAR(cone / kQueries / (rho_over_pi * e), 1.0, 0.008);
+    EXPECT_NEAR(in_scattering / kQueries / (e / (4.0 * 3.14159265358979)), 1.0, 0.008);
+}
+
 }  // namespace
 }  // namespace photond

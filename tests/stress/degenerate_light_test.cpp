@@ -130,9 +130,10 @@ TEST(CoincidentPhotons, EstimatesStayFiniteAtZeroRadius) {
     const double disc = 3.14159265358979 * 0.1 * 0.1;
     EXPECT_NEAR(map.estimate_irradiance(p, up, 2000, 0.1f).x, 1000 * kPhotonFlux / disc,
                 1e-3 * 1000 * kPhotonFlux / disc);
-    // Beside the pile the k nearest are all at the same distance d: E = k flux / (pi d^2).
+    // Beside the pile the k nearest are all at the same distance d, on the disc's edge: one of
+    // them sets the radius and the others count, E = (k - 1) flux / (pi d^2).
     const float d = 0.05f;
-    const double expected = 50 * kPhotonFlux / (3.14159265358979 * d * d);
+    const double expected = 49 * kPhotonFlux / (3.14159265358979 * d * d);
     EXPECT_NEAR(map.estimate_irradiance(p + Vec3(d, 0.0f, 0.0f), up, 50, 0.0f).x, expected,
                 1e-3 * expected);
 }
