@@ -3,7 +3,7 @@
 
 Every run is compared with the scene's converged path-traced reference (the mean of its two
 stored halves, bench/README.md). Each point is repeated with other seeds and the median of each
-figure is quoted. Writes, under --out (default bench/results):
+figure is quoted. Writes, under --out (default bench/results; bench/results/quick with --quick):
 
     benchmark_runs.csv   every run
     benchmark.csv        one row per point: medians, Pareto frontier, speed-up over path
@@ -453,8 +453,9 @@ def main():
                         help="runs per point, other seeds each (default 3, --quick 2)")
     parser.add_argument("--threads", type=int, default=os.cpu_count(),
                         help="render threads (default: every core)")
-    parser.add_argument("--out", default=str(REPO / "bench" / "results"),
-                        help="output directory (default bench/results)")
+    parser.add_argument("--out", default=None,
+                        help="output directory (default bench/results; with --quick bench/results/quick, "
+                             "so that a quick run leaves the full sweep's files alone)")
     parser.add_argument("--keep-renders", action="store_true",
                         help="keep the rendered EXRs under OUT/renders")
     parser.add_argument("--replot", action="store_true",
@@ -471,7 +472,7 @@ def main():
     for name in wanted:
         if name not in by_name:
             sys.exit(f"unknown scene '{name}'; benchmark scenes: {', '.join(by_name)}")
-    out = Path(args.out)
+    out = Path(args.out) if args.out else REPO / "bench" / "results" / ("quick" if args.quick else "")
     out.mkdir(parents=True, exist_ok=True)
     workdir = Path(tempfile.mkdtemp(prefix="photond-bench-"))
     if args.keep_renders:
