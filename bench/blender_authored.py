@@ -19,11 +19,9 @@ DIR/blender_authored.md and .csv (default bench/results) and prints the table. N
 (Debian 12's 3.4; `make blender-authored` installs it).
 """
 import argparse
-import csv
 import json
 import os
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
@@ -34,15 +32,12 @@ SCENES = ["window-room", "lamp-room"]
 SIZE = 256
 
 sys.path.insert(0, os.path.join(ROOT, "bench"))
-from cycles_compare import blender_version, compare, photond_render, run  # noqa: E402
+from cycles_compare import blender_version, errors, photond_render, run_blender_script, write_results  # noqa: E402
 
 
-def blender_scene(blender, name, work, spp, materials, bounces):
-    # Blender's Python takes its prefix from the first python3.x on the PATH (cycles_compare.py).
-    env = dict(os.environ, PATH=os.path.dirname(os.path.realpath(blender)) + os.pathsep + os.environ.get("PATH", ""))
-    return run([blender, "-b", "--factory-startup", "-noaudio", "--python-exit-code", "1", "-P", SCENE_SCRIPT, "--",
-                name, work, "--size", str(SIZE), "--spp", str(spp), "--materials", materials,
-                "--bounces", str(bounces)], env=env)
+def reference_path(work, name, materials, bounces):
+    """Where blender_scene.py writes Cycles' render of scene `name`."""
+    return os.path.join(work, f"{name}.cycles-{materials}{'-direct' if bounces == 0 else ''}.exr")
 
 
 def main():
@@ -74,13 +69,14 @@ def main():
     for name in args.scenes.split(","):
         cycles_s = {}
         for materials, bounces, _ in variants:
-            reference = os.path.join(work, f"{name}.cycles-{materials}{'-direct' if bounces == 0 else ''}.exr")
             if (materials, bounces) in cycles_s:
                 continue
-            if args.reuse and os.path.exists(reference):
+            if args.reuse and os.path.exists(reference_path(work, name, materials, bounces)):
                 cycles_s[materials, bounces] = float("nan")  # rendered before
             else:
-                cycles_s[materials, bounces] = blender_scene(args.blender, name, work, args.cycles_spp, materials, bounces)
+                cycles_s[materials, bounces] = run_blender_script(
+                    args.blender, SCENE_SCRIPT, [name, work, "--size", str(SIZE), "--spp", str(args.cycles_spp),
+                                                 "--materials", materials, "--bounces", str(bounces)])
         scene = os.path.join(work, name, name + ".gltf")
         with open(os.path.join(work, name + ".world.json")) as f:
             sky = json.load(f)["color"]
@@ -96,23 +92,16 @@ def main():
             renders[method] = (exr, photond_render(args.photond, scene, exr, job_path, extra))
         for materials, bounces, method in variants:
             exr, seconds = renders[method]
-            reference = os.path.join(work, f"{name}.cycles-{materials}{'-direct' if bounces == 0 else ''}.exr")
-            pixels = compare(args.photond, exr, reference)
-            blocks = compare(args.photond, exr, reference, block=32)
+            e = errors(args.photond, exr, reference_path(work, name, materials, bounces))
             row = {"scene": name, "cycles": f"{materials}, {'direct light' if bounces == 0 else f'{bounces} bounces'}",
                    "cycles_spp": args.cycles_spp, "cycles_s": round(cycles_s[materials, bounces], 1),
-                   "cycles_mean": float(f"{pixels['reference_mean']:.4g}"),
+                   "cycles_mean": e["reference_mean"],
                    "photond": method if method == "final" else f"{method} {args.path_spp} spp",
-                   "photond_s": round(seconds, 2), "bias_pct": round(100.0 * pixels["bias"], 2),
-                   "relmse": float(f"{pixels['relmse']:.3g}"), "block_relmse": float(f"{blocks['relmse']:.3g}")}
+                   "photond_s": round(seconds, 2), "bias_pct": e["bias_pct"], "relmse": e["relmse"],
+                   "block_relmse": e["block_relmse"]}
             rows.append(row)
             print(json.dumps(row), flush=True)
 
-    os.makedirs(args.out, exist_ok=True)
-    with open(os.path.join(args.out, "blender_authored.csv"), "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
-        writer.writeheader()
-        writer.writerows(rows)
     lines = [f"photond on glTF exported by Blender {blender_version(args.blender)} against Cycles "
              f"({args.cycles_spp} spp) rendering the scenes as built, {SIZE}x{SIZE}, measured "
              f"{time.strftime('%Y-%m-%d %H:%M')}",
@@ -123,9 +112,7 @@ def main():
     for r in rows:
         lines.append(f"| {r['scene']} | {r['cycles']} | {r['cycles_mean']} | {r['photond']} | {r['bias_pct']:+.2f} % | "
                      f"{r['relmse']} | {r['block_relmse']} | {r['photond_s']} |")
-    with open(os.path.join(args.out, "blender_authored.md"), "w") as f:
-        f.write("\n".join(lines) + "\n")
-    print("\n".join(lines))
+    write_results(args.out, "blender_authored", rows, lines)
 
 
 if __name__ == "__main__":

@@ -31,23 +31,16 @@ import bpy
 from mathutils import Vector
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from cycles_render import configure_cycles  # noqa: E402
+from cycles_render import configure_cycles, script_arguments  # noqa: E402
 
 
 def parse_arguments():
-    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-    if len(argv) < 2:
-        sys.exit("usage: blender -b -P blender_scene.py -- NAME OUT_DIR [options]")
-    options = {"size": 256, "spp": 1024, "seed": 1, "threads": 2, "materials": "gltf", "bounces": 64}
-    rest = argv[2:]
-    for name, value in zip(rest[0::2], rest[1::2]):
-        key = name.lstrip("-")
-        if key not in options:
-            sys.exit(f"unknown option {name}")
-        options[key] = type(options[key])(value)
+    (name, out_dir), options = script_arguments(
+        "blender -b -P blender_scene.py -- NAME OUT_DIR [options]", 2,
+        {"size": 256, "spp": 1024, "seed": 1, "threads": 2, "materials": "gltf", "bounces": 64})
     if options["materials"] not in ("gltf", "principled"):
         sys.exit("--materials is gltf or principled")
-    return argv[0], argv[1], options
+    return name, out_dir, options
 
 
 # ---- Textures: generated, saved as PNG files that the exporter copies beside the glTF ----------

@@ -48,13 +48,18 @@ def has_own_lights(scene):
     return bool(lights) or emissive
 
 
-def cycles(blender, scene, exr, camera_json, spp, seed, sky=1.0):
+def run_blender_script(blender, script, arguments):
+    """Runs `script` in Blender without its interface; returns the seconds it took."""
     # Blender's Python takes its prefix from the first python3.x on the PATH: the system's, next
     # to blender, and not a python3 of another installation (pyenv, a virtualenv) without numpy.
     env = dict(os.environ, PATH=os.path.dirname(os.path.realpath(blender)) + os.pathsep + os.environ.get("PATH", ""))
-    return run([blender, "-b", "--factory-startup", "-noaudio", "--python-exit-code", "1", "-P", CYCLES_SCRIPT, "--",
-                scene, exr, camera_json, "--size", str(SIZE), "--spp", str(spp), "--seed", str(seed), "--sky", str(sky)],
-               env=env)
+    return run([blender, "-b", "--factory-startup", "-noaudio", "--python-exit-code", "1", "-P", script, "--"] +
+               arguments, env=env)
+
+
+def cycles(blender, scene, exr, camera_json, spp, seed, sky=1.0):
+    return run_blender_script(blender, CYCLES_SCRIPT, [scene, exr, camera_json, "--size", str(SIZE), "--spp", str(spp),
+                                                       "--seed", str(seed), "--sky", str(sky)])
 
 
 def photond_render(photond, scene, exr, job, extra):
@@ -70,6 +75,27 @@ def compare(photond, exr, reference, block=None):
     if result.returncode != 0:
         sys.exit(f"compare failed: {result.stdout}{result.stderr}")
     return json.loads(result.stdout)
+
+
+def errors(photond, exr, reference):
+    """The image's bias (%), relMSE and relMSE over 32 x 32 blocks against `reference`, and the
+    reference's mean."""
+    pixels = compare(photond, exr, reference)
+    blocks = compare(photond, exr, reference, block=32)
+    return {"bias_pct": round(100.0 * pixels["bias"], 2), "relmse": float(f"{pixels['relmse']:.3g}"),
+            "block_relmse": float(f"{blocks['relmse']:.3g}"), "reference_mean": float(f"{pixels['reference_mean']:.4g}")}
+
+
+def write_results(out, name, rows, lines):
+    """rows into OUT/NAME.csv, the table's `lines` into OUT/NAME.md, and the table printed."""
+    os.makedirs(out, exist_ok=True)
+    with open(os.path.join(out, name + ".csv"), "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+        writer.writeheader()
+        writer.writerows(rows)
+    with open(os.path.join(out, name + ".md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    print("\n".join(lines))
 
 
 def main():
@@ -120,20 +146,14 @@ def main():
             row = {"model": name + suffix, "cycles_spp": args.cycles_spp, "cycles_s": round(cycles_s, 1),
                    "final_s": round(final_s, 2), "path_s": round(path_s, 1)}
             for kind, exr in (("final", final_exr), ("path", path_exr)):
-                pixels = compare(args.photond, exr, reference)
-                blocks = compare(args.photond, exr, reference, block=32)
-                row[f"{kind}_bias_pct"] = round(100.0 * pixels["bias"], 2)
-                row[f"{kind}_relmse"] = float(f"{pixels['relmse']:.3g}")
-                row[f"{kind}_block_relmse"] = float(f"{blocks['relmse']:.3g}")
-            row["cycles_mean"] = float(f"{pixels['reference_mean']:.4g}")
+                e = errors(args.photond, exr, reference)
+                row[f"{kind}_bias_pct"] = e["bias_pct"]
+                row[f"{kind}_relmse"] = e["relmse"]
+                row[f"{kind}_block_relmse"] = e["block_relmse"]
+            row["cycles_mean"] = e["reference_mean"]
             rows.append(row)
             print(json.dumps(row), flush=True)
 
-    os.makedirs(args.out, exist_ok=True)
-    with open(os.path.join(args.out, "cycles_compare.csv"), "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
-        writer.writeheader()
-        writer.writerows(rows)
     lines = [f"photond against Cycles (Blender {blender_version(args.blender)}, {args.cycles_spp} spp), "
              f"{SIZE}x{SIZE}, uniform sky of radiance 1 (own lights only: none), measured "
              f"{time.strftime('%Y-%m-%d %H:%M')}",
@@ -145,9 +165,7 @@ def main():
         lines.append(f"| {r['model']} | {r['cycles_mean']} | {r['final_bias_pct']:+.2f} % | {r['final_relmse']} | "
                      f"{r['final_block_relmse']} | {r['path_bias_pct']:+.2f} % | {r['path_relmse']} | "
                      f"{r['path_block_relmse']} |")
-    with open(os.path.join(args.out, "cycles_compare.md"), "w") as f:
-        f.write("\n".join(lines) + "\n")
-    print("\n".join(lines))
+    write_results(args.out, "cycles_compare", rows, lines)
 
 
 def blender_version(blender):

@@ -27,18 +27,27 @@ if not hasattr(numpy, "bool"):
     numpy.bool = bool
 
 
-def parse_arguments():
+def script_arguments(usage, positional, options):
+    """The arguments after Blender's `--`: `positional` of them, then `--name value` pairs for
+    the keys of `options` (the defaults, whose types the values take)."""
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-    if len(argv) < 3:
-        sys.exit("usage: blender -b -P cycles_render.py -- SCENE.gltf OUT.exr CAMERA.json [options]")
-    options = {"size": 256, "spp": 1024, "seed": 1, "sky": 1.0, "threads": 2}
-    rest = argv[3:]
+    if len(argv) < positional:
+        sys.exit("usage: " + usage)
+    options = dict(options)
+    rest = argv[positional:]
     for name, value in zip(rest[0::2], rest[1::2]):
         key = name.lstrip("-")
         if key not in options:
             sys.exit(f"unknown option {name}")
         options[key] = type(options[key])(value)
-    return argv[0], argv[1], argv[2], options
+    return argv[:positional], options
+
+
+def parse_arguments():
+    (scene, out, camera), options = script_arguments(
+        "blender -b -P cycles_render.py -- SCENE.gltf OUT.exr CAMERA.json [options]", 3,
+        {"size": 256, "spp": 1024, "seed": 1, "sky": 1.0, "threads": 2})
+    return scene, out, camera, options
 
 
 def to_blender(v):

@@ -135,6 +135,10 @@ void replace_heap_top(KnnNeighbor* heap, size_t n, KnnNeighbor value) {
 
 void KnnResult::sort_by_distance() { std::sort(neighbors.begin(), neighbors.end(), closer); }
 
+size_t KnnResult::farthest() const {
+    return full ? 0 : static_cast<size_t>(std::max_element(neighbors.begin(), neighbors.end(), closer) - neighbors.begin());
+}
+
 PhotonKdTree::PhotonKdTree(std::vector<Photon> photons) : photons_(std::move(photons)) {
     // Photons with a non-finite position go (the rest keep their order); every photon starts as
     // a leaf, and the build marks the inner nodes.
@@ -327,6 +331,7 @@ void PhotonKdTree::k_nearest_impl(const Vec3& p, uint32_t k, float max_radius, K
             if (accept(photons_[i])) consider(i, distance2_to(photons_[i].position));
     }
     out.radius2 = full ? heap[0].dist2 : farthest2;
+    out.full = full;
 }
 
 }  // namespace photond

@@ -31,15 +31,21 @@ struct KnnResult {
     /// 0 when none was found. When fewer than k were found, the region searched was the
     /// max_radius ball.
     float radius2 = 0.0f;
+    /// Whether k photons were found: `neighbors` is then a max-heap (the farthest first).
+    bool full = false;
 
     size_t size() const { return neighbors.size(); }
     bool empty() const { return neighbors.empty(); }
     void clear() {
         neighbors.clear();
         radius2 = 0.0f;
+        full = false;
     }
     /// Orders neighbors by increasing (dist2, index).
     void sort_by_distance();
+    /// The index in `neighbors` of the farthest by (dist2, index): the heap's top when full (no
+    /// search), else found by a scan. Not for an empty result.
+    size_t farthest() const;
 };
 
 /// A kd-tree over photons, built once and then only read.

@@ -40,14 +40,7 @@ struct EstimateSupport {
 EstimateSupport estimate_support(const KnnResult& found, uint32_t k, float max_radius) {
     if (found.size() < k && std::isfinite(max_radius)) return {static_cast<double>(max_radius) * max_radius, -1};
     if (found.empty()) return {};
-    // The farthest by (dist2, index): the max-heap's top once k were found; else a scan.
-    const auto farthest = found.size() >= k ? found.neighbors.begin()
-                                            : std::max_element(found.neighbors.begin(), found.neighbors.end(),
-                                                               [](const KnnNeighbor& a, const KnnNeighbor& b) {
-                                                                   return a.dist2 < b.dist2 ||
-                                                                          (a.dist2 == b.dist2 && a.index < b.index);
-                                                               });
-    return {static_cast<double>(found.radius2), static_cast<int>(farthest - found.neighbors.begin())};
+    return {static_cast<double>(found.radius2), static_cast<int>(found.farthest())};
 }
 
 /// Whether a photon may count in an estimate at a surface point with unit normal n (on the side
