@@ -13,7 +13,11 @@ constexpr float kBandsTimesAlpha = 2.0f;
 constexpr int kMinBands = 3;
 /// Records of more bands than this get a radius shrunk by kDensityBands / bands.
 constexpr float kDensityBands = 4.0f;
-constexpr uint32_t kRaysPerCoefficient = 16;
+/// Each record's coefficients carry the Monte Carlo noise of its gather; interpolated, that noise
+/// is a smooth error no number of camera samples removes. 16 rays a coefficient left it most of
+/// the error on glossy-objects' aluminium sphere at 32 spp (relMSE 0.0022 against 0.0013 with 32;
+/// README.md, "Glossy surfaces: the radiance cache").
+constexpr uint32_t kRaysPerCoefficient = 32;
 constexpr uint32_t kMaxRecordRays = 8192;
 constexpr uint64_t kRadianceStreamTag = 0x72616469616e6365ull;  // separates record streams
 
