@@ -12,6 +12,11 @@ namespace {
 
 /// How far beyond a record's domain (as a factor of a) the render pass may extrapolate.
 constexpr float kExtrapolationScale = 2.0f;
+/// Light samples at a point whose glossy lobes read the radiance cache (one elsewhere): the
+/// direct light keeps the two samples a glossy ray and a light sample gave it. On glossy-objects'
+/// cached sphere, 16 spp, relMSE 0.0025 -> 0.0018 (README.md, "Glossy surfaces: the radiance
+/// cache"); shadow rays cost a fraction of the gather ray the cache saves.
+constexpr int kCachedLobeLightSamples = 2;
 
 }  // namespace
 
@@ -326,9 +331,14 @@ RadianceParts PhotonMapIntegrator::surface_radiance(const Ray& ray, const Surfac
                             radiance_field(si.p, normal, &field, context);
         // Light sampling alone finds the emitters for cached lobes (their records hold no emission).
         const bool glossy_rays_sampled = glossy && !cached;
-        radiance.add_direct(sample_direct_light(rs, *direct_lights_, si, bsdf, wo, context, false, kAllLobes,
-                                                glossy_rays_sampled ? glossy_lobes : LobeMask(0),
-                                                static_cast<float>(glossy_rays)));
+        // A cached lobe traces no BSDF-sampled ray, whose emission was half of the direct light
+        // (MIS): a second light sample takes its place.
+        const int light_samples = cached ? kCachedLobeLightSamples : 1;
+        Color direct(0.0f);
+        for (int i = 0; i < light_samples; ++i)
+            direct += sample_direct_light(rs, *direct_lights_, si, bsdf, wo, context, false, kAllLobes,
+                                          glossy_rays_sampled ? glossy_lobes : LobeMask(0), static_cast<float>(glossy_rays));
+        radiance.add_direct(direct / static_cast<float>(light_samples));
         if (gatherer_) {
             const Color rho = bsdf.diffuse_reflectance(wo);
             if (max_component(rho) > 0.0f) {
