@@ -213,7 +213,16 @@ void IrradianceCache::for_each_weight(const Vec3& p, const Vec3& n, float accura
         // Every record whose domain holds p is filed in the node on p's root-to-leaf path.
         for_each_on_path(p, add);
     } else {
-        for_each_unique_candidate(p, accuracy_scale, 0.0f, add);
+        // Records filed in several nodes are met several times. Sorting only those that weigh
+        // (a few among the candidates) visits each once, in index order, as sorting all would.
+        thread_local std::vector<std::pair<uint32_t, double>> weighed;
+        weighed.clear();
+        for_each_candidate(p, accuracy_scale, 0.0f, [&](uint32_t index) {
+            if (const double w = weight(records_[index], p, n, a); w > 0.0) weighed.emplace_back(index, w);
+        });
+        std::sort(weighed.begin(), weighed.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+        for (size_t i = 0; i < weighed.size(); ++i)
+            if (i == 0 || weighed[i].first != weighed[i - 1].first) f(weighed[i].first, weighed[i].second);
     }
 }
 
