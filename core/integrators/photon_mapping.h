@@ -44,8 +44,9 @@ struct PhotonMapIntegratorSettings {
 /// glass at gather hits read from both sides; 4: glossy caustics left to the caustic map; 5: short
 /// gather rays trace a bounce (GatherSettings::short_ray_radii); 6: rough glass followed as glossy
 /// lobes are, and glass of any roughness read from both sides where the rays stop; 7: photon
-/// estimates without the photon on their edge (core/photon/photon_map.cpp, estimate_support); 8: every glossy
-/// lobe continues caustic paths (kSharpGlossyRoughness), so gathers leave its caustics to the map.
+/// estimates without the photon on their edge (core/photon/photon_map.cpp, estimate_support); 8: glossy lobes
+/// up to roughness 0.36 (was 0.25) continue caustic paths (kSharpGlossyRoughness): gathers leave their caustics
+/// to the map.
 inline constexpr uint32_t kRenderCacheAlgorithmVersion = 8;
 
 /// Nearest volume photons per estimate of the in-scattered light along a gather ray, at most.
