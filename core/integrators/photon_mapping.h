@@ -46,8 +46,9 @@ struct PhotonMapIntegratorSettings {
 /// lobes are, and glass of any roughness read from both sides where the rays stop; 7: photon
 /// estimates without the photon on their edge (core/photon/photon_map.cpp, estimate_support); 8: glossy lobes
 /// up to roughness 0.36 (was 0.25) continue caustic paths (kSharpGlossyRoughness): gathers leave their caustics
-/// to the map.
-inline constexpr uint32_t kRenderCacheAlgorithmVersion = 8;
+/// to the map; 9: a gather hit whose nearest irradiance sites face away reads a farther one that covers it
+/// (PhotonMap::nearest_irradiance) instead of a full photon estimate.
+inline constexpr uint32_t kRenderCacheAlgorithmVersion = 9;
 
 /// Nearest volume photons per estimate of the in-scattered light along a gather ray, at most.
 inline constexpr uint32_t kGatherVolumePhotons = 32;

@@ -111,6 +111,29 @@ TEST(PhotonMap, TheNearestIrradianceSiteGivesItsIrradianceAndRadius) {
     EXPECT_FALSE(sites.nearest_irradiance(Vec3(0.75f, 0.0f, 0.0f), up, 0.2f, &e, &radius));
 }
 
+TEST(PhotonMap, WhereTheNearestSitesFaceAwayAFartherOneThatCoversThePointIsTaken) {
+    // Four sites about p face down (a sheet's other side, a fold), a fifth farther away faces
+    // up: it is taken when p lies inside its estimate's disc, and not when p lies outside it.
+    const Vec3 up(0.0f, 1.0f, 0.0f), down(0.0f, -1.0f, 0.0f);
+    std::vector<Photon> facing_away;
+    for (int i = 0; i < 4; ++i)
+        facing_away.push_back(make_irradiance_site(Vec3(0.01f * float(i + 1), 0.0f, 0.0f), down, Color(9.0f), 0.05f));
+    std::vector<Photon> covering = facing_away, too_small = facing_away;
+    covering.push_back(make_irradiance_site(Vec3(0.2f, 0.0f, 0.0f), up, Color(2.0f), 0.25f));
+    too_small.push_back(make_irradiance_site(Vec3(0.2f, 0.0f, 0.0f), up, Color(2.0f), 0.15f));
+    Color e(-1.0f);
+    float radius = -1.0f;
+    ASSERT_TRUE(PhotonMap(covering, 0).nearest_irradiance(Vec3(0.0f), up, 1.0f, &e, &radius));
+    EXPECT_NEAR(e.x, 2.0f, 2e-3f);
+    EXPECT_NEAR(radius, 0.25f, 1e-3f);
+    EXPECT_FALSE(PhotonMap(too_small, 0).nearest_irradiance(Vec3(0.0f), up, 1.0f, &e, &radius));
+    // Among the nearest four, a site that agrees is taken wherever it lies within max_radius.
+    std::vector<Photon> near = facing_away;
+    near[3] = make_irradiance_site(Vec3(0.04f, 0.0f, 0.0f), up, Color(5.0f), 0.01f);
+    ASSERT_TRUE(PhotonMap(near, 0).nearest_irradiance(Vec3(0.0f), up, 1.0f, &e));
+    EXPECT_NEAR(e.x, 5.0f, 5e-3f);
+}
+
 TEST(PhotonMap, AFlatSurfaceReadsTheSameWithOrWithoutNormals) {
     // Photons and queries in one plane: the disc is the sphere there and every normal agrees,
     // so the estimates are those of the sphere search on photons without normals, bit for bit.
