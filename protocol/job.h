@@ -192,7 +192,8 @@ struct OutputSpec {
     std::string pixel_type;         // one of kPixelTypeNames
     std::vector<std::string> aovs;  // from kAovNames, no duplicates, in the order asked
     // Exposure of the PNG preview in stops (linear values x 2^exposure_ev before the tone curve);
-    // absent: automatic, from the image's log-average luminance. The EXR is not affected.
+    // absent: automatic, from the image's log-average luminance with highlight protection
+    // (core/image/png_preview.h). The EXR is not affected.
     std::optional<double> exposure_ev;
 
     bool operator==(const OutputSpec&) const = default;

@@ -851,8 +851,9 @@ std::vector<JobField> make_job_fields() {
         [](const json& value, const std::string& at) { return read_number(value, at, limits::kExposureEv); },
         number_schema(limits::kExposureEv,
                       "exposure of the PNG preview in stops (linear values x 2^exposure_ev, then the ACES filmic "
-                      "curve, then sRGB); absent: automatic, the log-average luminance mapped to 0.18. The EXR "
-                      "stays linear")));
+                      "curve, then sRGB); absent: automatic, the log-average luminance mapped to 0.18, lowered by up "
+                      "to 3 stops to keep the brightest tenth of the image under 2.0 (a sunlit subject over shade). "
+                      "The EXR stays linear")));
 
     fields.push_back({.path = "environment",
                       .read = [](const json& value, const std::string&, Job& job) {

@@ -140,7 +140,13 @@ float automatic_exposure_ev(const Image& image) {
     double sum = 0.0;
     for (auto it = first; it != last; ++it) sum += *it;
     const double mean = sum / double(last - first);
-    const double ev = std::log2(double(kPreviewMiddleGrey)) - mean;
+    const double average_ev = std::log2(double(kPreviewMiddleGrey)) - mean;
+    // Highlight protection (png_preview.h): the percentile's value, its rank among all the
+    // values left in.
+    const auto highlight = log_luminance.begin() + std::ptrdiff_t(kHighlightPercentile * double(n - 1));
+    std::nth_element(log_luminance.begin(), highlight, log_luminance.end());
+    const double highlight_ev = std::log2(double(kHighlightCeiling)) - double(*highlight);
+    const double ev = std::max(average_ev - double(kMaxHighlightProtectionEv), std::min(average_ev, highlight_ev));
     return float(std::clamp(ev, -double(kMaxAutomaticExposureEv), double(kMaxAutomaticExposureEv)));
 }
 

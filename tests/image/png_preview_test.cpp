@@ -186,6 +186,44 @@ TEST(AutomaticExposureTest, RobustToHotPixelsNonFiniteValuesAndBlack) {
     EXPECT_EQ(automatic_exposure_ev(Image(2, 2, Color(1e-40f))), kMaxAutomaticExposureEv);
 }
 
+/// An image with 15 of its 100 rows at radiance `bright`, the rest at `shade`.
+Image sunlit_over_shade(float bright, float shade) {
+    Image image(20, 100, Color(shade));
+    for (int y = 0; y < 15; ++y)
+        for (int x = 0; x < 20; ++x) image.at(x, y) = Color(bright);
+    return image;
+}
+
+/// automatic_exposure_ev's log-average exposure of sunlit_over_shade: its darkest and brightest
+/// 1 % (20 of each) left out, 280 bright and 1,680 shaded pixels remain.
+double average_ev_of(float bright, float shade) {
+    const double mean = (280.0 * std::log2(double(bright)) + 1680.0 * std::log2(double(shade))) / 1960.0;
+    return std::log2(double(kPreviewMiddleGrey)) - mean;
+}
+
+TEST(AutomaticExposureTest, ASunlitSubjectOverShadeKeepsItsShading) {
+    // 15 % in sunlight at 0.5, the rest in shade 100 times darker: the log-average alone exposes
+    // the sunlit part at 0.5 x 2^4.3 = 10, white; the brightest tenth is held at 2.0 instead.
+    const Image image = sunlit_over_shade(0.5f, 0.005f);
+    const double average_ev = average_ev_of(0.5f, 0.005f);
+    const float ev = automatic_exposure_ev(image);
+    EXPECT_NEAR(ev, std::log2(kHighlightCeiling / 0.5f), 1e-4f);
+    EXPECT_LT(ev, average_ev - 1.0);
+    Expected<std::vector<uint8_t>> bytes = encode_render_preview(image);
+    ASSERT_TRUE(bytes) << bytes.error().message;
+    const DecodedPng png = decode_png(*bytes);
+    EXPECT_EQ(png.at(5, 5, 0), preview_srgb8(kHighlightCeiling, 1.0f));
+    EXPECT_LT(png.at(5, 5, 0), 250);  // not white: the curve's 0.91
+    EXPECT_EQ(preview_srgb8(0.5f, float(std::exp2(average_ev))), 255);  // as it was
+
+    // A subject 2^20 times brighter than the rest: protection stops 3 stops under the average,
+    // so that a visible emitter does not blacken the rest of the picture.
+    EXPECT_NEAR(automatic_exposure_ev(sunlit_over_shade(1.0f, 1e-6f)),
+                average_ev_of(1.0f, 1e-6f) - kMaxHighlightProtectionEv, 1e-4);
+    // Where the brightest tenth is under the ceiling, the log-average alone decides.
+    EXPECT_NEAR(automatic_exposure_ev(sunlit_over_shade(0.3f, 0.1f)), average_ev_of(0.3f, 0.1f), 1e-4);
+}
+
 TEST(RenderPreviewTest, ExposureDoublesTheLinearValueBeforeTheCurve) {
     Image image(3, 1);
     image.at(0, 0) = Color(0.05f, 0.2f, 0.7f);
