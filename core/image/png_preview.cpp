@@ -141,8 +141,8 @@ float automatic_exposure_ev(const Image& image) {
     for (auto it = first; it != last; ++it) sum += *it;
     const double mean = sum / double(last - first);
     const double average_ev = std::log2(double(kPreviewMiddleGrey)) - mean;
-    // Highlight protection (png_preview.h): the percentile's value, its rank among all the
-    // values left in.
+    // Highlight protection (png_preview.h): the percentile's rank among all the positive finite
+    // values, the 1 % trimmed at either end included.
     const auto highlight = log_luminance.begin() + std::ptrdiff_t(kHighlightPercentile * double(n - 1));
     std::nth_element(log_luminance.begin(), highlight, log_luminance.end());
     const double highlight_ev = std::log2(double(kHighlightCeiling)) - double(*highlight);

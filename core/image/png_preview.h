@@ -22,12 +22,12 @@ namespace photond {
 inline constexpr float kPreviewMiddleGrey = 0.18f;
 /// Automatic exposure never goes beyond +-this many stops (2^64 keeps every float finite).
 inline constexpr float kMaxAutomaticExposureEv = 64.0f;
-/// Highlight protection of automatic exposure: the kHighlightPercentile of the luminances it
-/// averages is exposed no brighter than kHighlightCeiling (the filmic curve's 0.91), taking the
-/// exposure down from the log-average's by kMaxHighlightProtectionEv stops at most. A sunlit
-/// subject over deep shadows or a black background (IridescenceSuzanne: 2.6 % of the frame in
-/// sunlight, the rest shade and black) no longer comes out white; the cap leaves visible
-/// emitters free to clip (LightsPunctualLamp's glowing shade) rather than blacken the rest.
+/// Highlight protection of automatic exposure: the kHighlightPercentile of the image's positive
+/// finite luminances is exposed no brighter than kHighlightCeiling (the filmic curve's 0.91),
+/// taking the exposure down from the log-average's by kMaxHighlightProtectionEv stops at most. A
+/// sunlit subject over deep shade or a black background (IridescenceSuzanne: 7 % of its frame is
+/// not black, mostly shade) no longer comes out white; the cap leaves visible emitters free to
+/// clip (LightsPunctualLamp's glowing shade) rather than blacken the rest.
 inline constexpr double kHighlightPercentile = 0.9;
 inline constexpr float kHighlightCeiling = 2.0f;
 inline constexpr float kMaxHighlightProtectionEv = 3.0f;
@@ -44,9 +44,9 @@ float filmic_tone_curve(float x);
 /// luminance (black pixels, e.g. tiles not yet rendered, and NaN or inf are left out) with the
 /// darkest and brightest 1 % of them also left out, so that a few hot pixels cannot darken the
 /// picture; then lowered, by kMaxHighlightProtectionEv stops at most, until the
-/// kHighlightPercentile of those luminances is exposed no brighter than kHighlightCeiling. 0 when
-/// no pixel has positive finite luminance (an all-black image). Clamped to
-/// +-kMaxAutomaticExposureEv.
+/// kHighlightPercentile of all the positive finite luminances (the trimmed ones too) is exposed
+/// no brighter than kHighlightCeiling. 0 when no pixel has positive finite luminance (an
+/// all-black image). Clamped to +-kMaxAutomaticExposureEv.
 float automatic_exposure_ev(const Image& image);
 
 /// The 8-bit sRGB code of one linear channel of a render: scaled by exposure_scale, through
