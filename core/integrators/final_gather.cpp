@@ -17,8 +17,10 @@ GatherGrid GatherGrid::for_rays(uint32_t rays) {
 }
 
 FinalGatherer::FinalGatherer(std::shared_ptr<const RenderScene> scene, std::shared_ptr<const PhotonMaps> maps,
-                             const GatherSettings& settings)
+                             const GatherSettings& settings,
+                             std::shared_ptr<const CausticVisibility> caustic_visibility)
     : scene_(std::move(scene)), maps_(std::move(maps)), settings_(settings),
+      caustic_visibility_(std::move(caustic_visibility)),
       grid_(GatherGrid::for_rays(settings.rays)) {
     if (settings_.max_radius <= 0.0f) settings_.max_radius = 0.2f * scene_->scene->bounds.radius();
     site_radius_cap_ = kIrradianceRadiusShare * scene_->scene->bounds.radius();
@@ -302,7 +304,6 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
                 const LightSet& lights =
                     g.settings_.gather_diffuse_sky && rs.lights_with_sky_peaks ? *rs.lights_with_sky_peaks : *rs.lights;
                 radiance += sample_direct_light(rs, lights, si, bsdf, wo, context, false, lobes);
-                radiance += caustic_estimate(si, bsdf, wo, lobes);
             } else {
                 radiance += sample_direct_light(rs, *rs.lights, si, bsdf, wo, context, true, lobes);
             }
@@ -314,6 +315,14 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
                 const Walker on{g, rs, rng, counters, nullptr, caustics, short_ray_budget};
                 radiance += s->weight * on.along(spawn_ray(rs, si, s->wi), depth, nullptr, false, 0,
                                                  caustics ? nullptr : &origin);
+            }
+            // Last, so that what the hit sends otherwise is known: the caustic map's estimate
+            // only where it may show next to it, as at a visible point (it draws no random
+            // numbers, so the rest of the path is the same either way).
+            if (caustics) {
+                const Vec3 n = glm::dot(si.surface_normal, wo) >= 0.0f ? si.surface_normal : -si.surface_normal;
+                if (!g.caustic_visibility_ || g.caustic_visibility_->may_show(si.p, n, bsdf, wo, luminance(radiance), lobes))
+                    radiance += caustic_estimate(si, bsdf, wo, lobes);
             }
             return radiance;
         }

@@ -26,6 +26,7 @@
 
 #include <array>
 
+#include "core/integrators/caustic_visibility.h"
 #include "core/integrators/integrator.h"
 #include "core/photon/photon_tracer.h"
 
@@ -83,8 +84,11 @@ struct GatherGrid {
 
 class FinalGatherer {
 public:
+    /// `caustic_visibility`: decides where the short-ray rule's bounces read the caustic map
+    /// (null: everywhere).
     FinalGatherer(std::shared_ptr<const RenderScene> scene, std::shared_ptr<const PhotonMaps> maps,
-                  const GatherSettings& settings);
+                  const GatherSettings& settings,
+                  std::shared_ptr<const CausticVisibility> caustic_visibility = nullptr);
 
     /// Gathers at point p with unit normal n (the side light is gathered from), frame around n.
     /// `compute_gradients` adds the rotation and translation gradients.
@@ -123,6 +127,7 @@ private:
     std::shared_ptr<const RenderScene> scene_;
     std::shared_ptr<const PhotonMaps> maps_;
     GatherSettings settings_;
+    std::shared_ptr<const CausticVisibility> caustic_visibility_;
     GatherGrid grid_;
     /// The irradiance sites' estimate radius cap (kIrradianceRadiusShare of the scene's radius):
     /// a ray longer than short_ray_radii of it is never short.

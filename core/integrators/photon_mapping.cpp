@@ -36,6 +36,9 @@ PhotonMapIntegrator::PhotonMapIntegrator(std::shared_ptr<const RenderScene> scen
                                      : kDefaultGlobalRadiusShare * scene_radius;
     // Read directly, the global map must skip what light sampling and the caustic map count.
     global_options_.exclude_flags = photon_flags::kDirect | (maps_->caustic ? photon_flags::kCaustic : 0);
+    if (maps_->caustic)
+        caustic_visibility_ = std::make_shared<const CausticVisibility>(maps_->caustic_irradiance.get(),
+                                                                        caustic_options_.max_radius);
     if (settings_.final_gather && maps_->global) {
         GatherSettings gather = settings_.gather;
         gather.k_global = settings_.k_global;
@@ -46,7 +49,7 @@ PhotonMapIntegrator::PhotonMapIntegrator(std::shared_ptr<const RenderScene> scen
         gather.k_caustic = caustic_options_.k;
         gather.max_radius_caustic = caustic_options_.max_radius;
         gather.gather_diffuse_sky = scene_->lights_with_sky_peaks != nullptr;
-        gatherer_ = std::make_unique<FinalGatherer>(scene_, maps_, gather);
+        gatherer_ = std::make_unique<FinalGatherer>(scene_, maps_, gather, caustic_visibility_);
     }
     if (maps_->caustic) {
         for (const Photon& photon : maps_->caustic->tree().photons())
@@ -55,8 +58,6 @@ PhotonMapIntegrator::PhotonMapIntegrator(std::shared_ptr<const RenderScene> scen
                 break;
             }
     }
-    if (maps_->caustic_irradiance)
-        caustic_bound_ = IrradianceBoundGrid(*maps_->caustic_irradiance, caustic_options_.max_radius);
     direct_lights_ = gatherer_ && scene_->lights_with_sky_peaks ? scene_->lights_with_sky_peaks.get()
                                                                   : scene_->lights.get();
     if (gatherer_ && settings_.radiance_cache.enabled) {
@@ -241,32 +242,6 @@ Color PhotonMapIntegrator::indirect_irradiance(const DiffusePoint& point, Sample
     return g.irradiance;
 }
 
-/// Whether the caustic map's estimate at a visible point may add light that shows, next to the
-/// luminance `other` of what the point sends otherwise (emission, direct and indirect light). A
-/// surface that reads as diffuse (or is read by its Lambertian lobe alone: `lambertian_only`)
-/// reflects its irradiance whatever its direction, so its caustic is about rho(wo) / pi times the
-/// caustic irradiance precomputed at the nearest caustic photon: where that is under
-/// kInvisibleCausticRatio of `other`, the estimate (a hundred photons, each through the BSDF) is
-/// skipped. Each skipped sample leaves out under that share of its own value, so no pixel changes
-/// by more. No caustic photon within the estimate's radius means next to none would be found.
-/// Glossy and translucent surfaces read by their other lobes are always estimated: their lobes
-/// can gather a caustic that is faint as irradiance into a highlight.
-bool PhotonMapIntegrator::caustic_may_show(const Vec3& p, const Vec3& normal, const Bsdf& bsdf, const Vec3& wo,
-                                           float other, bool lambertian_only) const {
-    // reads_as_diffuse() is false for rough transmission too.
-    const bool diffuse = lambertian_only || bsdf.reads_as_diffuse();
-    const Color rho = !diffuse ? Color(0.0f) : lambertian_only ? bsdf.diffuse_reflectance(wo) : bsdf.diffuse_like_reflectance(wo);
-    if (diffuse && is_black(rho)) return false;
-    if (!maps_->caustic_irradiance || !diffuse) return true;
-    // First the bound over the sites in reach (luminance(rho E) <= max(rho) luminance(E)): most
-    // points of most scenes are decided without searching the sites.
-    const float threshold = static_cast<float>(kInvisibleCausticRatio) * other;
-    if (!caustic_bound_.empty() && max_component(rho) * kInvPi * caustic_bound_.bound(p) < threshold) return false;
-    Color irradiance;
-    if (!maps_->caustic_irradiance->nearest_irradiance(p, normal, caustic_options_.max_radius, &irradiance)) return false;
-    return luminance(rho * kInvPi * irradiance) >= threshold;
-}
-
 RadianceParts PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_length,
                                                   RayFootprint footprint, SampleContext& context) const {
     const RenderScene& rs = *scene_;
@@ -421,14 +396,15 @@ RadianceParts PhotonMapIntegrator::surface_radiance(const Ray& ray, const Surfac
             radiance.add_indirect(maps_->global->estimate_radiance(si.p, normal, bsdf, wo,
                                                                    estimate_options_at(global_options_, si, bsdf, front)));
         }
-        // Last, so that what the point sends otherwise is known (caustic_may_show).
+        // Last, so that what the point sends otherwise is known (CausticVisibility::may_show).
         if (maps_->caustic) {
             ++context.counters.caustic_points;
             // The rays (or the radiance cache) of the other non-delta lobes follow glossy lobes to
             // the lights: they hold the glossy caustics those lobes reflect, and with no ideal
             // specular caustics in the map, all the caustic light those lobes see.
             const bool lambertian_only = glossy && !specular_caustics_;
-            if (caustic_may_show(si.p, normal, bsdf, wo, luminance(radiance.total), lambertian_only)) {
+            if (caustic_visibility_->may_show(si.p, normal, bsdf, wo, luminance(radiance.total),
+                                              lambertian_only ? kLambertianLobe : kNonDeltaLobes)) {
                 RadianceEstimateOptions options = estimate_options_at(caustic_options_, si, bsdf, front);
                 if (lambertian_only)
                     options.lobes = kLambertianLobe;

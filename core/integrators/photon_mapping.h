@@ -18,7 +18,6 @@
 #include "core/integrators/integrator.h"
 #include "core/integrators/irradiance_cache_builder.h"
 #include "core/integrators/radiance_cache.h"
-#include "core/photon/irradiance_bound_grid.h"
 #include "core/photon/photon_tracer.h"
 
 namespace photond {
@@ -47,8 +46,10 @@ struct PhotonMapIntegratorSettings {
 /// estimates without the photon on their edge (core/photon/photon_map.cpp, estimate_support); 8: glossy lobes
 /// up to roughness 0.36 (was 0.25) continue caustic paths (kSharpGlossyRoughness): gathers leave their caustics
 /// to the map; 9: a gather hit whose nearest irradiance sites face away reads a farther one that covers it
-/// (PhotonMap::nearest_irradiance) instead of a full photon estimate.
-inline constexpr uint32_t kRenderCacheAlgorithmVersion = 9;
+/// (PhotonMap::nearest_irradiance) instead of a full photon estimate; 10: the nearest site that faces
+/// the hit's way and covers it, in one search, and the short-ray rule's caustic estimates only where
+/// they may show (CausticVisibility).
+inline constexpr uint32_t kRenderCacheAlgorithmVersion = 10;
 
 /// Nearest volume photons per estimate of the in-scattered light along a gather ray, at most.
 inline constexpr uint32_t kGatherVolumePhotons = 32;
@@ -122,9 +123,6 @@ private:
     /// The radiance cache's field at a glossy point, extrapolating a little where no record is
     /// usable; false (BSDF-sampled rays instead) where none is even then.
     bool radiance_field(const Vec3& p, const Vec3& normal, RadianceCache::Field* field, SampleContext& context) const;
-    /// `lambertian_only`: the estimate reflects the photons by the Lambertian lobe alone.
-    bool caustic_may_show(const Vec3& p, const Vec3& normal, const Bsdf& bsdf, const Vec3& wo, float other,
-                          bool lambertian_only) const;
 
     std::shared_ptr<const RenderScene> scene_;
     std::shared_ptr<const PhotonMaps> maps_;
@@ -138,8 +136,8 @@ private:
     /// Whether the caustic map holds photons of ideal specular paths alone (L S+ D without a
     /// glossy bounce): glossy lobes read only those.
     bool specular_caustics_ = false;
-    /// Bounds the caustic sites' irradiance within caustic_options_.max_radius (caustic_may_show).
-    IrradianceBoundGrid caustic_bound_;
+    /// Whether a caustic estimate may show (with a caustic map; shared with gatherer_).
+    std::shared_ptr<const CausticVisibility> caustic_visibility_;
     /// What next-event estimation samples: the scene's lights, or with final gathering under an
     /// environment, the lights with only the sky's peaks (the gather collects the rest).
     const LightSet* direct_lights_ = nullptr;

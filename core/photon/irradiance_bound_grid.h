@@ -2,7 +2,7 @@
 // nearest_irradiance) within a search radius of a point, found in one array read: a coarse grid
 // over the sites whose every cell holds the largest luminance among the sites within the radius
 // of some point of the cell. The caustic map's visibility test at visible points
-// (PhotonMapIntegrator::caustic_may_show) reads it first and searches the sites only where the
+// (CausticVisibility::may_show) reads it first and searches the sites only where the
 // bound could show.
 #pragma once
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -19,6 +20,30 @@ struct KnnNeighbor {
     uint32_t index = 0;
     float dist2 = 0.0f;
 };
+
+namespace knn_detail {
+// (dist2, index) order of the k-nearest max-heap: the result is the k smallest in this order.
+// A function object, not a function: std::make_heap and std::sort inline it, where a function
+// pointer was called for every comparison.
+inline constexpr auto closer = [](const KnnNeighbor& a, const KnnNeighbor& b) {
+    return a.dist2 < b.dist2 || (a.dist2 == b.dist2 && a.index < b.index);
+};
+
+// Replaces the root of the max-heap heap[0, n) and restores the heap property.
+inline void replace_heap_top(KnnNeighbor* heap, size_t n, KnnNeighbor value) {
+    size_t i = 0;
+    for (;;) {
+        size_t child = 2 * i + 1;
+        if (child >= n) break;
+        if (child + 1 < n && closer(heap[child], heap[child + 1])) ++child;
+        if (!closer(value, heap[child])) break;
+        heap[i] = heap[child];
+        i = child;
+    }
+    heap[i] = value;
+}
+
+}  // namespace knn_detail
 
 /// The result of PhotonKdTree::k_nearest. Keep one per thread and pass it to every query: its
 /// buffer is reused, so queries do not allocate once it has grown to k.
@@ -103,6 +128,16 @@ public:
     void k_nearest_flagged(const Vec3& p, uint32_t k, float max_radius, uint8_t required_flags,
                            uint8_t excluded_flags, KnnResult& out) const;
 
+    /// The k nearest to p within max_radius by `distance2_to(position)` (which must never be
+    /// below distance2(p, position): the tree prunes by it) among the photons that
+    /// `accept(photon, dist2)` takes, with k_nearest's guarantees. `accept` is asked only of a
+    /// photon that would enter the result as things stand (within the radius, and nearer than
+    /// the farthest once k are found), so a costly test (a decoded normal, a radius) runs for few
+    /// of the photons a search meets; it must depend on its arguments alone.
+    template <class Distance2, class Accept>
+    void k_nearest_where(const Vec3& p, uint32_t k, float max_radius, KnnResult& out, Distance2 distance2_to,
+                         Accept accept) const;
+
     /// Calls f(uint32_t index, float dist2) for every photon with distance <= radius to p, in a
     /// deterministic order. Nothing for a non-finite p or a negative or NaN radius.
     template <class F>
@@ -133,17 +168,91 @@ public:
 private:
     static void build_subtree(Photon* photons, uint32_t lo, uint32_t hi);
 
-    /// `accept(photon)`: whether the photon is a candidate at all.
-    template <class Distance2, class Accept>
-    void k_nearest_impl(const Vec3& p, uint32_t k, float max_radius, KnnResult& out,
-                        Distance2 distance2_to, Accept accept) const;
-
     // Deeper than any balanced tree over < 2^32 photons (depth <= 32).
     static constexpr int kMaxStackDepth = 64;
 
     std::vector<Photon> photons_;
     Bounds3 bounds_;
 };
+
+template <class Distance2, class Accept>
+void PhotonKdTree::k_nearest_where(const Vec3& p, uint32_t k, float max_radius, KnnResult& out,
+                                   Distance2 distance2_to, Accept accept) const {
+    using knn_detail::closer;
+    // distance2_to(q) >= distance2(p, q) for every q: a subtree whose cell lies beyond the
+    // current radius holds no closer photon in either metric.
+    out.clear();
+    if (k == 0 || photons_.empty() || !is_finite(p) || !(max_radius >= 0.0f)) return;
+    std::vector<KnnNeighbor>& heap = out.neighbors;
+    const size_t capacity = std::min<size_t>(k, photons_.size());
+    if (heap.capacity() < capacity) heap.reserve(capacity);
+
+    // Until the heap is full, r2 is the max_radius ball; then the heap top's distance (Jensen
+    // 2001, section 6.3.1). Subtrees whose cell distance equals r2 are still visited, since
+    // they may hold a photon at the same distance with a smaller index.
+    float r2 = max_radius * max_radius;
+    float farthest2 = 0.0f;
+    bool full = false;
+    const auto consider = [&](uint32_t index, float d2) {
+        if (d2 > r2) return;
+        if (full && !closer({index, d2}, heap[0])) return;
+        if (!accept(photons_[index], d2)) return;
+        if (!full) {
+            heap.push_back({index, d2});
+            farthest2 = std::max(farthest2, d2);
+            if (heap.size() == capacity) {
+                std::make_heap(heap.begin(), heap.end(), closer);
+                full = true;
+                r2 = heap[0].dist2;
+            }
+        } else {
+            knn_detail::replace_heap_top(heap.data(), heap.size(), {index, d2});
+            r2 = heap[0].dist2;
+        }
+    };
+
+    // A subtree is skipped when its cell (the slabs of the splits above it) lies beyond r2, not
+    // only its nearest splitting plane (Arya and Mount 1993, "Algorithms for fast vector
+    // quantization": incremental distance): per axis, the squared distance from p to the cell's
+    // slab, and their sum in distance2's order. Every photon of the cell is at least as far on
+    // each axis and rounding is monotonic, so the sum never exceeds its distance2 (nor its disc
+    // distance): no subtree that holds a candidate is skipped.
+    struct Entry {
+        uint32_t lo, hi;
+        Vec3 slab2;  // squared distance from p to the cell's slab on each axis (0: p inside)
+        float cell2;  // (slab2.x + slab2.y) + slab2.z
+    };
+    Entry stack[kMaxStackDepth];
+    int top = 0;
+    stack[top++] = {0, size(), Vec3(0.0f), 0.0f};
+    while (top > 0) {
+        const Entry entry = stack[--top];
+        if (entry.cell2 > r2) continue;
+        uint32_t lo = entry.lo, hi = entry.hi;
+        while (hi - lo > kLeafSize) {
+            const uint32_t mid = lo + (hi - lo) / 2;
+            const Photon& node = photons_[mid];
+            consider(mid, distance2_to(node.position));
+            const uint32_t axis = node.split_axis();
+            const float plane = p[axis] - node.position[axis];
+            // The far side's slab on this axis begins at the plane, no nearer than the one
+            // above (the near side keeps this cell's slabs).
+            Vec3 far_slab2 = entry.slab2;
+            far_slab2[axis] = plane * plane;
+            const float far2 = far_slab2.x + far_slab2.y + far_slab2.z;
+            if (plane <= 0.0f) {  // near side first; the far side waits on the stack
+                if (far2 <= r2) stack[top++] = {mid + 1, hi, far_slab2, far2};
+                hi = mid;
+            } else {
+                if (far2 <= r2) stack[top++] = {lo, mid, far_slab2, far2};
+                lo = mid + 1;
+            }
+        }
+        for (uint32_t i = lo; i < hi; ++i) consider(i, distance2_to(photons_[i].position));
+    }
+    out.radius2 = full ? heap[0].dist2 : farthest2;
+    out.full = full;
+}
 
 template <class F>
 void PhotonKdTree::for_each_in_radius(const Vec3& p, float radius, F&& f) const {

@@ -177,31 +177,23 @@ Color PhotonMap::estimate_in_scattering(const Vec3& x, const Vec3& wo, float g, 
 
 bool PhotonMap::nearest_irradiance(const Vec3& p, const Vec3& normal, float max_radius, Color* irradiance,
                                    float* site_radius) const {
-    if (tree_.empty()) return false;
+    if (tree_.empty() || !is_finite(normal)) return false;
     KnnResult& found = thread_scratch();
     if (!(max_radius > 0.0f)) max_radius = std::numeric_limits<float>::infinity();
-    // The nearest sites first; where none of them faces the way `normal` does (a crumpled cloth,
-    // a thin sheet's other side), more of them, each taken only inside its own estimate's disc.
-    // Callers fell back on a full estimate of k photons there, which costs tens of nearest
-    // searches (TransmissionTest's backdrop: 125,000 a frame) and, counting only the photons whose
-    // normals agree over a disc sized by all of them, read low.
-    const KnnNeighbor* best = nullptr;
-    for (const uint32_t candidates : {kIrradianceSiteCandidates, kIrradianceSiteMoreCandidates}) {
-        const bool more = candidates == kIrradianceSiteMoreCandidates;
-        tree_.k_nearest_in_disc(p, normal, kPhotonDiscFlattening, candidates, max_radius, found);
-        for (const KnnNeighbor& n : found.neighbors) {
-            const Photon& photon = tree_.photon(n.index);
-            if (!photon.has_normal() || glm::dot(photon.normal(), normal) <= kIrradianceNormalCosine) continue;
-            if (more && n.dist2 > photon.site_radius() * photon.site_radius()) continue;
-            // Nearest first; ties go to the smaller index so the choice is deterministic.
-            if (!best || n.dist2 < best->dist2 || (n.dist2 == best->dist2 && n.index < best->index)) best = &n;
-        }
-        // Fewer found than asked for: every site within max_radius was seen.
-        if (best || found.size() < candidates) break;
-    }
-    if (!best) return false;
-    *irradiance = tree_.photon(best->index).flux();
-    if (site_radius) *site_radius = tree_.photon(best->index).site_radius();
+    // One search for the nearest site that faces the query's way (the nearest few sites of a
+    // crumpled cloth or a sheet's other side face away), asking a site's normal only where it is
+    // nearer than the best so far (k_nearest_where). A site whose estimate's disc ends short of p
+    // never measured the light there: the caller estimates it from the photons instead.
+    constexpr float kStretch2 = kPhotonDiscFlattening * kPhotonDiscFlattening - 1.0f;
+    tree_.k_nearest_where(
+        p, 1, max_radius, found,
+        [p, normal](const Vec3& q) { return PhotonKdTree::disc_distance2(p, q, normal, kStretch2); },
+        [normal](const Photon& site, float) { return site.has_normal() && glm::dot(site.normal(), normal) > kIrradianceNormalCosine; });
+    if (found.empty()) return false;
+    const Photon& site = tree_.photon(found.neighbors[0].index);
+    if (found.neighbors[0].dist2 > site.site_radius() * site.site_radius()) return false;
+    *irradiance = site.flux();
+    if (site_radius) *site_radius = site.site_radius();
     return true;
 }
 

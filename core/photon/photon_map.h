@@ -35,10 +35,6 @@ inline constexpr uint32_t kMinPhotonsPerEstimate = 8;
 
 /// Minimum cosine between a query's normal and a precomputed-irradiance photon's normal.
 inline constexpr float kIrradianceNormalCosine = 0.9f;
-/// Irradiance sites PhotonMap::nearest_irradiance looks at, and looks at next where none of
-/// those faces the query's way.
-inline constexpr uint32_t kIrradianceSiteCandidates = 4;
-inline constexpr uint32_t kIrradianceSiteMoreCandidates = 16;
 
 /// Minimum cosine between a query's normal and the surface normal a photon was stored with, for
 /// the photon to count in an estimate (Jensen 2001, section 7.2: photons of other surfaces are
@@ -129,12 +125,11 @@ public:
 
     /// Precomputed irradiance (Christensen 1999, "Faster photon map global illumination"): in a
     /// map of irradiance sites (make_irradiance_site: irradiance as flux, a surface normal, the
-    /// estimate's radius), the nearest one within max_radius whose normal agrees with `normal`
-    /// (cosine > kIrradianceNormalCosine) of the kIrradianceSiteCandidates nearest; where none of
-    /// them agrees, of the kIrradianceSiteMoreCandidates nearest, the nearest that agrees and
-    /// holds p inside its own estimate's disc. Sites without a normal are never taken. Returns
-    /// false when none is found; else its irradiance, and its estimate's radius in `site_radius`
-    /// when given.
+    /// estimate's radius), the nearest one within max_radius (by disc distance, as estimates
+    /// search) whose normal agrees with `normal` (cosine > kIrradianceNormalCosine), where its
+    /// own estimate's disc holds p. Sites without a normal are never taken. Returns false when
+    /// there is no such site or its disc ends short of p; else its irradiance, and its
+    /// estimate's radius in `site_radius` when given.
     bool nearest_irradiance(const Vec3& p, const Vec3& normal, float max_radius, Color* irradiance,
                             float* site_radius = nullptr) const;
 

@@ -28,7 +28,7 @@
 // while tracing it and estimating it at visible points would cost time: the map is not built,
 // tracing for it stops, and the statistics say why (caustic_dropped, caustic_peak_ratio). A map
 // that shows somewhere is kept; where it is faint, the render skips it point by point
-// (PhotonMapIntegrator::caustic_may_show, with the caustic irradiance precomputed here).
+// (CausticVisibility::may_show, with the caustic irradiance precomputed here).
 #pragma once
 
 #include <atomic>

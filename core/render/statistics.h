@@ -50,7 +50,7 @@ struct RenderStatistics {
     size_t photon_map_bytes = 0;
     double caustic_flux_share = 0.0;  // caustic_flux_share (core/photon/photon_tracer.h) of the maps used
     /// Visible points of the render pass where the caustic map could be read, and those where
-    /// its estimate was skipped as too faint to show (PhotonMapIntegrator::caustic_may_show).
+    /// its estimate was skipped as too faint to show (CausticVisibility::may_show).
     uint64_t caustic_points = 0;
     uint64_t caustic_skipped = 0;
     /// "hit" when the photon maps came from the cache, "miss" when traced and stored, empty when

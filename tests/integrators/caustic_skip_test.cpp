@@ -1,5 +1,5 @@
 // Caustic estimates skipped where the caustic is too faint to show
-// (PhotonMapIntegrator::caustic_may_show): the image with them skipped against the one with every
+// (CausticVisibility::may_show): the image with them skipped against the one with every
 // estimate made, on the glass sphere of `caustic-area`, whose caustic lies in the sphere's shadow
 // and nowhere else.
 #include <gtest/gtest.h>

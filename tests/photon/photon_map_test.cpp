@@ -92,11 +92,12 @@ TEST(PhotonMap, AParallelSurfaceJustAboveIsNotRead) {
 }
 
 TEST(PhotonMap, TheNearestIrradianceSiteGivesItsIrradianceAndRadius) {
-    // Two sites on a plane: the nearer one's irradiance and estimate radius come back; a site
-    // facing another way, or one without a normal, is never taken.
+    // Two sites on a plane: the nearer one whose estimate's disc holds the query gives its
+    // irradiance and radius; a site facing another way, or one without a normal, is never taken,
+    // however near.
     const Vec3 up(0.0f, 1.0f, 0.0f);
-    const PhotonMap sites({make_irradiance_site(Vec3(0.0f), up, Color(1.0f), 0.05f),
-                           make_irradiance_site(Vec3(1.0f, 0.0f, 0.0f), up, Color(2.0f), 0.2f),
+    const PhotonMap sites({make_irradiance_site(Vec3(0.0f), up, Color(1.0f), 0.25f),
+                           make_irradiance_site(Vec3(1.0f, 0.0f, 0.0f), up, Color(2.0f), 0.3f),
                            make_irradiance_site(Vec3(0.1f, 0.0f, 0.0f), Vec3(1.0f, 0.0f, 0.0f), Color(3.0f), 0.3f),
                            make_irradiance_site(Vec3(0.8f, 0.0f, 0.0f), Vec3(0.0f), Color(4.0f), 0.4f)},
                           0);
@@ -104,11 +105,13 @@ TEST(PhotonMap, TheNearestIrradianceSiteGivesItsIrradianceAndRadius) {
     float radius = -1.0f;
     ASSERT_TRUE(sites.nearest_irradiance(Vec3(0.2f, 0.0f, 0.0f), up, 2.0f, &e, &radius));
     EXPECT_NEAR(e.x, 1.0f, 1e-3f);
-    EXPECT_NEAR(radius, 0.05f, 1e-4f);
+    EXPECT_NEAR(radius, 0.25f, 1e-3f);
     ASSERT_TRUE(sites.nearest_irradiance(Vec3(0.75f, 0.0f, 0.0f), up, 2.0f, &e, &radius));
     EXPECT_NEAR(e.x, 2.0f, 2e-3f);
-    EXPECT_NEAR(radius, 0.2f, 1e-4f);
+    EXPECT_NEAR(radius, 0.3f, 1e-3f);
     EXPECT_FALSE(sites.nearest_irradiance(Vec3(0.75f, 0.0f, 0.0f), up, 0.2f, &e, &radius));
+    // Between the two discs (0.25 from the first, 0.3 from the second): none stands for it.
+    EXPECT_FALSE(sites.nearest_irradiance(Vec3(0.4f, 0.0f, 0.0f), up, 2.0f, &e, &radius));
 }
 
 TEST(PhotonMap, WhereTheNearestSitesFaceAwayAFartherOneThatCoversThePointIsTaken) {
@@ -127,11 +130,59 @@ TEST(PhotonMap, WhereTheNearestSitesFaceAwayAFartherOneThatCoversThePointIsTaken
     EXPECT_NEAR(e.x, 2.0f, 2e-3f);
     EXPECT_NEAR(radius, 0.25f, 1e-3f);
     EXPECT_FALSE(PhotonMap(too_small, 0).nearest_irradiance(Vec3(0.0f), up, 1.0f, &e, &radius));
-    // Among the nearest four, a site that agrees is taken wherever it lies within max_radius.
-    std::vector<Photon> near = facing_away;
+    // A nearer site that faces up but whose disc ends short of p: p lies in a gap of the light
+    // it measured, and no farther site is read for it; where its disc holds p, it is the one read.
+    std::vector<Photon> near = covering;
     near[3] = make_irradiance_site(Vec3(0.04f, 0.0f, 0.0f), up, Color(5.0f), 0.01f);
+    EXPECT_FALSE(PhotonMap(near, 0).nearest_irradiance(Vec3(0.0f), up, 1.0f, &e));
+    near[3] = make_irradiance_site(Vec3(0.04f, 0.0f, 0.0f), up, Color(5.0f), 0.05f);
     ASSERT_TRUE(PhotonMap(near, 0).nearest_irradiance(Vec3(0.0f), up, 1.0f, &e));
     EXPECT_NEAR(e.x, 5.0f, 5e-3f);
+}
+
+TEST(PhotonMap, TheNearestIrradianceSiteIsTheOneABruteForceSearchFinds) {
+    // Random sites with random normals and radii on a bumpy sheet, queried anywhere about it:
+    // the site found is the nearest by (disc distance, index) that faces the query's way, and
+    // is found where its disc holds the query, exactly.
+    Rng rng = Rng::for_stream(11, 0, 0);
+    std::vector<Photon> photons;
+    for (int i = 0; i < 3000; ++i) {
+        const Vec3 position(rng.next_float(), 0.1f * rng.next_float(), rng.next_float());
+        const Vec3 normal = glm::normalize(Vec3(rng.next_float() - 0.5f, 1.0f, rng.next_float() - 0.5f) *
+                                           (rng.next_float() < 0.3f ? -1.0f : 1.0f));
+        photons.push_back(make_irradiance_site(position, normal, Color(float(i + 1)), 0.01f + 0.05f * rng.next_float()));
+    }
+    const PhotonMap sites(photons, 0);
+    const float stretch2 = kPhotonDiscFlattening * kPhotonDiscFlattening - 1.0f;
+    size_t found = 0;
+    for (int q = 0; q < 2000; ++q) {
+        const Vec3 p(1.2f * rng.next_float() - 0.1f, 0.2f * rng.next_float() - 0.05f, 1.2f * rng.next_float() - 0.1f);
+        const Vec3 n = glm::normalize(Vec3(rng.next_float() - 0.5f, 1.0f, rng.next_float() - 0.5f));
+        const float max_radius = q % 2 ? 0.05f : 1.0f;
+        int best = -1;
+        float best2 = 0.0f;
+        const std::span<const Photon> all = sites.tree().photons();
+        for (size_t i = 0; i < all.size(); ++i) {
+            const float d2 = PhotonKdTree::disc_distance2(p, all[i].position, n, stretch2);
+                if (d2 > max_radius * max_radius || !(glm::dot(all[i].normal(), n) > kIrradianceNormalCosine)) continue;
+            if (best < 0 || d2 < best2) {  // ascending index: ties keep the smaller
+                best = int(i);
+                best2 = d2;
+            }
+        }
+        if (best >= 0 && best2 > all[size_t(best)].site_radius() * all[size_t(best)].site_radius()) best = -1;
+        Color e(-1.0f);
+        float radius = -1.0f;
+        const bool hit = sites.nearest_irradiance(p, n, max_radius, &e, &radius);
+        ASSERT_EQ(hit, best >= 0) << "query " << q;
+        if (!hit) continue;
+        ++found;
+        EXPECT_EQ(e, all[size_t(best)].flux()) << "query " << q;
+        EXPECT_EQ(radius, all[size_t(best)].site_radius()) << "query " << q;
+    }
+    // Both outcomes exercised: found, and none facing or covering.
+    EXPECT_GT(found, 200u);
+    EXPECT_LT(found, 1800u);
 }
 
 TEST(PhotonMap, AFlatSurfaceReadsTheSameWithOrWithoutNormals) {
