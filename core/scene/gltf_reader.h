@@ -79,6 +79,8 @@ Expected<Texture> decode_image(const tinygltf::Image& image, int image_index, bo
 // Accessors (gltf_accessors.cpp).
 
 int component_size(int component_type);
+/// The rotation of quaternion (x, y, z, w), normalized first; nullopt for a zero quaternion.
+std::optional<Mat3> rotation_matrix(double x, double y, double z, double w);
 int component_count(int type);
 std::string type_name(int type);
 std::string component_type_name(int component_type);
@@ -109,6 +111,10 @@ extern const AccessorRule kTexcoordRule;
 extern const AccessorRule kColorRule;
 extern const AccessorRule kTangentRule;
 extern const AccessorRule kIndexRule;
+/// EXT_mesh_gpu_instancing's instance attributes.
+extern const AccessorRule kInstanceTranslationRule;
+extern const AccessorRule kInstanceRotationRule;
+extern const AccessorRule kInstanceScaleRule;
 
 /// The rule an attribute follows in this file: the core rule, widened where the file declares
 /// KHR_mesh_quantization.
@@ -228,6 +234,11 @@ private:
                                      const std::string& context, const std::string& role, bool srgb,
                                      std::vector<int>& sets);
     Status visit_node(int node_index, const Mat4& parent, int depth);
+    /// The node's mesh, every primitive, placed by `world`.
+    Status add_node_mesh(const tinygltf::Node& node, int node_index, const Mat4& world);
+    /// The node's EXT_mesh_gpu_instancing transforms (gltf_instancing.cpp), each applied before
+    /// the node's world transform; the identity alone for a node without the extension.
+    Expected<std::vector<Mat4>> instance_transforms(const tinygltf::Node& node, int node_index);
     Status add_camera(const tinygltf::Node& node, int node_index, const Mat4& world);
     void add_cameras();
     void note_dropped_primitive_features(const tinygltf::Primitive& prim);

@@ -13,7 +13,8 @@ const std::set<std::string, std::less<>> kSupportedRequiredExtensions = {
 // Geometry and file extensions (kept apart from the material ones above): decoded by the loader,
 // so a file may require them.
 const std::set<std::string, std::less<>> kSupportedGeometryExtensions = {
-    "KHR_mesh_quantization", "EXT_meshopt_compression", "KHR_draco_mesh_compression"};
+    "KHR_mesh_quantization", "EXT_meshopt_compression", "KHR_draco_mesh_compression",
+    "EXT_mesh_gpu_instancing"};
 
 bool is_supported_extension(const std::string& name) {
     return kSupportedRequiredExtensions.count(name) > 0 ||
@@ -46,19 +47,10 @@ Expected<Mat4> GltfSceneReader::local_transform(const tinygltf::Node& node, int 
         t[3] = Vec4(float(node.translation[0]), float(node.translation[1]),
                     float(node.translation[2]), 1.0f);
     if (!node.rotation.empty()) {
-        // Unit quaternion (x, y, z, w) to a rotation matrix (columns below).
-        double x = node.rotation[0], y = node.rotation[1], z = node.rotation[2],
-               w = node.rotation[3];
-        const double len = std::sqrt(x * x + y * y + z * z + w * w);
-        if (!(len > 0.0)) return fail(context + "rotation is a zero quaternion");
-        x /= len, y /= len, z /= len, w /= len;
-        const Mat3 rot(float(1 - 2 * (y * y + z * z)), float(2 * (x * y + z * w)),
-                       float(2 * (x * z - y * w)),  // column 0
-                       float(2 * (x * y - z * w)), float(1 - 2 * (x * x + z * z)),
-                       float(2 * (y * z + x * w)),  // column 1
-                       float(2 * (x * z + y * w)), float(2 * (y * z - x * w)),
-                       float(1 - 2 * (x * x + y * y)));  // column 2
-        r = Mat4(rot);
+        const std::optional<Mat3> rot =
+            rotation_matrix(node.rotation[0], node.rotation[1], node.rotation[2], node.rotation[3]);
+        if (!rot) return fail(context + "rotation is a zero quaternion");
+        r = Mat4(*rot);
     }
     if (!node.scale.empty()) {
         s[0][0] = float(node.scale[0]);
@@ -210,6 +202,36 @@ Status GltfSceneReader::add_light(const tinygltf::Node& node, int node_index, co
     return Status::ok();
 }
 
+Status GltfSceneReader::add_node_mesh(const tinygltf::Node& node, int node_index, const Mat4& world) {
+    const std::string context = "node " + std::to_string(node_index) + quoted(node.name) + ": ";
+    auto& cached = meshes_[static_cast<size_t>(node.mesh)];
+    if (!cached) {
+        if (Status st = load_mesh(node.mesh); !st) return st;
+    }
+    for (size_t p = 0; p < cached->size(); ++p) {
+        const DecodedPrimitive& prim = (*cached)[p];
+        if (prim.triangles.empty()) continue;
+        const size_t new_vertices = prim.normals.empty() ? 3 * prim.triangles.size() : prim.positions.size();
+        triangle_count_ += prim.triangles.size();
+        vertex_count_ += new_vertices;
+        if (triangle_count_ > kMaxSceneTriangles || vertex_count_ > kMaxSceneVertices)
+            return fail("the scene has more than " + std::to_string(kMaxSceneTriangles) + " triangles or " +
+                        std::to_string(kMaxSceneVertices) + " vertices");
+        SceneBuilder::MeshExtras extras;
+        extras.uvs1 = prim.uvs1;
+        extras.colors = prim.colors;
+        extras.tangents = prim.tangents;
+        if (Status st = builder_.add_mesh(prim.positions, prim.normals, prim.uvs, prim.triangles, prim.material,
+                                          world, extras);
+            !st) {
+            const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(node.mesh)];
+            return fail(context + "mesh " + std::to_string(node.mesh) + quoted(mesh.name) + " primitive " +
+                        std::to_string(p) + ": " + st.error().message);
+        }
+    }
+    return Status::ok();
+}
+
 Status GltfSceneReader::visit_node(int node_index, const Mat4& parent, int depth) {
     const auto index = static_cast<size_t>(node_index);
     const tinygltf::Node& node = model_.nodes[index];
@@ -230,32 +252,14 @@ Status GltfSceneReader::visit_node(int node_index, const Mat4& parent, int depth
     if (node.mesh >= 0) {
         if (static_cast<size_t>(node.mesh) >= model_.meshes.size())
             return fail(context + "mesh " + std::to_string(node.mesh) + " does not exist");
-        auto& cached = meshes_[static_cast<size_t>(node.mesh)];
-        if (!cached) {
-            if (Status st = load_mesh(node.mesh); !st) return st;
-        }
-        for (size_t p = 0; p < cached->size(); ++p) {
-            const DecodedPrimitive& prim = (*cached)[p];
-            if (prim.triangles.empty()) continue;
-            const size_t new_vertices =
-                prim.normals.empty() ? 3 * prim.triangles.size() : prim.positions.size();
-            triangle_count_ += prim.triangles.size();
-            vertex_count_ += new_vertices;
-            if (triangle_count_ > kMaxSceneTriangles || vertex_count_ > kMaxSceneVertices)
-                return fail("the scene has more than " + std::to_string(kMaxSceneTriangles) +
-                            " triangles or " + std::to_string(kMaxSceneVertices) + " vertices");
-            SceneBuilder::MeshExtras extras;
-            extras.uvs1 = prim.uvs1;
-            extras.colors = prim.colors;
-            extras.tangents = prim.tangents;
-            if (Status st = builder_.add_mesh(prim.positions, prim.normals, prim.uvs,
-                                              prim.triangles, prim.material, world, extras);
-                !st) {
-                const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(node.mesh)];
-                return fail(context + "mesh " + std::to_string(node.mesh) + quoted(mesh.name) +
-                            " primitive " + std::to_string(p) + ": " + st.error().message);
-            }
-        }
+        // EXT_mesh_gpu_instancing: the mesh at each instance's transform, applied before the
+        // node's, and not at the node's alone.
+        Expected<std::vector<Mat4>> instances = instance_transforms(node, node_index);
+        if (!instances) return instances.error();
+        for (const Mat4& instance : *instances)
+            if (Status st = add_node_mesh(node, node_index, world * instance); !st) return st;
+    } else if (node.extensions.count("EXT_mesh_gpu_instancing")) {
+        builder_.add_warning(context + "EXT_mesh_gpu_instancing on a node without a mesh is ignored");
     }
     if (node.camera >= 0) {
         if (Status st = add_camera(node, node_index, world); !st) return st;

@@ -1,7 +1,8 @@
-// Compressed and quantized copies of a glTF scene render the same image as the original:
-// gltfpack's KHR_mesh_quantization and EXT_meshopt_compression copies (tests/data/gltf/
-// compression, written by generate.py), and a KHR_draco_mesh_compression copy that this test
-// writes itself with libdraco's encoder (Debian ships no tool that writes Draco glTF).
+// Compressed, quantized and instanced copies of a glTF scene render the same image as the
+// original: gltfpack's KHR_mesh_quantization, EXT_meshopt_compression and EXT_mesh_gpu_instancing
+// copies (tests/data/gltf/compression, written by generate.py), and a KHR_draco_mesh_compression
+// copy that this test writes itself with libdraco's encoder (Debian ships no tool that writes
+// Draco glTF).
 #include <draco/compression/encode.h>
 #include <draco/mesh/triangle_soup_mesh_builder.h>
 #include <gtest/gtest.h>
@@ -100,6 +101,20 @@ TEST(GltfCompression, QuantizedAndMeshoptCopiesRenderTheSameImageToRounding) {
         EXPECT_LT(std::abs(e.mean_bias), 5e-4) << e.mean_bias;  // measured 7e-5
         EXPECT_LT(e.relative_mse, 1e-4) << e.relative_mse;      // measured 8e-6
     }
+}
+
+TEST(GltfCompression, GpuInstancedCopyRendersTheSameImageToRounding) {
+    // gltfpack -mi -noq: the six boxes of one mesh become one node with EXT_mesh_gpu_instancing
+    // (rotations as 16-bit quaternions); the file must declare it, or this tests nothing.
+    std::ifstream in(data_path("shelf_instanced.glb"), std::ios::binary);
+    const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    ASSERT_NE(bytes.find("\"EXT_mesh_gpu_instancing\":{\"attributes\""), std::string::npos);
+    const Image original = render(load(data_path("shelf.gltf")));
+    const Scene instanced = load(data_path("shelf_instanced.glb"));
+    EXPECT_TRUE(instanced.warnings.empty());
+    const ImageError e = compare(render(instanced), original);
+    EXPECT_LT(std::abs(e.mean_bias), 1e-5) << e.mean_bias;  // measured 6e-8
+    EXPECT_LT(e.relative_mse, 1e-8) << e.relative_mse;      // measured 1e-11
 }
 
 std::string base64(const std::vector<uint8_t>& bytes) {

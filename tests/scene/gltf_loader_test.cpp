@@ -373,6 +373,37 @@ TEST(GltfLoader, MeshoptCompressedCopiesHoldTheSameGeometry) {
     }
 }
 
+TEST(GltfLoader, GpuInstancesArePlacedLikeNodes) {
+    // EXT_mesh_gpu_instancing: three instances of one triangle under a moved, scaled node
+    // (rotations as normalized SHORT quaternions), against the same three placed by child nodes.
+    const Scene instanced = load_ok("instancing.gltf");
+    const Scene flat = load_ok("instancing_flat.gltf");
+    ASSERT_EQ(instanced.triangles.size(), 3u);  // the instances alone, not the node's own copy
+    ASSERT_EQ(flat.triangles.size(), 3u);
+    for (uint32_t t = 0; t < 3; ++t) {
+        SCOPED_TRACE("triangle " + std::to_string(t));
+        const glm::uvec3 a = instanced.triangles[t], b = flat.triangles[t];
+        // 16-bit quaternions: off by under 1e-4 of the distance from the instance's origin (2).
+        for (int v = 0; v < 3; ++v) expect_vec_near(instanced.positions[a[v]], flat.positions[b[v]], 1e-3f);
+        expect_vec_near(instanced.normals[a.x], flat.normals[b.x], 1e-3f);
+    }
+    // Instance 1: Parent (translate (1,1,0), scale 2) * translate (2,0,0) * 90 deg about z *
+    // scale 0.5: (1,0,0) -> (5,2,0).
+    expect_vec_near(instanced.positions[instanced.triangles[1].y], {5, 2, 0}, 1e-3f);
+    EXPECT_TRUE(has_warning(instanced, "EXT_mesh_gpu_instancing attribute(s) _ID are ignored"))
+        << all_warnings(instanced);
+    EXPECT_FALSE(has_warning(instanced, "glTF extension EXT_mesh_gpu_instancing")) << all_warnings(instanced);
+    EXPECT_TRUE(flat.warnings.empty()) << all_warnings(flat);
+}
+
+TEST(GltfLoaderErrors, GpuInstancingAttributesOfDifferentCounts) {
+    const std::string error = load_error("broken/instancing_count_mismatch.gltf");
+    EXPECT_NE(error.find("node 0 'Parent': EXT_mesh_gpu_instancing SCALE has 3 elements, the other "
+                         "attributes 2 (all must have the same count)"),
+              std::string::npos)
+        << error;
+}
+
 TEST(GltfLoader, MaterialsWithExtensionsAndDefaults) {
     const Scene scene = load_ok("materials.gltf");
     ASSERT_EQ(scene.triangles.size(), 3u);

@@ -902,6 +902,113 @@ def faint_caustics(half_side=0.5, reflectance=0.001):
     point_light_over_floor("faint_caustics.gltf", reflectance, mirror)
 
 
+def shelf():
+    """Six boxes of one mesh and material on their own nodes (turned, scaled, two under a moved
+    parent) on a floor under a point light: gltfpack -mi turns them into one node with
+    EXT_mesh_gpu_instancing (tests/scene/gltf_compression_test.cpp)."""
+    b = Builder()
+    b.doc["extensionsUsed"] = ["KHR_lights_punctual"]
+    b.doc["materials"] = [
+        {"name": "Floor", "pbrMetallicRoughness": {"baseColorFactor": [0.7, 0.7, 0.7, 1],
+                                                    "metallicFactor": 0}},
+        {"name": "Orange", "pbrMetallicRoughness": {"baseColorFactor": [0.85, 0.45, 0.1, 1],
+                                                     "metallicFactor": 0, "roughnessFactor": 0.6}},
+    ]
+    quad = [[-4, 0, -3], [4, 0, -3], [4, 0, 4], [-4, 0, 4]]
+    floor = mesh_primitive(b, quad, [[0, 1, 0]] * 4, [0, 2, 1, 0, 3, 2], 0)
+    wall = mesh_primitive(b, [[-4, 0, -3], [4, 0, -3], [4, 4, -3], [-4, 4, -3]], [[0, 0, 1]] * 4,
+                          [0, 1, 2, 0, 2, 3], 0)
+    bp, bn, bi = box_mesh()
+    b.doc["meshes"] = [{"name": "Floor", "primitives": [floor, wall]},
+                       {"name": "Box", "primitives": [mesh_primitive(b, bp, bn, bi, 1)]}]
+    b.doc["extensions"] = {"KHR_lights_punctual": {"lights": [
+        {"name": "Bulb", "type": "point", "color": [1, 0.95, 0.9], "intensity": 8000}]}}
+    b.doc["cameras"] = [{"name": "View", "type": "perspective",
+                         "perspective": {"yfov": 0.8, "znear": 0.05}}]
+
+    def turn(angle):  # about +y
+        return [0, math.sin(angle / 2), 0, math.cos(angle / 2)]
+    boxes = [
+        {"name": "Box0", "mesh": 1, "translation": [-2.0, 0.25, 0], "scale": [0.5, 0.5, 0.5]},
+        {"name": "Box1", "mesh": 1, "translation": [-1.0, 0.3, 0.4], "rotation": turn(0.4),
+         "scale": [0.6, 0.6, 0.6]},
+        {"name": "Box2", "mesh": 1, "translation": [0.0, 0.5, -0.5], "rotation": turn(-0.7),
+         "scale": [0.5, 1.0, 0.5]},
+        # Equal x and z scales under the turn: with three different ones, gltfpack's instance
+        # (its own decomposition of the matrix) came out turned by 1.085 rad and scaled by
+        # (0.646, 0.4, 0.763).
+        {"name": "Box3", "mesh": 1, "translation": [1.1, 0.2, 0.2], "rotation": turn(1.1),
+         "scale": [0.7, 0.4, 0.7]},
+        {"name": "Box4", "mesh": 1, "translation": [-0.5, 0, 0], "rotation": turn(0.2),
+         "scale": [0.3, 0.3, 0.3]},
+        {"name": "Box5", "mesh": 1, "translation": [0.5, 0, 0], "scale": [0.35, 0.35, 0.35]},
+    ]
+    b.doc["nodes"] = [
+        {"name": "FloorNode", "mesh": 0},
+        boxes[0], boxes[1], boxes[2], boxes[3],
+        # Two more on a lifted, turned board: their parent's transform applies too.
+        {"name": "Board", "translation": [1.8, 0.15, 1.2], "rotation": turn(-0.5),
+         "children": [6, 7]},
+        boxes[4], boxes[5],
+        {"name": "LightNode", "translation": [0.5, 2.6, 1.5],
+         "extensions": {"KHR_lights_punctual": {"light": 0}}},
+        {"name": "CameraNode", "camera": 0, "translation": [0, 1.6, 4.5],
+         "rotation": [-math.sin(0.15), 0, 0, math.cos(0.15)]},
+    ]
+    b.doc["scenes"] = [{"nodes": [0, 1, 2, 3, 4, 5, 8, 9]}]
+    b.doc["scene"] = 0
+    write("compression/shelf.gltf", b.finish())
+    gltfpack = shutil.which("gltfpack")
+    if not gltfpack:
+        print("gltfpack not found (Debian package gltfpack): the instanced copy not rewritten")
+        return
+    subprocess.run([gltfpack, "-i", os.path.join(HERE, "compression", "shelf.gltf"),
+                    "-o", os.path.join(HERE, "compression", "shelf_instanced.glb"), "-mi", "-noq"],
+                   check=True, stdout=subprocess.DEVNULL)
+
+
+def instancing():
+    """EXT_mesh_gpu_instancing written by hand: three instances of a triangle under a moved node,
+    rotations as normalized SHORT quaternions, a custom _ID attribute (ignored, with a warning);
+    instancing_flat.gltf places the same three triangles by nodes alone; broken/ holds one whose
+    attributes disagree on the instance count."""
+    translations = [[0, 0, 0], [2, 0, 0], [0, 3, -1]]
+    angles = [0.0, math.pi / 2, -math.pi / 3]  # about +z
+    scales = [[1, 1, 1], [0.5, 0.5, 0.5], [1, 2, 1]]
+
+    def quaternion(angle):
+        return [0, 0, math.sin(angle / 2), math.cos(angle / 2)]
+
+    def build(instanced, rotation_count=3):
+        b = Builder()
+        b.doc["meshes"] = [{"name": "Tri", "primitives": [{"attributes": triangle(b)}]}]
+        parent = {"name": "Parent", "translation": [1, 1, 0], "scale": [2, 2, 2]}
+        if instanced:
+            b.doc["extensionsUsed"] = ["EXT_mesh_gpu_instancing"]
+            b.doc["extensionsRequired"] = ["EXT_mesh_gpu_instancing"]
+            t = b.floats([c for v in translations for c in v], "VEC3")
+            shorts = [round(c * 32767) for a in angles[:rotation_count] for c in quaternion(a)]
+            r = b.accessor(b.view(struct.pack("<%dh" % len(shorts), *shorts)), 5122, rotation_count,
+                           "VEC4", normalized=True)
+            s = b.floats([c for v in scales for c in v], "VEC3")
+            ids = b.floats([0, 1, 2], "SCALAR")
+            parent["mesh"] = 0
+            parent["extensions"] = {"EXT_mesh_gpu_instancing": {"attributes": {
+                "TRANSLATION": t, "ROTATION": r, "SCALE": s, "_ID": ids}}}
+            b.doc["nodes"] = [parent]
+        else:
+            parent["children"] = [1, 2, 3]
+            b.doc["nodes"] = [parent] + [
+                {"name": "Instance%d" % i, "mesh": 0, "translation": translations[i],
+                 "rotation": quaternion(angles[i]), "scale": scales[i]} for i in range(3)]
+        b.doc["scenes"] = [{"nodes": [0]}]
+        b.doc["scene"] = 0
+        return b.finish()
+    write("instancing.gltf", build(True))
+    write("instancing_flat.gltf", build(False))
+    write("broken/instancing_count_mismatch.gltf", build(True, rotation_count=2))
+
+
 def main():
     os.makedirs(os.path.join(HERE, "broken"), exist_ok=True)
     write("indexed_u8.gltf", quad_indexed(U8).finish())
@@ -927,6 +1034,8 @@ def main():
     sparse_caustics()
     faint_caustics()
     room()
+    shelf()
+    instancing()
 
 
 if __name__ == "__main__":

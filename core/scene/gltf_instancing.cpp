@@ -1,0 +1,85 @@
+// EXT_mesh_gpu_instancing: a node's mesh drawn at many transforms, given per instance by
+// TRANSLATION, ROTATION and SCALE accessors. The instances are flattened into the scene like the
+// nodes of a hierarchy that share a mesh: each is a copy of the mesh, placed by
+// NodeWorldXform * Translation * Rotation * Scale.
+#include "core/scene/gltf_reader.h"
+
+namespace photond::gltf {
+
+Expected<std::vector<Mat4>> GltfSceneReader::instance_transforms(const tinygltf::Node& node, int node_index) {
+    const auto it = node.extensions.find("EXT_mesh_gpu_instancing");
+    if (it == node.extensions.end()) return std::vector<Mat4>{Mat4(1.0f)};
+    const std::string context =
+        "node " + std::to_string(node_index) + quoted(node.name) + ": EXT_mesh_gpu_instancing ";
+    const tinygltf::Value& ext = it->second;
+    if (!ext.IsObject()) return fail(context + "is not an object");
+    if (!ext.Has("attributes")) return std::vector<Mat4>{Mat4(1.0f)};  // every attribute is optional
+    const tinygltf::Value& attributes = ext.Get("attributes");
+    if (!attributes.IsObject()) return fail(context + "attributes is not an object");
+
+    std::optional<std::vector<Vec3>> translations, scales;
+    std::optional<std::vector<Vec4>> rotations;
+    std::optional<size_t> count;
+    std::vector<std::string> ignored;
+    for (const std::string& name : attributes.Keys()) {
+        const AccessorRule* rule = name == "TRANSLATION" ? &kInstanceTranslationRule
+                                   : name == "ROTATION"  ? &kInstanceRotationRule
+                                   : name == "SCALE"     ? &kInstanceScaleRule
+                                                         : nullptr;
+        if (!rule) {
+            // Custom attributes (_ID, _COLOR, ...) are the application's; nothing here reads them.
+            ignored.push_back(name);
+            continue;
+        }
+        const std::optional<int> accessor = int_value(attributes.Get(name));
+        if (!accessor) return fail(context + name + " is not an accessor index");
+        Expected<PackedAccessor> packed = pack_accessor(*accessor, context, name, *rule);
+        if (!packed) return packed.error();
+        if (count && *count != packed->count)
+            return fail(context + name + " has " + std::to_string(packed->count) + " elements, the other attributes " +
+                        std::to_string(*count) + " (all must have the same count)");
+        count = packed->count;
+        // Bounds the copies before they are made, like the node walk's own instancing.
+        if (node_visits_ + packed->count > kMaxNodeVisits)
+            return fail(context + "has " + std::to_string(packed->count) + " instances: the scene instantiates more than " +
+                        std::to_string(kMaxNodeVisits) + " nodes and instances");
+        const std::string what = context + name;
+        if (name == "ROTATION") {
+            Expected<std::vector<Vec4>> values = unpack_vectors<Vec4>(*packed, what);
+            if (!values) return values.error();
+            rotations = std::move(*values);
+        } else {
+            Expected<std::vector<Vec3>> values = unpack_vectors<Vec3>(*packed, what);
+            if (!values) return values.error();
+            (name == "TRANSLATION" ? translations : scales) = std::move(*values);
+        }
+    }
+    if (!ignored.empty()) {
+        std::string list;
+        for (const std::string& name : ignored) list += (list.empty() ? "" : ", ") + name;
+        builder_.add_warning(context + "attribute(s) " + list +
+                             " are ignored (only TRANSLATION, ROTATION and SCALE place instances)");
+    }
+    if (!count) return std::vector<Mat4>{Mat4(1.0f)};
+    node_visits_ += *count;
+
+    std::vector<Mat4> transforms(*count, Mat4(1.0f));
+    for (size_t i = 0; i < *count; ++i) {
+        Mat4 t(1.0f), r(1.0f), s(1.0f);
+        if (translations) t[3] = Vec4((*translations)[i], 1.0f);
+        if (rotations) {
+            const Vec4& q = (*rotations)[i];
+            const std::optional<Mat3> rotation = rotation_matrix(q.x, q.y, q.z, q.w);
+            if (!rotation) return fail(context + "ROTATION of instance " + std::to_string(i) + " is a zero quaternion");
+            r = Mat4(*rotation);
+        }
+        if (scales) {
+            const Vec3& v = (*scales)[i];
+            s[0][0] = v.x, s[1][1] = v.y, s[2][2] = v.z;
+        }
+        transforms[i] = t * r * s;
+    }
+    return transforms;
+}
+
+}  // namespace photond::gltf
