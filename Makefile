@@ -6,7 +6,7 @@ JOBS ?= $(shell nproc)
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 DEBIAN_PACKAGES := cmake g++ make pkg-config libembree-dev libtbb-dev libopenexr-dev libimath-dev \
 	libtinygltf-dev libcpp-httplib-dev nlohmann-json3-dev libglm-dev libpng-dev libssl-dev libarchive-dev libgtest-dev \
-	libbenchmark-dev curl python3 python3-venv python3-pip python3-setuptools python3-wheel gnuplot-nox libmeshoptimizer-dev libdraco-dev libstb-dev gltfpack
+	libbenchmark-dev curl python3 python3-venv python3-pip python3-setuptools python3-wheel gnuplot-nox libmeshoptimizer-dev libdraco-dev libstb-dev libwebp-dev gltfpack
 OUT ?= out
 # The tools of the interface checks that ctest runs (tests/server/metrics_exposition_test.cpp:
 # promtool; tests/server/openapi_document_test.cpp: npm, which installs the OpenAPI validator into

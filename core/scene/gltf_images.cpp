@@ -1,5 +1,8 @@
-// glTF images: kept encoded while the file is parsed, decoded (PNG, JPEG) when a material uses them.
+// glTF images: kept encoded while the file is parsed, decoded (PNG, JPEG; WebP by libwebp for
+// EXT_texture_webp) when a material uses them.
 #include "core/scene/gltf_reader.h"
+
+#include <webp/decode.h>
 
 #include <cstring>
 #include <span>
@@ -16,6 +19,11 @@ bool is_jpeg(std::span<const uint8_t> b) {
     return b.size() >= 3 && b[0] == 0xff && b[1] == 0xd8 && b[2] == 0xff;
 }
 
+// "RIFF" size "WEBP" (the RIFF container of every WebP file).
+bool is_webp(std::span<const uint8_t> b) {
+    return b.size() >= 12 && std::memcmp(b.data(), "RIFF", 4) == 0 && std::memcmp(b.data() + 8, "WEBP", 4) == 0;
+}
+
 uint32_t read_be16(const uint8_t* p) { return (uint32_t(p[0]) << 8) | p[1]; }
 uint32_t read_be32(const uint8_t* p) { return (read_be16(p) << 16) | read_be16(p + 2); }
 
@@ -25,6 +33,11 @@ std::optional<std::pair<uint32_t, uint32_t>> encoded_image_size(std::span<const 
     if (is_png(b)) {
         if (b.size() < 24 || std::memcmp(b.data() + 12, "IHDR", 4) != 0) return std::nullopt;
         return std::make_pair(read_be32(b.data() + 16), read_be32(b.data() + 20));
+    }
+    if (is_webp(b)) {
+        int width = 0, height = 0;
+        if (!WebPGetInfo(b.data(), b.size(), &width, &height) || width <= 0 || height <= 0) return std::nullopt;
+        return std::make_pair(uint32_t(width), uint32_t(height));
     }
     if (is_jpeg(b)) {
         size_t pos = 2;
@@ -87,7 +100,7 @@ Expected<Texture> decode_image(const tinygltf::Image& image, int image_index, bo
                              (image.uri.empty() ? "" : " (uri '" + image.uri + "')");
     if (!image.as_is || image.image.empty()) return Error{what + " could not be read"};
     const std::span<const uint8_t> bytes(image.image.data(), image.image.size());
-    if (!is_png(bytes) && !is_jpeg(bytes)) return Error{what + " is neither PNG nor JPEG"};
+    if (!is_png(bytes) && !is_jpeg(bytes) && !is_webp(bytes)) return Error{what + " is not PNG, JPEG or WebP"};
     const auto size = encoded_image_size(bytes);
     if (!size) return Error{what + " has an unreadable header"};
     const auto [width, height] = *size;
@@ -98,11 +111,23 @@ Expected<Texture> decode_image(const tinygltf::Image& image, int image_index, bo
                      " per side and " + std::to_string(kMaxImagePixels) + " pixels)"};
 
     tinygltf::Image decoded;
-    std::string err, warn;
-    // Without user data the decoder expands every image to RGBA, 8 or 16 bits per channel.
-    if (!tinygltf::LoadImageData(&decoded, image_index, &err, &warn, 0, 0, image.image.data(),
-                                 static_cast<int>(image.image.size()), nullptr))
-        return Error{what + " cannot be decoded: " + trim_trailing_whitespace(err)};
+    if (is_webp(bytes)) {
+        int w = 0, h = 0;
+        uint8_t* rgba = WebPDecodeRGBA(bytes.data(), bytes.size(), &w, &h);
+        if (!rgba) return Error{what + " cannot be decoded: libwebp refused it (corrupt or truncated WebP)"};
+        decoded.width = w;
+        decoded.height = h;
+        decoded.component = 4;
+        decoded.bits = 8;
+        decoded.image.assign(rgba, rgba + size_t(w) * size_t(h) * 4);
+        WebPFree(rgba);
+    } else {
+        std::string err, warn;
+        // Without user data the decoder expands every image to RGBA, 8 or 16 bits per channel.
+        if (!tinygltf::LoadImageData(&decoded, image_index, &err, &warn, 0, 0, image.image.data(),
+                                     static_cast<int>(image.image.size()), nullptr))
+            return Error{what + " cannot be decoded: " + trim_trailing_whitespace(err)};
+    }
     const size_t texel_count = size_t(decoded.width) * size_t(decoded.height);
     const size_t bytes_per_channel = decoded.bits == 16 ? 2 : 1;
     if (decoded.width <= 0 || decoded.height <= 0 || decoded.component != 4 ||

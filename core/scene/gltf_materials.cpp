@@ -54,7 +54,17 @@ Expected<int> GltfSceneReader::scene_texture(int texture_index, const std::strin
         return fail(context + role + " uses texture " + std::to_string(texture_index) +
                     ", which does not exist");
     const tinygltf::Texture& texture = model_.textures[static_cast<size_t>(texture_index)];
-    const int source = texture.source;
+    int source = texture.source;
+    // EXT_texture_webp: its WebP image where given, else the core source (the file's fallback
+    // for viewers without WebP).
+    if (const auto it = texture.extensions.find("EXT_texture_webp"); it != texture.extensions.end()) {
+        const std::optional<int> webp =
+            it->second.IsObject() && it->second.Has("source") ? int_value(it->second.Get("source")) : std::nullopt;
+        if (!webp)
+            return fail(context + "texture " + std::to_string(texture_index) + quoted(texture.name) +
+                        ": EXT_texture_webp has no image index (source)");
+        source = *webp;
+    }
     if (source < 0 || static_cast<size_t>(source) >= model_.images.size())
         return fail(context + "texture " + std::to_string(texture_index) + quoted(texture.name) +
                     " has no usable image source (" + std::to_string(source) + ")");

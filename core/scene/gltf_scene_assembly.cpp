@@ -8,7 +8,7 @@ namespace {
 const std::set<std::string, std::less<>> kSupportedRequiredExtensions = {
     "KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_transmission",
     "KHR_materials_ior", "KHR_materials_specular", "KHR_texture_transform",
-    "KHR_materials_clearcoat", "KHR_materials_volume"};
+    "KHR_materials_clearcoat", "KHR_materials_volume", "EXT_texture_webp"};
 
 // Geometry and file extensions (kept apart from the material ones above): decoded by the loader,
 // so a file may require them.
