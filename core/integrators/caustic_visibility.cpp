@@ -6,7 +6,10 @@ namespace photond {
 
 CausticVisibility::CausticVisibility(const PhotonMap* sites, float max_radius)
     : sites_(sites), max_radius_(max_radius) {
-    if (sites_) bound_ = IrradianceBoundGrid(*sites_, max_radius_);
+    if (sites_) {
+        bound_ = IrradianceBoundGrid(*sites_, max_radius_);
+        site_reach_ = std::min(max_radius_, largest_site_radius(*sites_));
+    }
 }
 
 bool CausticVisibility::may_show(const Vec3& p, const Vec3& normal, const Bsdf& bsdf, const Vec3& wo, float other,
@@ -23,7 +26,7 @@ bool CausticVisibility::may_show(const Vec3& p, const Vec3& normal, const Bsdf& 
     // No site whose estimate reaches p (a caustic's rim, where the photons thin out): the
     // estimate itself decides.
     Color irradiance;
-    if (!sites_->nearest_irradiance(p, normal, max_radius_, &irradiance)) return true;
+    if (!sites_->nearest_irradiance(p, normal, site_reach_, &irradiance)) return true;
     return luminance(rho * kInvPi * irradiance) >= threshold;
 }
 

@@ -25,6 +25,8 @@ FinalGatherer::FinalGatherer(std::shared_ptr<const RenderScene> scene, std::shar
     if (settings_.max_radius <= 0.0f) settings_.max_radius = 0.2f * scene_->scene->bounds.radius();
     site_radius_cap_ = kIrradianceRadiusShare * scene_->scene->bounds.radius();
     if (settings_.max_radius_caustic <= 0.0f) settings_.max_radius_caustic = kCausticRadiusShare * scene_->scene->bounds.radius();
+    site_reach_ = maps_->irradiance ? std::min(settings_.max_radius, largest_site_radius(*maps_->irradiance))
+                                    : settings_.max_radius;
 }
 
 namespace {
@@ -61,9 +63,10 @@ struct NearestSite {
 /// glass of any roughness, the same from both sides (one lobe sample picks the side and carries
 /// the lobes' weight); else the global map's estimate.
 /// `exclude_flags`: photons the estimate leaves out (where it falls back to one). `front_site`:
-/// the nearest site on wo's side, when the caller has looked it up already.
+/// the nearest site on wo's side, when the caller has looked it up already. `site_reach`: how
+/// far to search for a site (FinalGatherer::site_reach_).
 Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si, const Bsdf& bsdf,
-                            const Vec3& wo, const GatherSettings& settings, Rng& rng,
+                            const Vec3& wo, const GatherSettings& settings, float site_reach, Rng& rng,
                             LobeMask lobes = kNonDeltaLobes, uint8_t exclude_flags = 0,
                             const NearestSite* front_site = nullptr) {
     if (!maps.global) return Color(0.0f);
@@ -75,7 +78,7 @@ Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si
     if (maps.irradiance && bent == Vec3(0.0f)) {
         Color e;
         if (bsdf.reads_as_diffuse(lobes)) {
-            if (front_site ? front_site->found : maps.irradiance->nearest_irradiance(si.p, n, settings.max_radius, &e))
+            if (front_site ? front_site->found : maps.irradiance->nearest_irradiance(si.p, n, site_reach, &e))
                 return bsdf.diffuse_like_reflectance(wo) * kInvPi * (front_site ? front_site->irradiance : e);
         } else if (bsdf.reads_as_diffuse_from_both_sides(lobes) || (bsdf.transmits_non_delta(lobes) && exclude_flags == 0)) {
             // Rough glass: each side's incident light taken as uniform, E_side / pi, exact for
@@ -93,7 +96,7 @@ Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si
             const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Radiance, lobes);
             if (!s || !(s->pdf > 0.0f) || is_black(s->weight)) return Color(0.0f);
             const Vec3 side = glm::dot(s->wi, n) >= 0.0f ? n : -n;
-            if (!maps.irradiance->nearest_irradiance(si.p, side, settings.max_radius, &e))
+            if (!maps.irradiance->nearest_irradiance(si.p, side, site_reach, &e))
                 e = maps.global->estimate_irradiance(si.p, side, settings.k_global, settings.max_radius);
             return s->weight * kInvPi * e;
         }
@@ -236,7 +239,7 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
                     // surface (those straight from the lights or through caustic bounces would
                     // continue the caustic chain).
                     radiance += photons_or_bounce(si, bsdf, wo, depth, kNonDeltaLobes & ~kGlossy);
-                    radiance += radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_, rng, kGlossy,
+                    radiance += radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_, g.site_reach_, rng, kGlossy,
                                                       photon_flags::kDirect | photon_flags::kCaustic);
                 } else if (follows_glass) {
                     radiance += glossy_lobes(si, bsdf, wo, depth, glossy_bounces, false, kRoughLobes);
@@ -262,7 +265,8 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
             if (!(bsdf.lobes() & lobes)) return Color(0.0f);
             NearestSite site;
             if (takes_short_ray_bounce(si, wo, &site)) return short_ray_bounce(si, bsdf, wo, depth, lobes);
-            return radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_, rng, lobes, 0, site.found ? &site : nullptr);
+            return radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_, g.site_reach_, rng, lobes, 0,
+                                         site.found ? &site : nullptr);
         }
         /// Whether the ray that reached `si` is short next to the radius of the nearest
         /// irradiance site's estimate (GatherSettings::short_ray_radii). Where no site is near
@@ -275,7 +279,7 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
                 !(si.distance < factor * g.site_radius_cap_))
                 return false;
             const Vec3 n = glm::dot(si.surface_normal, wo) >= 0.0f ? si.surface_normal : -si.surface_normal;
-            site->found = g.maps_->irradiance->nearest_irradiance(si.p, n, g.settings_.max_radius, &site->irradiance,
+            site->found = g.maps_->irradiance->nearest_irradiance(si.p, n, g.site_reach_, &site->irradiance,
                                                                   &site->radius);
             return site->found && si.distance < factor * site->radius;
         }

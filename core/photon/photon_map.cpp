@@ -197,4 +197,10 @@ bool PhotonMap::nearest_irradiance(const Vec3& p, const Vec3& normal, float max_
     return true;
 }
 
+float largest_site_radius(const PhotonMap& sites) {
+    float largest = 0.0f;
+    for (const Photon& site : sites.tree().photons()) largest = std::max(largest, site.site_radius());
+    return largest;
+}
+
 }  // namespace photond

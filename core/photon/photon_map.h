@@ -144,4 +144,10 @@ private:
     uint64_t emitted_ = 0;
 };
 
+/// The largest estimate radius among a map of irradiance sites (Photon::site_radius). No site is
+/// taken farther from a query than its radius (PhotonMap::nearest_irradiance), so searching
+/// further than this finds nothing more.
+float largest_site_radius(const PhotonMap& sites);
+
+
 }  // namespace photond

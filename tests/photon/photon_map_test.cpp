@@ -180,6 +180,19 @@ TEST(PhotonMap, TheNearestIrradianceSiteIsTheOneABruteForceSearchFinds) {
         EXPECT_EQ(e, all[size_t(best)].flux()) << "query " << q;
         EXPECT_EQ(radius, all[size_t(best)].site_radius()) << "query " << q;
     }
+    // Searching no further than the largest site's radius (what the gatherer does) takes the
+    // same sites: none farther is ever taken.
+    const float reach = largest_site_radius(sites);
+    EXPECT_GE(reach, 0.055f);  // the largest of 3000 radii in [0.01, 0.06)
+    EXPECT_LT(reach, 0.061f);
+    for (int q = 0; q < 2000; ++q) {
+        const Vec3 p(1.2f * rng.next_float() - 0.1f, 0.2f * rng.next_float() - 0.05f, 1.2f * rng.next_float() - 0.1f);
+        const Vec3 n = glm::normalize(Vec3(rng.next_float() - 0.5f, 1.0f, rng.next_float() - 0.5f));
+        Color wide(-1.0f), near(-2.0f);
+        const bool wide_hit = sites.nearest_irradiance(p, n, 1.0f, &wide);
+        ASSERT_EQ(sites.nearest_irradiance(p, n, reach, &near), wide_hit) << "query " << q;
+        if (wide_hit) EXPECT_EQ(near, wide) << "query " << q;
+    }
     // Both outcomes exercised: found, and none facing or covering.
     EXPECT_GT(found, 200u);
     EXPECT_LT(found, 1800u);
