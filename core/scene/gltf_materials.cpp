@@ -55,8 +55,8 @@ Expected<int> GltfSceneReader::scene_texture(int texture_index, const std::strin
                     ", which does not exist");
     const tinygltf::Texture& texture = model_.textures[static_cast<size_t>(texture_index)];
     int source = texture.source;
-    // EXT_texture_webp: its WebP image where given, else the core source (the file's fallback
-    // for viewers without WebP).
+    // EXT_texture_webp: its WebP image (the core source, where the file gives one, is the
+    // fallback for viewers without WebP).
     if (const auto it = texture.extensions.find("EXT_texture_webp"); it != texture.extensions.end()) {
         const std::optional<int> webp =
             it->second.IsObject() && it->second.Has("source") ? int_value(it->second.Get("source")) : std::nullopt;
