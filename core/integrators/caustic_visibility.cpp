@@ -8,7 +8,7 @@ CausticVisibility::CausticVisibility(const PhotonMap* sites, float max_radius)
     : sites_(sites), max_radius_(max_radius) {
     if (sites_) {
         bound_ = IrradianceBoundGrid(*sites_, max_radius_);
-        site_reach_ = std::min(max_radius_, largest_site_radius(*sites_));
+        site_reach_ = site_search_radius(*sites_, max_radius_);
     }
 }
 

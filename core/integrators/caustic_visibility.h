@@ -33,8 +33,7 @@ public:
 private:
     const PhotonMap* sites_;
     float max_radius_;
-    /// The sites' search radius: max_radius_, or the largest site's radius where that is less
-    /// (largest_site_radius: the same sites are taken, found sooner).
+    /// The sites' search radius (site_search_radius: the same sites are taken, found sooner).
     float site_reach_ = 0.0f;
     /// Bounds the sites' irradiance within max_radius_: most points of most scenes are decided
     /// without searching the sites.

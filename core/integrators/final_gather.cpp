@@ -25,8 +25,7 @@ FinalGatherer::FinalGatherer(std::shared_ptr<const RenderScene> scene, std::shar
     if (settings_.max_radius <= 0.0f) settings_.max_radius = 0.2f * scene_->scene->bounds.radius();
     site_radius_cap_ = kIrradianceRadiusShare * scene_->scene->bounds.radius();
     if (settings_.max_radius_caustic <= 0.0f) settings_.max_radius_caustic = kCausticRadiusShare * scene_->scene->bounds.radius();
-    site_reach_ = maps_->irradiance ? std::min(settings_.max_radius, largest_site_radius(*maps_->irradiance))
-                                    : settings_.max_radius;
+    site_reach_ = maps_->irradiance ? site_search_radius(*maps_->irradiance, settings_.max_radius) : settings_.max_radius;
 }
 
 namespace {

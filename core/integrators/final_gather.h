@@ -132,9 +132,9 @@ private:
     /// The irradiance sites' estimate radius cap (kIrradianceRadiusShare of the scene's radius):
     /// a ray longer than short_ray_radii of it is never short.
     float site_radius_cap_ = 0.0f;
-    /// How far a lookup of the nearest irradiance site searches: max_radius, or the largest
-    /// site's radius where that is less (no site farther than its own radius is taken, so the
-    /// result is the same, and the search stops sooner where the nearest sites face away).
+    /// How far a lookup of the nearest irradiance site searches (site_search_radius: no site
+    /// farther than its own radius is taken, so the result is the same, and the search stops
+    /// sooner where the nearest sites face away).
     float site_reach_ = 0.0f;
 };
 

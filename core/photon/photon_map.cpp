@@ -203,4 +203,10 @@ float largest_site_radius(const PhotonMap& sites) {
     return largest;
 }
 
+float site_search_radius(const PhotonMap& sites, float max_radius) {
+    const float largest = largest_site_radius(sites);
+    if (!(largest > 0.0f)) return max_radius;
+    return max_radius > 0.0f ? std::min(max_radius, largest) : largest;
+}
+
 }  // namespace photond

@@ -148,6 +148,10 @@ private:
 /// taken farther from a query than its radius (PhotonMap::nearest_irradiance), so searching
 /// further than this finds nothing more.
 float largest_site_radius(const PhotonMap& sites);
+/// How far a search for the nearest site need reach (nearest_irradiance's max_radius): the
+/// largest site's radius where that is less than max_radius (or max_radius is <= 0, unbounded);
+/// max_radius where the sites have no radius (0 would mean unbounded).
+float site_search_radius(const PhotonMap& sites, float max_radius);
 
 
 }  // namespace photond

@@ -46,13 +46,12 @@ bool looks_absolute_or_remote(const std::string& uri) {
 std::optional<fs::path> resolve_in_sandbox(FileSandbox& box, const std::string& path) {
     const std::optional<std::string> uri = uri_of_path(box, path);
     if (!uri) return std::nullopt;
-    // tinygltf decodes data: URIs of buffers and of PNG, JPEG, BMP and GIF images, and hands any
-    // other type here as a file name.
+    // tinygltf reads data: URIs of buffers and of PNG, JPEG, BMP and GIF images (the last two
+    // refused later by decode_image), and hands any other type here as a file name.
     if (uri->compare(0, 5, "data:") == 0) {
         record_refusal(box, uri->substr(0, std::min(uri->find(','), size_t(40))) + ",...",
                        "is a data: URI of a type the glTF reader does not decode (it reads buffers "
-                       "and PNG, JPEG, BMP or GIF images so; put a WebP image in a file or a "
-                       "bufferView)");
+                       "and PNG or JPEG images so; put a WebP image in a file or a bufferView)");
         return std::nullopt;
     }
     if (!box.allow_files) {

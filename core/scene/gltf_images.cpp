@@ -27,8 +27,8 @@ bool is_webp(std::span<const uint8_t> b) {
 uint32_t read_be16(const uint8_t* p) { return (uint32_t(p[0]) << 8) | p[1]; }
 uint32_t read_be32(const uint8_t* p) { return (read_be16(p) << 16) | read_be16(p + 2); }
 
-// Width and height from the PNG IHDR chunk or the first JPEG start-of-frame segment, so that
-// absurd images are refused before the decoder allocates.
+// Width and height from the PNG IHDR chunk, the WebP header or the first JPEG start-of-frame
+// segment, so that absurd images are refused before the decoder allocates.
 std::optional<std::pair<uint32_t, uint32_t>> encoded_image_size(std::span<const uint8_t> b) {
     if (is_png(b)) {
         if (b.size() < 24 || std::memcmp(b.data() + 12, "IHDR", 4) != 0) return std::nullopt;
@@ -112,15 +112,18 @@ Expected<Texture> decode_image(const tinygltf::Image& image, int image_index, bo
 
     tinygltf::Image decoded;
     if (is_webp(bytes)) {
-        int w = 0, h = 0;
-        uint8_t* rgba = WebPDecodeRGBA(bytes.data(), bytes.size(), &w, &h);
-        if (!rgba) return Error{what + " cannot be decoded: libwebp refused it (corrupt or truncated WebP)"};
-        decoded.width = w;
-        decoded.height = h;
+        WebPBitstreamFeatures features;
+        if (WebPGetFeatures(bytes.data(), bytes.size(), &features) == VP8_STATUS_OK && features.has_animation)
+            return Error{what + " is an animated WebP, which a texture cannot be"};
+        // Decoded straight into the texel array: nothing for libwebp to free.
+        decoded.width = int(width);
+        decoded.height = int(height);
         decoded.component = 4;
         decoded.bits = 8;
-        decoded.image.assign(rgba, rgba + size_t(w) * size_t(h) * 4);
-        WebPFree(rgba);
+        decoded.image.resize(size_t(width) * size_t(height) * 4);
+        if (!WebPDecodeRGBAInto(bytes.data(), bytes.size(), decoded.image.data(), decoded.image.size(),
+                                int(width) * 4))
+            return Error{what + " cannot be decoded: libwebp refused it (corrupt or truncated WebP)"};
     } else {
         std::string err, warn;
         // Without user data the decoder expands every image to RGBA, 8 or 16 bits per channel.

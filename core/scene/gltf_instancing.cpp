@@ -22,6 +22,20 @@ Expected<std::vector<Mat4>> GltfSceneReader::instance_transforms(const tinygltf:
     std::optional<size_t> count;
     std::vector<std::string> ignored;
     for (const std::string& name : attributes.Keys()) {
+        const std::optional<int> accessor = int_value(attributes.Get(name));
+        if (!accessor || *accessor < 0 || static_cast<size_t>(*accessor) >= model_.accessors.size())
+            return fail(context + name + " is not the index of an accessor");
+        // Every attribute, custom ones too, has one element per instance.
+        const size_t elements = model_.accessors[static_cast<size_t>(*accessor)].count;
+        if (count && *count != elements)
+            return fail(context + name + " has " + std::to_string(elements) + " elements, the other attributes " +
+                        std::to_string(*count) + " (all must have the same count)");
+        if (elements == 0) return fail(context + name + " has no elements (an accessor's count is at least 1)");
+        count = elements;
+        // Bounds the copies before anything is read, like the node walk's own instancing.
+        if (node_visits_ + elements > kMaxNodeVisits)
+            return fail(context + "has " + std::to_string(elements) + " instances: the scene instantiates more than " +
+                        std::to_string(kMaxNodeVisits) + " nodes and instances");
         const AccessorRule* rule = name == "TRANSLATION" ? &kInstanceTranslationRule
                                    : name == "ROTATION"  ? &kInstanceRotationRule
                                    : name == "SCALE"     ? &kInstanceScaleRule
@@ -31,18 +45,8 @@ Expected<std::vector<Mat4>> GltfSceneReader::instance_transforms(const tinygltf:
             ignored.push_back(name);
             continue;
         }
-        const std::optional<int> accessor = int_value(attributes.Get(name));
-        if (!accessor) return fail(context + name + " is not an accessor index");
         Expected<PackedAccessor> packed = pack_accessor(*accessor, context, name, *rule);
         if (!packed) return packed.error();
-        if (count && *count != packed->count)
-            return fail(context + name + " has " + std::to_string(packed->count) + " elements, the other attributes " +
-                        std::to_string(*count) + " (all must have the same count)");
-        count = packed->count;
-        // Bounds the copies before they are made, like the node walk's own instancing.
-        if (node_visits_ + packed->count > kMaxNodeVisits)
-            return fail(context + "has " + std::to_string(packed->count) + " instances: the scene instantiates more than " +
-                        std::to_string(kMaxNodeVisits) + " nodes and instances");
         const std::string what = context + name;
         if (name == "ROTATION") {
             Expected<std::vector<Vec4>> values = unpack_vectors<Vec4>(*packed, what);

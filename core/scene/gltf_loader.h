@@ -1,10 +1,11 @@
 // glTF 2.0 loader (.gltf and .glb) producing a photond::Scene through SceneBuilder.
 //
 // Reads triangle meshes (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN; points and lines are skipped)
-// under the default scene's node hierarchy, also quantized (KHR_mesh_quantization) and compressed
-// (EXT_meshopt_compression, KHR_draco_mesh_compression: gltf_compression.h), metallic-roughness
-// materials with KHR_materials_emissive_strength / _transmission / _ior / _specular, base-colour
-// textures (PNG or JPEG, decoded to linear RGB), perspective and orthographic cameras (one
+// under the default scene's node hierarchy (and EXT_mesh_gpu_instancing's instances), also
+// quantized (KHR_mesh_quantization) and compressed (EXT_meshopt_compression,
+// KHR_draco_mesh_compression: gltf_compression.h), metallic-roughness materials with
+// KHR_materials_emissive_strength / _transmission / _ior / _specular, textures (PNG, JPEG, and
+// WebP by EXT_texture_webp), perspective and orthographic cameras (one
 // Scene::cameras entry per cameras[] entry) and KHR_lights_punctual lights (candela and lux
 // converted to W/sr and W/m^2). What the file holds and the loader ignores is named in
 // Scene::warnings.

@@ -70,7 +70,7 @@ struct ImageLoadContext {
 /// tinygltf's image loader: keeps the encoded bytes (user data: an ImageLoadContext).
 bool keep_encoded_image(tinygltf::Image* image, const int image_index, std::string* err,
                         std::string*, int, int, const unsigned char* bytes, int size, void* user);
-/// Decodes a PNG or JPEG into a texture read as sRGB colour (base colour, emission) or as data
+/// Decodes a PNG, JPEG or WebP into a texture read as sRGB colour (base colour, emission) or as data
 /// (metallic-roughness, normals): 8-bit images keep their bytes (TexelEncoding), 16-bit ones
 /// become float linear RGB and alpha.
 Expected<Texture> decode_image(const tinygltf::Image& image, int image_index, bool srgb);
@@ -224,7 +224,7 @@ private:
     /// given now; the image is decoded by decode_textures() once the whole file was accepted.
     Expected<int> scene_texture(int texture_index, const std::string& context, const std::string& role,
                                 bool srgb);
-    /// Decodes every texture scene_texture() handed out, in parallel (PNG and JPEG decoding is
+    /// Decodes every texture scene_texture() handed out, in parallel (image decoding is
     /// most of the time a textured file takes to read), and adds them to the scene in the order
     /// their indices were given; the first failure in that order is the error.
     Status decode_textures();

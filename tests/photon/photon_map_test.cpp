@@ -182,7 +182,11 @@ TEST(PhotonMap, TheNearestIrradianceSiteIsTheOneABruteForceSearchFinds) {
     }
     // Searching no further than the largest site's radius (what the gatherer does) takes the
     // same sites: none farther is ever taken.
-    const float reach = largest_site_radius(sites);
+    const float reach = site_search_radius(sites, 1.0f);
+    EXPECT_EQ(reach, largest_site_radius(sites));
+    EXPECT_EQ(site_search_radius(sites, 0.0f), reach);  // unbounded: the largest radius
+    EXPECT_EQ(site_search_radius(sites, 0.02f), 0.02f);
+    EXPECT_EQ(site_search_radius(PhotonMap(), 0.3f), 0.3f);  // no sites: no radius to cut to
     EXPECT_GE(reach, 0.055f);  // the largest of 3000 radii in [0.01, 0.06)
     EXPECT_LT(reach, 0.061f);
     for (int q = 0; q < 2000; ++q) {
@@ -191,7 +195,9 @@ TEST(PhotonMap, TheNearestIrradianceSiteIsTheOneABruteForceSearchFinds) {
         Color wide(-1.0f), near(-2.0f);
         const bool wide_hit = sites.nearest_irradiance(p, n, 1.0f, &wide);
         ASSERT_EQ(sites.nearest_irradiance(p, n, reach, &near), wide_hit) << "query " << q;
-        if (wide_hit) EXPECT_EQ(near, wide) << "query " << q;
+        if (wide_hit) {
+            EXPECT_EQ(near, wide) << "query " << q;
+        }
     }
     // Both outcomes exercised: found, and none facing or covering.
     EXPECT_GT(found, 200u);

@@ -402,6 +402,10 @@ TEST(GltfLoaderErrors, GpuInstancingAttributesOfDifferentCounts) {
                          "attributes 2 (all must have the same count)"),
               std::string::npos)
         << error;
+    // A custom attribute is ignored, but must have one element per instance too.
+    const std::string custom = load_error("broken/instancing_id_count_mismatch.gltf");
+    EXPECT_NE(custom.find("EXT_mesh_gpu_instancing _ID has 2 elements, the other attributes 3"), std::string::npos)
+        << custom;
 }
 
 TEST(GltfLoader, MaterialsWithExtensionsAndDefaults) {

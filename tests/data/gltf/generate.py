@@ -970,8 +970,8 @@ def shelf():
 def instancing():
     """EXT_mesh_gpu_instancing written by hand: three instances of a triangle under a moved node,
     rotations as normalized SHORT quaternions, a custom _ID attribute (ignored, with a warning);
-    instancing_flat.gltf places the same three triangles by nodes alone; broken/ holds one whose
-    attributes disagree on the instance count."""
+    instancing_flat.gltf places the same three triangles by nodes alone; broken/ holds two whose
+    attributes disagree on the instance count (a placing one, the custom one)."""
     translations = [[0, 0, 0], [2, 0, 0], [0, 3, -1]]
     angles = [0.0, math.pi / 2, -math.pi / 3]  # about +z
     scales = [[1, 1, 1], [0.5, 0.5, 0.5], [1, 2, 1]]
@@ -979,7 +979,7 @@ def instancing():
     def quaternion(angle):
         return [0, 0, math.sin(angle / 2), math.cos(angle / 2)]
 
-    def build(instanced, rotation_count=3):
+    def build(instanced, rotation_count=3, id_count=3):
         b = Builder()
         b.doc["meshes"] = [{"name": "Tri", "primitives": [{"attributes": triangle(b)}]}]
         parent = {"name": "Parent", "translation": [1, 1, 0], "scale": [2, 2, 2]}
@@ -991,7 +991,7 @@ def instancing():
             r = b.accessor(b.view(struct.pack("<%dh" % len(shorts), *shorts)), 5122, rotation_count,
                            "VEC4", normalized=True)
             s = b.floats([c for v in scales for c in v], "VEC3")
-            ids = b.floats([0, 1, 2], "SCALAR")
+            ids = b.floats(list(range(id_count)), "SCALAR")
             parent["mesh"] = 0
             parent["extensions"] = {"EXT_mesh_gpu_instancing": {"attributes": {
                 "TRANSLATION": t, "ROTATION": r, "SCALE": s, "_ID": ids}}}
@@ -1007,6 +1007,7 @@ def instancing():
     write("instancing.gltf", build(True))
     write("instancing_flat.gltf", build(False))
     write("broken/instancing_count_mismatch.gltf", build(True, rotation_count=2))
+    write("broken/instancing_id_count_mismatch.gltf", build(True, id_count=2))
 
 
 def main():
