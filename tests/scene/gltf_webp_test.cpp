@@ -1,10 +1,11 @@
 // EXT_texture_webp: a texture's WebP image, decoded by libwebp, is the one used, not the PNG
 // fallback beside it, from a file or a .glb's bufferView; a data: URI of WebP (which tinygltf
-// does not decode) and a corrupt WebP are refused by name. The WebP images are written here with
+// does not decode), an animated WebP and a corrupt one are refused by name. The WebP images are written here with
 // libwebp's lossless encoder, so the texels must come back exactly.
 #include <gtest/gtest.h>
 #include <unistd.h>
 #include <webp/encode.h>
+#include <webp/mux.h>
 
 #include <cstdint>
 #include <cstring>
@@ -37,6 +38,40 @@ std::vector<uint8_t> lossless_webp(const std::vector<uint8_t>& rgba) {
     const size_t size = WebPEncodeLosslessRGBA(rgba.data(), kWidth, kHeight, kWidth * 4, &out);
     std::vector<uint8_t> bytes(out, out + size);
     WebPFree(out);
+    return bytes;
+}
+
+/// Two frames of the pattern, the second with its colours inverted: an animated WebP.
+std::vector<uint8_t> animated_webp(const std::vector<uint8_t>& rgba) {
+    WebPAnimEncoderOptions options;
+    WebPAnimEncoderOptionsInit(&options);
+    WebPAnimEncoder* encoder = WebPAnimEncoderNew(kWidth, kHeight, &options);
+    WebPConfig config;
+    WebPConfigInit(&config);
+    config.lossless = 1;
+    std::vector<uint8_t> inverted = rgba;
+    for (size_t i = 0; i < inverted.size(); ++i)
+        if (i % 4 != 3) inverted[i] = uint8_t(255 - inverted[i]);
+    const std::vector<uint8_t>* frames[] = {&rgba, &inverted};
+    int timestamp = 0;
+    for (const std::vector<uint8_t>* frame : frames) {
+        WebPPicture picture;
+        WebPPictureInit(&picture);
+        picture.use_argb = 1;
+        picture.width = kWidth;
+        picture.height = kHeight;
+        WebPPictureImportRGBA(&picture, frame->data(), kWidth * 4);
+        WebPAnimEncoderAdd(encoder, &picture, timestamp, &config);
+        WebPPictureFree(&picture);
+        timestamp += 100;
+    }
+    WebPAnimEncoderAdd(encoder, nullptr, timestamp, nullptr);
+    WebPData data;
+    WebPDataInit(&data);
+    WebPAnimEncoderAssemble(encoder, &data);
+    std::vector<uint8_t> bytes(data.bytes, data.bytes + data.size);
+    WebPDataClear(&data);
+    WebPAnimEncoderDelete(encoder);
     return bytes;
 }
 
@@ -190,6 +225,17 @@ TEST_F(GltfWebp, AWebpDataUriIsRefusedWithWhatToDoInstead) {
     EXPECT_NE(scene.error().message.find("uri 'data:image/webp;base64,...' is a data: URI of a type the glTF "
                                          "reader does not decode"),
               std::string::npos)
+        << scene.error().message;
+}
+
+TEST_F(GltfWebp, AnAnimatedWebpIsRefusedAsSuch) {
+    const std::vector<uint8_t> bytes = animated_webp(pattern());
+    ASSERT_GT(bytes.size(), 12u);
+    write_file(dir_ / "texture.webp", bytes);
+    write_scene(dir_, true);
+    Expected<Scene> scene = load_gltf_file(dir_ / "scene.gltf");
+    ASSERT_FALSE(scene.has_value());
+    EXPECT_NE(scene.error().message.find("image 0 (uri 'texture.webp') is an animated WebP"), std::string::npos)
         << scene.error().message;
 }
 
