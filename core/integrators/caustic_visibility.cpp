@@ -4,11 +4,10 @@
 
 namespace photond {
 
-CausticVisibility::CausticVisibility(const PhotonMap* sites, float max_radius)
-    : sites_(sites), max_radius_(max_radius) {
+CausticVisibility::CausticVisibility(const PhotonMap* sites, float max_radius) : sites_(sites) {
     if (sites_) {
-        bound_ = IrradianceBoundGrid(*sites_, max_radius_);
-        site_reach_ = site_search_radius(*sites_, max_radius_);
+        bound_ = IrradianceBoundGrid(*sites_, max_radius);
+        site_reach_ = site_search_radius(*sites_, max_radius);
     }
 }
 

@@ -32,10 +32,9 @@ public:
 
 private:
     const PhotonMap* sites_;
-    float max_radius_;
     /// The sites' search radius (site_search_radius: the same sites are taken, found sooner).
     float site_reach_ = 0.0f;
-    /// Bounds the sites' irradiance within max_radius_: most points of most scenes are decided
+    /// Bounds the sites' irradiance within the search radius cap: most points of most scenes are decided
     /// without searching the sites.
     IrradianceBoundGrid bound_;
 };

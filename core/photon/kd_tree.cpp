@@ -208,13 +208,13 @@ Expected<PhotonKdTree> PhotonKdTree::from_tree_order(std::vector<Photon> photons
 
 void PhotonKdTree::k_nearest(const Vec3& p, uint32_t k, float max_radius, KnnResult& out) const {
     k_nearest_where(p, k, max_radius, out, [p](const Vec3& q) { return distance2(p, q); },
-                    [](const Photon&, float) { return true; });
+                    [](const Photon&) { return true; });
 }
 
 void PhotonKdTree::k_nearest_flagged(const Vec3& p, uint32_t k, float max_radius, uint8_t required_flags,
                                      uint8_t excluded_flags, KnnResult& out) const {
     k_nearest_where(p, k, max_radius, out, [p](const Vec3& q) { return distance2(p, q); },
-                    [required_flags, excluded_flags](const Photon& photon, float) {
+                    [required_flags, excluded_flags](const Photon& photon) {
                         const uint8_t flags = photon.user_flags();
                         return (flags & required_flags) == required_flags && (flags & excluded_flags) == 0;
                     });
@@ -229,7 +229,7 @@ void PhotonKdTree::k_nearest_in_disc(const Vec3& p, const Vec3& normal, float fl
     }
     k_nearest_where(p, k, max_radius, out,
                     [p, normal, stretch2](const Vec3& q) { return disc_distance2(p, q, normal, stretch2); },
-                    [](const Photon&, float) { return true; });
+                    [](const Photon&) { return true; });
 }
 
 }  // namespace photond

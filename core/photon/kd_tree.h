@@ -130,10 +130,10 @@ public:
 
     /// The k nearest to p within max_radius by `distance2_to(position)` (which must never be
     /// below distance2(p, position): the tree prunes by it) among the photons that
-    /// `accept(photon, dist2)` takes, with k_nearest's guarantees. `accept` is asked only of a
-    /// photon that would enter the result as things stand (within the radius, and nearer than
-    /// the farthest once k are found), so a costly test (a decoded normal, a radius) runs for few
-    /// of the photons a search meets; it must depend on its arguments alone.
+    /// `accept(photon)` takes, with k_nearest's guarantees. `accept` is asked only of a photon
+    /// that would enter the result as things stand (within the radius, and nearer than the
+    /// farthest once k are found), so a costly test (a decoded normal) runs for few of the
+    /// photons a search meets; it must depend on the photon alone.
     template <class Distance2, class Accept>
     void k_nearest_where(const Vec3& p, uint32_t k, float max_radius, KnnResult& out, Distance2 distance2_to,
                          Accept accept) const;
@@ -196,7 +196,7 @@ void PhotonKdTree::k_nearest_where(const Vec3& p, uint32_t k, float max_radius, 
     const auto consider = [&](uint32_t index, float d2) {
         if (d2 > r2) return;
         if (full && !closer({index, d2}, heap[0])) return;
-        if (!accept(photons_[index], d2)) return;
+        if (!accept(photons_[index])) return;
         if (!full) {
             heap.push_back({index, d2});
             farthest2 = std::max(farthest2, d2);

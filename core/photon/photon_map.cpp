@@ -188,7 +188,7 @@ bool PhotonMap::nearest_irradiance(const Vec3& p, const Vec3& normal, float max_
     tree_.k_nearest_where(
         p, 1, max_radius, found,
         [p, normal](const Vec3& q) { return PhotonKdTree::disc_distance2(p, q, normal, kStretch2); },
-        [normal](const Photon& site, float) { return site.has_normal() && glm::dot(site.normal(), normal) > kIrradianceNormalCosine; });
+        [normal](const Photon& site) { return site.has_normal() && glm::dot(site.normal(), normal) > kIrradianceNormalCosine; });
     if (found.empty()) return false;
     const Photon& site = tree_.photon(found.neighbors[0].index);
     if (found.neighbors[0].dist2 > site.site_radius() * site.site_radius()) return false;

@@ -153,5 +153,4 @@ float largest_site_radius(const PhotonMap& sites);
 /// max_radius where the sites have no radius (0 would mean unbounded).
 float site_search_radius(const PhotonMap& sites, float max_radius);
 
-
 }  // namespace photond

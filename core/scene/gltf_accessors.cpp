@@ -325,13 +325,4 @@ const AccessorRule kInstanceRotationRule{
     {TINYGLTF_TYPE_VEC4}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, {TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT}, {}};
 const AccessorRule kInstanceScaleRule{{TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, {}, {}};
 
-std::optional<Mat3> rotation_matrix(double x, double y, double z, double w) {
-    const double len = std::sqrt(x * x + y * y + z * z + w * w);
-    if (!(len > 0.0)) return std::nullopt;
-    x /= len, y /= len, z /= len, w /= len;
-    return Mat3(float(1 - 2 * (y * y + z * z)), float(2 * (x * y + z * w)), float(2 * (x * z - y * w)),  // column 0
-                float(2 * (x * y - z * w)), float(1 - 2 * (x * x + z * z)), float(2 * (y * z + x * w)),  // column 1
-                float(2 * (x * z + y * w)), float(2 * (y * z - x * w)), float(1 - 2 * (x * x + y * y)));  // column 2
-}
-
 }  // namespace photond::gltf

@@ -69,19 +69,14 @@ Expected<std::vector<Mat4>> GltfSceneReader::instance_transforms(const tinygltf:
 
     std::vector<Mat4> transforms(*count, Mat4(1.0f));
     for (size_t i = 0; i < *count; ++i) {
-        Mat4 t(1.0f), r(1.0f), s(1.0f);
-        if (translations) t[3] = Vec4((*translations)[i], 1.0f);
+        std::optional<Mat3> rotation = Mat3(1.0f);
         if (rotations) {
             const Vec4& q = (*rotations)[i];
-            const std::optional<Mat3> rotation = rotation_matrix(q.x, q.y, q.z, q.w);
-            if (!rotation) return fail(context + "ROTATION of instance " + std::to_string(i) + " is a zero quaternion");
-            r = Mat4(*rotation);
+            rotation = rotation_matrix(q.x, q.y, q.z, q.w);
         }
-        if (scales) {
-            const Vec3& v = (*scales)[i];
-            s[0][0] = v.x, s[1][1] = v.y, s[2][2] = v.z;
-        }
-        transforms[i] = t * r * s;
+        if (!rotation) return fail(context + "ROTATION of instance " + std::to_string(i) + " is a zero quaternion");
+        transforms[i] = trs_matrix(translations ? (*translations)[i] : Vec3(0.0f), *rotation,
+                                   scales ? (*scales)[i] : Vec3(1.0f));
     }
     return transforms;
 }

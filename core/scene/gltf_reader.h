@@ -79,8 +79,11 @@ Expected<Texture> decode_image(const tinygltf::Image& image, int image_index, bo
 // Accessors (gltf_accessors.cpp).
 
 int component_size(int component_type);
-/// The rotation of quaternion (x, y, z, w), normalized first; nullopt for a zero quaternion.
+/// The rotation of quaternion (x, y, z, w), normalized first; nullopt for a zero quaternion
+/// (gltf_scene_assembly.cpp, like trs_matrix).
 std::optional<Mat3> rotation_matrix(double x, double y, double z, double w);
+/// Translation * Rotation * Scale, glTF's order for nodes and EXT_mesh_gpu_instancing's instances.
+Mat4 trs_matrix(const Vec3& translation, const Mat3& rotation, const Vec3& scale);
 int component_count(int type);
 std::string type_name(int type);
 std::string component_type_name(int component_type);

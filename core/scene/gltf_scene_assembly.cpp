@@ -23,6 +23,22 @@ bool is_supported_extension(const std::string& name) {
 
 }  // namespace
 
+std::optional<Mat3> rotation_matrix(double x, double y, double z, double w) {
+    const double len = std::sqrt(x * x + y * y + z * z + w * w);
+    if (!(len > 0.0)) return std::nullopt;
+    x /= len, y /= len, z /= len, w /= len;
+    return Mat3(float(1 - 2 * (y * y + z * z)), float(2 * (x * y + z * w)), float(2 * (x * z - y * w)),  // column 0
+                float(2 * (x * y - z * w)), float(1 - 2 * (x * x + z * z)), float(2 * (y * z + x * w)),  // column 1
+                float(2 * (x * z + y * w)), float(2 * (y * z - x * w)), float(1 - 2 * (x * x + y * y)));  // column 2
+}
+
+Mat4 trs_matrix(const Vec3& translation, const Mat3& rotation, const Vec3& scale) {
+    Mat4 t(1.0f), s(1.0f);
+    t[3] = Vec4(translation, 1.0f);
+    s[0][0] = scale.x, s[1][1] = scale.y, s[2][2] = scale.z;
+    return t * Mat4(rotation) * s;
+}
+
 Expected<Mat4> GltfSceneReader::local_transform(const tinygltf::Node& node, int node_index) const {
     const std::string context = "node " + std::to_string(node_index) + quoted(node.name) + ": ";
     const auto all_finite = [](const std::vector<double>& v) {
@@ -42,22 +58,14 @@ Expected<Mat4> GltfSceneReader::local_transform(const tinygltf::Node& node, int 
         (!node.scale.empty() && node.scale.size() != 3) || !all_finite(node.translation) ||
         !all_finite(node.rotation) || !all_finite(node.scale))
         return fail(context + "translation, rotation or scale is malformed or non-finite");
-    Mat4 t(1.0f), r(1.0f), s(1.0f);
-    if (!node.translation.empty())
-        t[3] = Vec4(float(node.translation[0]), float(node.translation[1]),
-                    float(node.translation[2]), 1.0f);
-    if (!node.rotation.empty()) {
-        const std::optional<Mat3> rot =
-            rotation_matrix(node.rotation[0], node.rotation[1], node.rotation[2], node.rotation[3]);
-        if (!rot) return fail(context + "rotation is a zero quaternion");
-        r = Mat4(*rot);
-    }
-    if (!node.scale.empty()) {
-        s[0][0] = float(node.scale[0]);
-        s[1][1] = float(node.scale[1]);
-        s[2][2] = float(node.scale[2]);
-    }
-    return t * r * s;
+    const auto vec3 = [](const std::vector<double>& v, float fallback) {
+        return v.empty() ? Vec3(fallback) : Vec3(float(v[0]), float(v[1]), float(v[2]));
+    };
+    std::optional<Mat3> rotation = Mat3(1.0f);
+    if (!node.rotation.empty())
+        rotation = rotation_matrix(node.rotation[0], node.rotation[1], node.rotation[2], node.rotation[3]);
+    if (!rotation) return fail(context + "rotation is a zero quaternion");
+    return trs_matrix(vec3(node.translation, 0.0f), *rotation, vec3(node.scale, 1.0f));
 }
 
 Status GltfSceneReader::add_camera(const tinygltf::Node& node, int node_index, const Mat4& world) {

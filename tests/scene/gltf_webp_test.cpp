@@ -123,15 +123,16 @@ void copy_fallback(const fs::path& dir) {
                   dir / "fallback.png", fs::copy_options::overwrite_existing);
 }
 
-/// scene.gltf beside quad.bin, texture.webp (written by the test) and fallback.png (the PNG of
-/// TextureTransformTest's "Error.png").
-void write_scene(const fs::path& dir, bool fallback) {
+/// scene.gltf beside quad.bin and fallback.png (the PNG of TextureTransformTest's "Error.png"),
+/// its WebP image `webp_image` (texture.webp, which the test writes, unless given).
+void write_scene(const fs::path& dir, bool fallback,
+                 const std::string& webp_image = R"({"uri": "texture.webp", "mimeType": "image/webp"})") {
     copy_fallback(dir);
     const std::vector<uint8_t> buffer = quad_buffer();
     write_file(dir / "quad.bin", buffer);
     std::ofstream(dir / "scene.gltf")
-        << scene_json(R"({"uri": "texture.webp", "mimeType": "image/webp"})",
-                      R"({"uri": "quad.bin", "byteLength": )" + std::to_string(buffer.size()) + "}", "", fallback);
+        << scene_json(webp_image, R"({"uri": "quad.bin", "byteLength": )" + std::to_string(buffer.size()) + "}", "",
+                      fallback);
 }
 
 /// scene.glb: the quad and the WebP image in its binary chunk, the image by a bufferView (as
@@ -171,6 +172,12 @@ protected:
         fs::create_directories(dir_);
     }
     void TearDown() override { fs::remove_all(dir_); }
+    /// The refusal of dir_/name.
+    std::string load_error(const std::string& name) const {
+        Expected<Scene> scene = load_gltf_file(dir_ / name);
+        EXPECT_FALSE(scene.has_value()) << name << " loaded";
+        return scene ? std::string() : scene.error().message;
+    }
     fs::path dir_;
 };
 
@@ -212,20 +219,16 @@ TEST_F(GltfWebp, AWebpInAGlbBufferViewIsUsed) {
     expect_pattern(*scene);
 }
 
-TEST_F(GltfWebp, AWebpDataUriIsRefusedWithWhatToDoInstead) {
+TEST_F(GltfWebp, AWebpDataUriIsRefusedSayingWhereTheImageCanGo) {
     // tinygltf decodes no data:image/webp URI: the refusal says so, not "absolute or remote".
-    const std::vector<uint8_t> buffer = quad_buffer();
-    write_file(dir_ / "quad.bin", buffer);
-    copy_fallback(dir_);
-    std::ofstream(dir_ / "scene.gltf") << scene_json(
-        R"({"uri": "data:image/webp;base64,UklGRh4AAABXRUJQVlA4TBEAAAAvA0AAAAdQsiJXpv+BiOh/AAA=", "mimeType": "image/webp"})",
-        R"({"uri": "quad.bin", "byteLength": )" + std::to_string(buffer.size()) + "}", "", true);
-    Expected<Scene> scene = load_gltf_file(dir_ / "scene.gltf");
-    ASSERT_FALSE(scene.has_value());
-    EXPECT_NE(scene.error().message.find("uri 'data:image/webp;base64,...' is a data: URI of a type the glTF "
-                                         "reader does not decode"),
+    write_scene(dir_, true,
+                R"({"uri": "data:image/webp;base64,UklGRh4AAABXRUJQVlA4TBEAAAAvA0AAAAdQsiJXpv+BiOh/AAA=", "mimeType": "image/webp"})");
+    const std::string error = load_error("scene.gltf");
+    EXPECT_NE(error.find("uri 'data:image/webp;base64,...' is a data: URI of a type the glTF reader does not "
+                         "decode (it reads buffers and PNG or JPEG images so; put a WebP image in a file or a "
+                         "bufferView)"),
               std::string::npos)
-        << scene.error().message;
+        << error;
 }
 
 TEST_F(GltfWebp, AnAnimatedWebpIsRefusedAsSuch) {
@@ -233,10 +236,8 @@ TEST_F(GltfWebp, AnAnimatedWebpIsRefusedAsSuch) {
     ASSERT_GT(bytes.size(), 12u);
     write_file(dir_ / "texture.webp", bytes);
     write_scene(dir_, true);
-    Expected<Scene> scene = load_gltf_file(dir_ / "scene.gltf");
-    ASSERT_FALSE(scene.has_value());
-    EXPECT_NE(scene.error().message.find("image 0 (uri 'texture.webp') is an animated WebP"), std::string::npos)
-        << scene.error().message;
+    const std::string error = load_error("scene.gltf");
+    EXPECT_NE(error.find("image 0 (uri 'texture.webp') is an animated WebP"), std::string::npos) << error;
 }
 
 TEST_F(GltfWebp, ACorruptWebpIsAnErrorNamingTheImage) {
@@ -244,10 +245,8 @@ TEST_F(GltfWebp, ACorruptWebpIsAnErrorNamingTheImage) {
     bytes.resize(bytes.size() / 2);  // the RIFF header promises more
     write_file(dir_ / "texture.webp", bytes);
     write_scene(dir_, true);
-    Expected<Scene> scene = load_gltf_file(dir_ / "scene.gltf");
-    ASSERT_FALSE(scene.has_value());
-    EXPECT_NE(scene.error().message.find("image 0 (uri 'texture.webp') cannot be decoded"), std::string::npos)
-        << scene.error().message;
+    const std::string error = load_error("scene.gltf");
+    EXPECT_NE(error.find("image 0 (uri 'texture.webp') cannot be decoded"), std::string::npos) << error;
 }
 
 }  // namespace

@@ -632,6 +632,30 @@ def mesh_primitive(b, positions, normals, indices, material, uvs=None):
     return {"attributes": attrs, "indices": idx, "material": material}
 
 
+def floor_and_wall(b, floor_uvs=None):
+    """The floor (8 x 7) and back wall (8 x 4) of the lit test rooms, material 0."""
+    quad = [[-4, 0, -3], [4, 0, -3], [4, 0, 4], [-4, 0, 4]]
+    floor = mesh_primitive(b, quad, [[0, 1, 0]] * 4, [0, 2, 1, 0, 3, 2], 0, uvs=floor_uvs)
+    wall_quad = [[-4, 0, -3], [4, 0, -3], [4, 4, -3], [-4, 4, -3]]
+    wall = mesh_primitive(b, wall_quad, [[0, 0, 1]] * 4, [0, 1, 2, 0, 2, 3], 0)
+    return floor, wall
+
+
+def bulb_and_view(b):
+    """The lit test rooms' point light and camera (light 0, camera 0); returns their nodes."""
+    b.doc["extensions"] = {"KHR_lights_punctual": {"lights": [
+        {"name": "Bulb", "type": "point", "color": [1, 0.95, 0.9], "intensity": 8000}]}}
+    b.doc["cameras"] = [{"name": "View", "type": "perspective",
+                         "perspective": {"yfov": 0.8, "znear": 0.05}}]
+    return [
+        {"name": "LightNode", "translation": [0.5, 2.6, 1.5],
+         "extensions": {"KHR_lights_punctual": {"light": 0}}},
+        # Looking down 0.3 rad from (0, 1.6, 4.5).
+        {"name": "CameraNode", "camera": 0, "translation": [0, 1.6, 4.5],
+         "rotation": [-math.sin(0.15), 0, 0, math.cos(0.15)]},
+    ]
+
+
 def room():
     """A lit test scene for the mesh-compression tests: a floor, a back wall, a smooth sphere and a
     turned, scaled box under a point light, with a camera. gltfpack writes its quantized and
@@ -646,11 +670,7 @@ def room():
         {"name": "Blue", "pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.3, 0.8, 1],
                                                    "metallicFactor": 0}},
     ]
-    quad = [[-4, 0, -3], [4, 0, -3], [4, 0, 4], [-4, 0, 4]]
-    floor = mesh_primitive(b, quad, [[0, 1, 0]] * 4, [0, 2, 1, 0, 3, 2], 0,
-                           uvs=[[0, 0], [1, 0], [1, 1], [0, 1]])
-    wall_quad = [[-4, 0, -3], [4, 0, -3], [4, 4, -3], [-4, 4, -3]]
-    wall = mesh_primitive(b, wall_quad, [[0, 0, 1]] * 4, [0, 1, 2, 0, 2, 3], 0)
+    floor, wall = floor_and_wall(b, floor_uvs=[[0, 0], [1, 0], [1, 1], [0, 1]])
     verts, faces = icosphere(2)
     sphere = mesh_primitive(b, verts, verts, [i for f in faces for i in f], 1)
     bp, bn, bi = box_mesh()
@@ -658,10 +678,7 @@ def room():
     b.doc["meshes"] = [{"name": "Floor", "primitives": [floor, wall]},
                        {"name": "Sphere", "primitives": [sphere]},
                        {"name": "Box", "primitives": [box]}]
-    b.doc["extensions"] = {"KHR_lights_punctual": {"lights": [
-        {"name": "Bulb", "type": "point", "color": [1, 0.95, 0.9], "intensity": 8000}]}}
-    b.doc["cameras"] = [{"name": "View", "type": "perspective",
-                         "perspective": {"yfov": 0.8, "znear": 0.05}}]
+    light_node, camera_node = bulb_and_view(b)
     s = math.sin(0.3)
     c = math.cos(0.3)
     b.doc["nodes"] = [
@@ -669,11 +686,7 @@ def room():
         {"name": "SphereNode", "mesh": 1, "translation": [-0.4, 0.7, 0], "scale": [0.7, 0.7, 0.7]},
         {"name": "BoxNode", "mesh": 2, "translation": [1.1, 0.35, -0.3],
          "rotation": [0, s, 0, c], "scale": [0.7, 0.7, 0.9]},
-        {"name": "LightNode", "translation": [0.5, 2.6, 1.5],
-         "extensions": {"KHR_lights_punctual": {"light": 0}}},
-        # Looking down 0.3 rad from (0, 1.6, 4.5).
-        {"name": "CameraNode", "camera": 0, "translation": [0, 1.6, 4.5],
-         "rotation": [-math.sin(0.15), 0, 0, math.cos(0.15)]},
+        light_node, camera_node,
     ]
     b.doc["scenes"] = [{"nodes": [0, 1, 2, 3, 4]}]
     b.doc["scene"] = 0
@@ -914,17 +927,11 @@ def shelf():
         {"name": "Orange", "pbrMetallicRoughness": {"baseColorFactor": [0.85, 0.45, 0.1, 1],
                                                      "metallicFactor": 0, "roughnessFactor": 0.6}},
     ]
-    quad = [[-4, 0, -3], [4, 0, -3], [4, 0, 4], [-4, 0, 4]]
-    floor = mesh_primitive(b, quad, [[0, 1, 0]] * 4, [0, 2, 1, 0, 3, 2], 0)
-    wall = mesh_primitive(b, [[-4, 0, -3], [4, 0, -3], [4, 4, -3], [-4, 4, -3]], [[0, 0, 1]] * 4,
-                          [0, 1, 2, 0, 2, 3], 0)
+    floor, wall = floor_and_wall(b)
     bp, bn, bi = box_mesh()
     b.doc["meshes"] = [{"name": "Floor", "primitives": [floor, wall]},
                        {"name": "Box", "primitives": [mesh_primitive(b, bp, bn, bi, 1)]}]
-    b.doc["extensions"] = {"KHR_lights_punctual": {"lights": [
-        {"name": "Bulb", "type": "point", "color": [1, 0.95, 0.9], "intensity": 8000}]}}
-    b.doc["cameras"] = [{"name": "View", "type": "perspective",
-                         "perspective": {"yfov": 0.8, "znear": 0.05}}]
+    light_node, camera_node = bulb_and_view(b)
 
     def turn(angle):  # about +y
         return [0, math.sin(angle / 2), 0, math.cos(angle / 2)]
@@ -950,10 +957,7 @@ def shelf():
         {"name": "Board", "translation": [1.8, 0.15, 1.2], "rotation": turn(-0.5),
          "children": [6, 7]},
         boxes[4], boxes[5],
-        {"name": "LightNode", "translation": [0.5, 2.6, 1.5],
-         "extensions": {"KHR_lights_punctual": {"light": 0}}},
-        {"name": "CameraNode", "camera": 0, "translation": [0, 1.6, 4.5],
-         "rotation": [-math.sin(0.15), 0, 0, math.cos(0.15)]},
+        light_node, camera_node,
     ]
     b.doc["scenes"] = [{"nodes": [0, 1, 2, 3, 4, 5, 8, 9]}]
     b.doc["scene"] = 0
