@@ -181,7 +181,7 @@ Status GltfSceneReader::check_accessor_rule(const tinygltf::Accessor& accessor, 
     if (accepted) return Status::ok();
     const AccessorRule& widened = effective_rule(core_rule, true);
     const bool quantization_would_allow =
-        !quantized_ && (contains(widened.normalized_component_types, ct) ||
+        !quantized_ && &widened != &core_rule && (contains(widened.normalized_component_types, ct) ||
                         contains(widened.integer_component_types, ct));
     return fail(what + " has componentType " + component_type_name(ct) +
                 (accessor.normalized ? " (normalized)" : "") + ", which " + role + " does not allow" +
@@ -295,10 +295,18 @@ const AccessorRule kQuantizedTexcoordRule{{TINYGLTF_TYPE_VEC2},
                                           {kByte, kUnsignedByte, kShort, kUnsignedShort},
                                           {kByte, kUnsignedByte, kShort, kUnsignedShort}};
 
+// Morph targets: displacements of POSITION (also signed 8- or 16-bit integers, normalized or
+// not) and of NORMAL and TANGENT (normalized signed ones), by KHR_mesh_quantization.
+const AccessorRule kMorphPositionRule{{TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, {}, {}};
+const AccessorRule kMorphDirectionRule{{TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, {}, {}};
+const AccessorRule kQuantizedMorphPositionRule{
+    {TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, {kByte, kShort}, {kByte, kShort}};
+
 const AccessorRule& effective_rule(const AccessorRule& rule, bool quantized) {
     if (!quantized) return rule;
     if (&rule == &kPositionRule) return kQuantizedPositionRule;
-    if (&rule == &kNormalRule) return kQuantizedNormalRule;
+    if (&rule == &kNormalRule || &rule == &kMorphDirectionRule) return kQuantizedNormalRule;
+    if (&rule == &kMorphPositionRule) return kQuantizedMorphPositionRule;
     if (&rule == &kTexcoordRule) return kQuantizedTexcoordRule;
     return rule;
 }
@@ -318,6 +326,9 @@ const AccessorRule kIndexRule{
     {},
     {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
      TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT}};
+const AccessorRule kJointsRule{{TINYGLTF_TYPE_VEC4}, {}, {}, {kUnsignedByte, kUnsignedShort}};
+const AccessorRule kWeightsRule{{TINYGLTF_TYPE_VEC4}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, {kUnsignedByte, kUnsignedShort}, {}};
+const AccessorRule kInverseBindMatrixRule{{TINYGLTF_TYPE_MAT4}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, {}, {}};
 // EXT_mesh_gpu_instancing: float translations and scales; rotations also normalized signed
 // integers (the extension's table, which KHR_mesh_quantization does not widen).
 const AccessorRule kInstanceTranslationRule{{TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, {}, {}};

@@ -13,11 +13,35 @@
 namespace photond::gltf {
 namespace {
 
+/// Appends vertex v of `from` to `to`: every per-vertex array `from` has (morph displacements and
+/// skin influences too) but tangents, which the callers make. `to` may be `from`.
+void append_vertex(DecodedPrimitive& to, const DecodedPrimitive& from, uint32_t v) {
+    const auto append = [v](auto& target, const auto& source) {
+        if (!source.empty()) target.push_back(source[v]);
+    };
+    append(to.positions, from.positions);
+    append(to.normals, from.normals);
+    append(to.uvs, from.uvs);
+    append(to.uvs1, from.uvs1);
+    append(to.colors, from.colors);
+    for (size_t k = 0; k < from.targets.size(); ++k) {
+        append(to.targets[k].positions, from.targets[k].positions);
+        append(to.targets[k].normals, from.targets[k].normals);
+        append(to.targets[k].tangents, from.targets[k].tangents);
+    }
+    for (size_t set = 0; set < from.joints.size(); ++set) {
+        append(to.joints[set], from.joints[set]);
+        append(to.weights[set], from.weights[set]);
+    }
+}
+
 /// Flat shading: unwelds the primitive, so that each corner has its face's normal (SceneBuilder
 /// would do the same later, after tangents could no longer be made).
 DecodedPrimitive unwelded_with_face_normals(const DecodedPrimitive& prim) {
     DecodedPrimitive flat;
     flat.material = prim.material;
+    flat.face_normals = true;
+    flat.targets.resize(prim.targets.size());
     for (const glm::uvec3& t : prim.triangles) {
         const uint32_t base = static_cast<uint32_t>(flat.positions.size());
         const Vec3 c = glm::cross(prim.positions[t.y] - prim.positions[t.x],
@@ -25,11 +49,8 @@ DecodedPrimitive unwelded_with_face_normals(const DecodedPrimitive& prim) {
         const float len = glm::length(c);
         const Vec3 n = len > 0.0f && std::isfinite(len) ? c / len : Vec3(0.0f, 0.0f, 1.0f);
         for (uint32_t v : {t.x, t.y, t.z}) {
-            flat.positions.push_back(prim.positions[v]);
+            append_vertex(flat, prim, v);
             flat.normals.push_back(n);
-            if (!prim.uvs.empty()) flat.uvs.push_back(prim.uvs[v]);
-            if (!prim.uvs1.empty()) flat.uvs1.push_back(prim.uvs1[v]);
-            if (!prim.colors.empty()) flat.colors.push_back(prim.colors[v]);
         }
         flat.triangles.emplace_back(base, base + 1, base + 2);
     }
@@ -105,11 +126,7 @@ void assign_tangents(DecodedPrimitive& prim, const TangentSums& sums) {
             } else if (first_sign[v] != negative) {
                 if (copy_of[v] < 0) {
                     copy_of[v] = static_cast<int64_t>(prim.positions.size());
-                    prim.positions.push_back(prim.positions[v]);
-                    prim.normals.push_back(prim.normals[v]);
-                    if (!prim.uvs.empty()) prim.uvs.push_back(prim.uvs[v]);
-                    if (!prim.uvs1.empty()) prim.uvs1.push_back(prim.uvs1[v]);
-                    if (!prim.colors.empty()) prim.colors.push_back(prim.colors[v]);
+                    append_vertex(prim, prim, v);
                     prim.tangents.push_back(finished_tangent(prim, sums, v, negative));
                 }
                 v = static_cast<uint32_t>(copy_of[v]);
@@ -117,6 +134,8 @@ void assign_tangents(DecodedPrimitive& prim, const TangentSums& sums) {
         }
     }
 }
+
+}  // namespace
 
 /// Per-vertex tangents for a normal-mapped primitive without TANGENT (glTF 2.0 section 3.7.2.1:
 /// MikkTSpace). MikkTSpace's essentials (Mikkelsen 2008, "Simulation of wrinkled surfaces
@@ -131,6 +150,8 @@ void generate_tangents(DecodedPrimitive& prim, int slot) {
     const TangentSums sums = sum_face_tangents(prim, uvs);
     assign_tangents(prim, sums);
 }
+
+namespace {
 
 /// Whether the triangles of `parts` together close a volume: every edge (vertices welded by
 /// position, across the parts) is shared by exactly two triangles.
@@ -258,8 +279,13 @@ Expected<DecodedPrimitive> GltfSceneReader::decode_primitive(const tinygltf::Pri
     Expected<std::vector<glm::uvec3>> triangles = assemble_triangles(prim.mode, *indices, context);
     if (!triangles) return triangles.error();
     out.triangles = std::move(triangles).value();
+    if (Status st = read_morph_targets(prim, context, out); !st) return st.error();
+    if (Status st = read_skin_influences(prim, context, out); !st) return st.error();
     note_dropped_primitive_features(prim);
-    if (normal_slot >= 0 && out.tangents.empty()) generate_tangents(out, normal_slot);
+    if (normal_slot >= 0 && out.tangents.empty()) {
+        generate_tangents(out, normal_slot);
+        out.generated_tangent_slot = normal_slot;
+    }
     return out;
 }
 

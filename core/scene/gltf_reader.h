@@ -1,12 +1,14 @@
 // The glTF loader's parts (core/scene/gltf_loader.h is its interface): shared by
 // gltf_file_sandbox.cpp (what tinygltf may read), gltf_images.cpp, gltf_accessors.cpp,
 // gltf_materials.cpp, gltf_meshes.cpp, gltf_warnings.cpp, gltf_scene_assembly.cpp (nodes,
-// cameras, lights) and gltf_loader.cpp (the entry points). Not for use outside core/scene/.
+// cameras, lights), gltf_instancing.cpp, gltf_deformation.cpp (morph targets, skins) and
+// gltf_loader.cpp (the entry points). Not for use outside core/scene/.
 #pragma once
 
 #include <tiny_gltf.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
@@ -114,6 +116,13 @@ extern const AccessorRule kTexcoordRule;
 extern const AccessorRule kColorRule;
 extern const AccessorRule kTangentRule;
 extern const AccessorRule kIndexRule;
+/// Skins: JOINTS_n (joint indices), WEIGHTS_n, a skin's inverseBindMatrices.
+extern const AccessorRule kJointsRule;
+extern const AccessorRule kWeightsRule;
+extern const AccessorRule kInverseBindMatrixRule;
+/// Morph targets' displacements: POSITION, and NORMAL or TANGENT (both VEC3).
+extern const AccessorRule kMorphPositionRule;
+extern const AccessorRule kMorphDirectionRule;
 /// EXT_mesh_gpu_instancing's instance attributes.
 extern const AccessorRule kInstanceTranslationRule;
 extern const AccessorRule kInstanceRotationRule;
@@ -154,7 +163,8 @@ Expected<double> extension_number(const tinygltf::ExtensionMap& extensions, cons
 // The reader: one tinygltf::Model into a Scene. Its members are defined by concept in the files
 // named above.
 
-/// One primitive of a mesh as read: attributes per vertex, triangles, its scene material.
+/// One primitive of a mesh as read: attributes per vertex, triangles, its scene material, and
+/// what deforms it where a node places it (morph targets, skin influences).
 struct DecodedPrimitive {
     std::vector<Vec3> positions;
     std::vector<Vec3> normals;
@@ -164,7 +174,40 @@ struct DecodedPrimitive {
     std::vector<Vec4> tangents;
     std::vector<glm::uvec3> triangles;
     uint32_t material = 0;
+    /// The slot of the normal texture whose tangents were generated here (the file gave none):
+    /// a morphed copy generates its own. -1: none generated.
+    int generated_tangent_slot = -1;
+    /// The normals are the faces' own, made here for a primitive without NORMAL (each triangle
+    /// has vertices of its own): a morphed copy makes them anew.
+    bool face_normals = false;
+    /// A morph target's displacements per vertex; each empty where the target has none.
+    struct MorphTarget {
+        std::vector<Vec3> positions;
+        std::vector<Vec3> normals;
+        std::vector<Vec3> tangents;
+    };
+    std::vector<MorphTarget> targets;
+    /// Skin influences: JOINTS_0 / WEIGHTS_0 and JOINTS_1 / WEIGHTS_1 (up to eight joints per
+    /// vertex); empty when the primitive has none.
+    std::array<std::vector<glm::uvec4>, 2> joints;
+    std::array<std::vector<Vec4>, 2> weights;
 };
+
+/// MikkTSpace-compatible tangents for `prim` from the TEXCOORD set of `slot` (gltf_meshes.cpp).
+void generate_tangents(DecodedPrimitive& prim, int slot);
+
+// Morph targets and skins (gltf_deformation.cpp): a primitive in the pose the file gives, the
+// weights and joint transforms of its nodes (no animation is applied).
+
+/// `prim` with its morph targets blended by `weights` (one per target): displacements added,
+/// normals and tangents renormalized, generated tangents made anew.
+DecodedPrimitive morphed(const DecodedPrimitive& prim, const std::vector<float>& weights);
+/// Skins `prim` in place into world space: each vertex by the blend of its joints' matrices
+/// (joint world transform times inverse bind matrix) by their weights. A vertex whose weights
+/// sum to zero is placed by `unskinned` (its node's world transform). Fails, with `context`,
+/// on a joint index beyond `joint_matrices`.
+Status skin_in_place(DecodedPrimitive& prim, const std::vector<Mat4>& joint_matrices, const Mat4& unskinned,
+                     const std::string& context);
 
 class GltfSceneReader {
 public:
@@ -255,6 +298,16 @@ private:
     uint32_t thin_walled_material(int material_index, uint32_t solid);
     void add_feature_warnings();
     Status add_light(const tinygltf::Node& node, int node_index, const Mat4& world);
+    /// A primitive's morph targets and skin influences into `out` (gltf_deformation.cpp).
+    Status read_morph_targets(const tinygltf::Primitive& prim, const std::string& context, DecodedPrimitive& out);
+    Status read_skin_influences(const tinygltf::Primitive& prim, const std::string& context, DecodedPrimitive& out);
+    /// The node's morph weights: its own `weights`, else its mesh's, else none (all zero).
+    Expected<std::vector<float>> morph_weights(const tinygltf::Node& node, int node_index) const;
+    /// The node's skin as joint matrices: each joint's world transform times its inverse bind
+    /// matrix (glTF 2.0 section 3.7.3).
+    Expected<std::vector<Mat4>> joint_matrices(const tinygltf::Node& node, int node_index);
+    /// A node's world transform through its parents (joints may lie anywhere in the hierarchy).
+    Expected<Mat4> node_world(int node_index);
     Expected<Mat4> local_transform(const tinygltf::Node& node, int node_index) const;
 
 
@@ -282,6 +335,8 @@ private:
     std::map<int, std::vector<int>> texcoord_sets_;  // glTF material -> TEXCOORD sets by slot
     std::map<int, int> normal_slots_;  // glTF material with a normal texture -> its slot
     std::vector<uint8_t> on_path_;       // cycle detection during the node walk
+    std::vector<int> parents_;                      // each node's parent (-1: a root)
+    std::vector<std::optional<Mat4>> node_worlds_;  // node_world's results so far
     std::vector<std::optional<CameraDesc>> cameras_;  // per glTF camera, from the first node
     std::vector<std::vector<int>> camera_nodes_;      // per glTF camera, the nodes placing it
     // What the walk met and drops or takes its own way, for add_feature_warnings.

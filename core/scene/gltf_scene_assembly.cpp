@@ -216,9 +216,34 @@ Status GltfSceneReader::add_node_mesh(const tinygltf::Node& node, int node_index
     if (!cached) {
         if (Status st = load_mesh(node.mesh); !st) return st;
     }
+    // Morph targets blended by the node's weights, then its skin (glTF 2.0 section 3.7.3: a
+    // skinned mesh is placed by its joints alone, not by its node's transform).
+    Expected<std::vector<float>> weights = morph_weights(node, node_index);
+    if (!weights) return weights.error();
+    const bool morphs = std::any_of(weights->begin(), weights->end(), [](float w) { return w != 0.0f; });
+    std::vector<Mat4> joints;
+    if (node.skin >= 0) {
+        Expected<std::vector<Mat4>> matrices = joint_matrices(node, node_index);
+        if (!matrices) return matrices.error();
+        joints = std::move(matrices).value();
+    }
     for (size_t p = 0; p < cached->size(); ++p) {
-        const DecodedPrimitive& prim = (*cached)[p];
-        if (prim.triangles.empty()) continue;
+        const DecodedPrimitive* placed = &(*cached)[p];
+        if (placed->triangles.empty()) continue;
+        const bool skinned = !joints.empty() && !placed->joints[0].empty();
+        DecodedPrimitive deformed;
+        if (morphs && !placed->targets.empty()) {
+            deformed = morphed(*placed, *weights);
+            placed = &deformed;
+        }
+        if (skinned) {
+            if (placed != &deformed) deformed = *placed;
+            if (Status st = skin_in_place(deformed, joints, world, context + "skin " + std::to_string(node.skin) + ": ");
+                !st)
+                return fail(st.error().message);
+            placed = &deformed;
+        }
+        const DecodedPrimitive& prim = *placed;
         const size_t new_vertices = prim.normals.empty() ? 3 * prim.triangles.size() : prim.positions.size();
         triangle_count_ += prim.triangles.size();
         vertex_count_ += new_vertices;
@@ -230,7 +255,7 @@ Status GltfSceneReader::add_node_mesh(const tinygltf::Node& node, int node_index
         extras.colors = prim.colors;
         extras.tangents = prim.tangents;
         if (Status st = builder_.add_mesh(prim.positions, prim.normals, prim.uvs, prim.triangles, prim.material,
-                                          world, extras);
+                                          skinned ? Mat4(1.0f) : world, extras);
             !st) {
             const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(node.mesh)];
             return fail(context + "mesh " + std::to_string(node.mesh) + quoted(mesh.name) + " primitive " +
@@ -298,6 +323,12 @@ Expected<Scene> GltfSceneReader::read() {
     }
     meshes_.resize(model_.meshes.size());
     on_path_.assign(model_.nodes.size(), 0);
+    parents_.assign(model_.nodes.size(), -1);
+    for (size_t i = 0; i < model_.nodes.size(); ++i)
+        for (int child : model_.nodes[i].children)
+            if (child >= 0 && static_cast<size_t>(child) < parents_.size() && parents_[static_cast<size_t>(child)] < 0)
+                parents_[static_cast<size_t>(child)] = static_cast<int>(i);
+    node_worlds_.assign(model_.nodes.size(), std::nullopt);
     cameras_.assign(model_.cameras.size(), std::nullopt);
     camera_nodes_.assign(model_.cameras.size(), {});
 

@@ -3,6 +3,7 @@
 #include "core/scene/gltf_reader.h"
 
 #include <array>
+#include <cstdlib>
 
 namespace photond::gltf {
 namespace {
@@ -20,13 +21,14 @@ std::string name_list(const std::vector<std::string>& names) {
 }  // namespace
 
 void GltfSceneReader::note_dropped_primitive_features(const tinygltf::Primitive& prim) {
+    const auto set_index = [](const std::string& name) { return std::atoi(name.c_str() + name.find('_') + 1); };
     for (const auto& [name, accessor] : prim.attributes) {
         // COLOR_0 multiplies the base colour; further colour sets are read by nothing.
-        if ((name.rfind("COLOR_", 0) == 0 && name != "COLOR_0") || name.rfind("JOINTS_", 0) == 0 ||
-            name.rfind("WEIGHTS_", 0) == 0)
-            ignored_attributes_.insert(name.substr(0, name.find('_')));
+        if (name.rfind("COLOR_", 0) == 0 && name != "COLOR_0") ignored_attributes_.insert("COLOR");
+        // Skins read JOINTS_0/WEIGHTS_0 and JOINTS_1/WEIGHTS_1 (read_skin_influences).
+        if ((name.rfind("JOINTS_", 0) == 0 || name.rfind("WEIGHTS_", 0) == 0) && set_index(name) >= 2)
+            ignored_attributes_.insert("JOINTS");
     }
-    if (!prim.targets.empty()) ignored_attributes_.insert("morph targets");
 }
 
 void GltfSceneReader::add_feature_warnings() {
@@ -36,15 +38,17 @@ void GltfSceneReader::add_feature_warnings() {
     for (const std::string& what : ignored_attributes_) {
         if (what == "COLOR")
             builder_.add_warning("vertex colour sets after COLOR_0 (COLOR_1, ...) are ignored");
-        else if (what == "morph targets")
-            builder_.add_warning("morph targets are ignored: meshes are rendered in their base shape");
-        else
-            builder_.add_warning("skinning (" + what + "_n) is ignored: skinned meshes are rendered "
-                                 "in their bind pose");
+        else if (what == "JOINTS")
+            builder_.add_warning("skin influences after JOINTS_1 and WEIGHTS_1 (more than eight joints a "
+                                 "vertex) are ignored");
+        else  // "morph target TEXCOORD", ...
+            builder_.add_warning(what + "_n displacements are ignored (a morph target moves POSITION, "
+                                 "NORMAL and TANGENT here)");
     }
     if (!model_.animations.empty())
         builder_.add_warning(std::to_string(model_.animations.size()) +
-                             " animation(s) are ignored: the nodes' static transforms are rendered");
+                             " animation(s) are ignored: the nodes' own transforms and morph weights are "
+                             "rendered");
     if (model_.scenes.size() > 1)
         builder_.add_warning("the file has " + std::to_string(model_.scenes.size()) +
                              " scenes; only the default scene is rendered");

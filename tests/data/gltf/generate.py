@@ -48,7 +48,7 @@ class Builder:
         return len(self.doc["accessors"]) - 1
 
     def floats(self, values, type_, count=None):
-        n = {"SCALAR": 1, "VEC2": 2, "VEC3": 3}[type_]
+        n = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}[type_]
         v = self.view(struct.pack("<%df" % len(values), *values))
         return self.accessor(v, FLOAT, count if count is not None else len(values) // n, type_)
 
@@ -1014,6 +1014,71 @@ def instancing():
     write("broken/instancing_id_count_mismatch.gltf", build(True, id_count=2))
 
 
+def morph_and_skin():
+    """Morph targets and a skin with closed-form results (gltf_deformation_test.cpp).
+
+    morph.gltf: a quad with two targets, one of them sparse (moving vertices 2 and 3 up by 1, their
+    normals by -0.5 in y), the other moving all four by +x; mesh weights [0.5, 0.25] on node
+    Shared, and node Own's weights [1, 0] instead (it is also moved by +5 in x).
+    skin.gltf: a strip of three rows bound to joints J0 (bottom row), J0 and J1 half and half
+    (middle row) and J1 (top row), and a vertex of no weight; J1 is turned 90 degrees about z
+    where the file puts it, a translation of the skinned node (which the skin ignores) and the
+    root's translation of 10 in x, which the joints carry. broken/ holds four that are refused."""
+    def morph(weights_count=2):
+        b = Builder()
+        pos = b.floats(QUAD_POSITIONS, "VEC3")
+        nrm = b.floats([0, 0, 1] * 4, "VEC3")
+        idx = b.indices(QUAD_INDICES, U16)
+        sparse_indices = b.view(struct.pack("<2H", 2, 3))
+        sparse_values = b.view(struct.pack("<6f", 0, 0, 1, 0, 0, 1))
+        up = b.accessor(None, FLOAT, 4, "VEC3", sparse={
+            "count": 2, "indices": {"bufferView": sparse_indices, "componentType": U16},
+            "values": {"bufferView": sparse_values}})
+        del b.doc["accessors"][up]["bufferView"]
+        tilt = b.floats([0, 0, 0, 0, 0, 0, 0, -0.5, 0, 0, -0.5, 0], "VEC3")
+        right = b.floats([1, 0, 0] * 4, "VEC3")
+        b.doc["meshes"] = [{"name": "Quad", "weights": [0.5, 0.25][:weights_count], "primitives": [{
+            "attributes": {"POSITION": pos, "NORMAL": nrm}, "indices": idx,
+            "targets": [{"POSITION": up, "NORMAL": tilt}, {"POSITION": right}]}]}]
+        b.doc["nodes"] = [{"name": "Shared", "mesh": 0},
+                          {"name": "Own", "mesh": 0, "weights": [1, 0], "translation": [5, 0, 0]}]
+        b.doc["scenes"] = [{"nodes": [0, 1]}]
+        return b.finish()
+    write("morph.gltf", morph())
+    write("broken/morph_weights_count.gltf", morph(weights_count=1))
+
+    def skin(joint=1, bind_matrices=2, weights=True):
+        b = Builder()
+        # Three rows of two vertices in the bind pose (x = 10, 10.5; y = 0, 1, 2), and one more.
+        positions = [10, 0, 0, 10.5, 0, 0, 10, 1, 0, 10.5, 1, 0, 10, 2, 0, 10.5, 2, 0, 0, 3, 0]
+        pos = b.floats(positions, "VEC3")
+        nrm = b.floats([1, 0, 0] * 7, "VEC3")
+        idx = b.indices([0, 1, 3, 0, 3, 2, 2, 3, 5, 2, 5, 4, 4, 5, 6], U16)
+        joints = [0, 0, 0, 0] * 2 + [0, joint, 0, 0] * 2 + [joint, 0, 0, 0] * 2 + [0, 0, 0, 0]
+        j = b.accessor(b.view(struct.pack("<28B", *joints)), U8, 7, "VEC4")
+        w = b.floats([1, 0, 0, 0] * 2 + [0.5, 0.5, 0, 0] * 2 + [1, 0, 0, 0] * 2 + [0, 0, 0, 0], "VEC4")
+        attributes = {"POSITION": pos, "NORMAL": nrm, "JOINTS_0": j}
+        if weights:
+            attributes["WEIGHTS_0"] = w
+        b.doc["meshes"] = [{"name": "Strip", "primitives": [{"attributes": attributes, "indices": idx}]}]
+        # Inverse bind matrices (column-major): J0 bound at (10, 0, 0), J1 at (10, 1, 0).
+        ibm = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -10, 0, 0, 1,
+               1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -10, -1, 0, 1][:16 * bind_matrices]
+        inverse_bind = b.floats(ibm, "MAT4")
+        b.doc["skins"] = [{"name": "Rig", "joints": [1, 2], "inverseBindMatrices": inverse_bind}]
+        quarter = [0, 0, math.sin(math.pi / 4), math.cos(math.pi / 4)]
+        b.doc["nodes"] = [{"name": "Root", "translation": [10, 0, 0], "children": [1, 3]},
+                          {"name": "J0", "children": [2]},
+                          {"name": "J1", "translation": [0, 1, 0], "rotation": quarter},
+                          {"name": "Skinned", "mesh": 0, "skin": 0, "translation": [100, 0, 0]}]
+        b.doc["scenes"] = [{"nodes": [0]}]
+        return b.finish()
+    write("skin.gltf", skin())
+    write("broken/skin_joint_out_of_range.gltf", skin(joint=2))
+    write("broken/skin_inverse_bind_count.gltf", skin(bind_matrices=1))
+    write("broken/skin_joints_without_weights.gltf", skin(weights=False))
+
+
 def main():
     os.makedirs(os.path.join(HERE, "broken"), exist_ok=True)
     write("indexed_u8.gltf", quad_indexed(U8).finish())
@@ -1041,6 +1106,7 @@ def main():
     room()
     shelf()
     instancing()
+    morph_and_skin()
 
 
 if __name__ == "__main__":
