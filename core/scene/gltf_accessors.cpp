@@ -327,7 +327,8 @@ const AccessorRule kIndexRule{
     {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
      TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT}};
 const AccessorRule kJointsRule{{TINYGLTF_TYPE_VEC4}, {}, {}, {kUnsignedByte, kUnsignedShort}};
-const AccessorRule kWeightsRule{{TINYGLTF_TYPE_VEC4}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, {kUnsignedByte, kUnsignedShort}, {}};
+const AccessorRule kWeightsRule{
+    {TINYGLTF_TYPE_VEC4}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, {kUnsignedByte, kUnsignedShort}, {}};
 const AccessorRule kInverseBindMatrixRule{{TINYGLTF_TYPE_MAT4}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, {}, {}};
 // EXT_mesh_gpu_instancing: float translations and scales; rotations also normalized signed
 // integers (the extension's table, which KHR_mesh_quantization does not widen).

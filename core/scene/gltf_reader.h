@@ -34,6 +34,9 @@ inline constexpr size_t kMaxSceneTriangles = size_t(1) << 25;
 inline constexpr size_t kMaxSceneVertices = size_t(1) << 26;
 inline constexpr uint32_t kMaxImageSide = 16384;
 inline constexpr uint64_t kMaxImagePixels = uint64_t(1) << 26;
+// Morph targets: the displacements decoded, and those added up while placing morphed meshes.
+inline constexpr size_t kMaxMorphElements = size_t(1) << 24;
+inline constexpr size_t kMaxMorphWork = size_t(1) << 28;
 
 /// " 'name'" for a message, or nothing for an unnamed object.
 inline std::string quoted(const std::string& name) { return name.empty() ? "" : " '" + name + "'"; }
@@ -163,9 +166,9 @@ Expected<double> extension_number(const tinygltf::ExtensionMap& extensions, cons
 // The reader: one tinygltf::Model into a Scene. Its members are defined by concept in the files
 // named above.
 
-/// One primitive of a mesh as read: attributes per vertex, triangles, its scene material, and
-/// what deforms it where a node places it (morph targets, skin influences).
-struct DecodedPrimitive {
+/// One primitive of a mesh as read, but its morph targets: attributes per vertex, triangles, its
+/// scene material, its skin influences.
+struct PrimitiveVertices {
     std::vector<Vec3> positions;
     std::vector<Vec3> normals;
     std::vector<Vec2> uvs;
@@ -178,8 +181,20 @@ struct DecodedPrimitive {
     /// a morphed copy generates its own. -1: none generated.
     int generated_tangent_slot = -1;
     /// The normals are the faces' own, made here for a primitive without NORMAL (each triangle
-    /// has vertices of its own): a morphed copy makes them anew.
+    /// has vertices of its own): a morphed or skinned copy makes them anew.
     bool face_normals = false;
+    /// Skin influences: JOINTS_0 / WEIGHTS_0 and JOINTS_1 / WEIGHTS_1 (up to eight joints per
+    /// vertex); empty when the primitive has none.
+    std::array<std::vector<glm::uvec4>, 2> joints;
+    std::array<std::vector<Vec4>, 2> weights;
+    /// The largest joint index given a weight, and where the file gives it (for the message
+    /// when a skin has fewer joints).
+    uint32_t largest_joint = 0;
+    std::string largest_joint_at;
+};
+
+/// A primitive as read, with its morph targets.
+struct DecodedPrimitive : PrimitiveVertices {
     /// A morph target's displacements per vertex; each empty where the target has none.
     struct MorphTarget {
         std::vector<Vec3> positions;
@@ -187,10 +202,6 @@ struct DecodedPrimitive {
         std::vector<Vec3> tangents;
     };
     std::vector<MorphTarget> targets;
-    /// Skin influences: JOINTS_0 / WEIGHTS_0 and JOINTS_1 / WEIGHTS_1 (up to eight joints per
-    /// vertex); empty when the primitive has none.
-    std::array<std::vector<glm::uvec4>, 2> joints;
-    std::array<std::vector<Vec4>, 2> weights;
 };
 
 /// MikkTSpace-compatible tangents for `prim` from the TEXCOORD set of `slot` (gltf_meshes.cpp).
@@ -204,10 +215,9 @@ void generate_tangents(DecodedPrimitive& prim, int slot);
 DecodedPrimitive morphed(const DecodedPrimitive& prim, const std::vector<float>& weights);
 /// Skins `prim` in place into world space: each vertex by the blend of its joints' matrices
 /// (joint world transform times inverse bind matrix) by their weights. A vertex whose weights
-/// sum to zero is placed by `unskinned` (its node's world transform). Fails, with `context`,
-/// on a joint index beyond `joint_matrices`.
-Status skin_in_place(DecodedPrimitive& prim, const std::vector<Mat4>& joint_matrices, const Mat4& unskinned,
-                     const std::string& context);
+/// sum to zero is placed by `unskinned` (its node's world transform). Every joint index given a
+/// weight is below joint_matrices.size() (prim.largest_joint, checked by the caller).
+void skin_in_place(DecodedPrimitive& prim, const std::vector<Mat4>& joint_matrices, const Mat4& unskinned);
 
 class GltfSceneReader {
 public:
@@ -304,10 +314,11 @@ private:
     /// The node's morph weights: its own `weights`, else its mesh's, else none (all zero).
     Expected<std::vector<float>> morph_weights(const tinygltf::Node& node, int node_index) const;
     /// The node's skin as joint matrices: each joint's world transform times its inverse bind
-    /// matrix (glTF 2.0 section 3.7.3).
-    Expected<std::vector<Mat4>> joint_matrices(const tinygltf::Node& node, int node_index);
-    /// A node's world transform through its parents (joints may lie anywhere in the hierarchy).
-    Expected<Mat4> node_world(int node_index);
+    /// matrix (glTF 2.0 section 3.7.3); made once per skin.
+    Expected<const std::vector<Mat4>*> joint_matrices(const tinygltf::Node& node, int node_index);
+    /// A node's world transform through its parents (joints may lie anywhere in the hierarchy);
+    /// `context` opens the message of a failure.
+    Expected<Mat4> node_world(int node_index, const std::string& context);
     Expected<Mat4> local_transform(const tinygltf::Node& node, int node_index) const;
 
 
@@ -337,11 +348,15 @@ private:
     std::vector<uint8_t> on_path_;       // cycle detection during the node walk
     std::vector<int> parents_;                      // each node's parent (-1: a root)
     std::vector<std::optional<Mat4>> node_worlds_;  // node_world's results so far
+    std::vector<std::optional<std::vector<Mat4>>> skin_matrices_;  // joint_matrices' by skin
+    size_t morph_elements_ = 0;  // morph displacements decoded (read_morph_targets)
+    size_t morph_work_ = 0;      // displacements added while placing meshes (add_node_mesh)
     std::vector<std::optional<CameraDesc>> cameras_;  // per glTF camera, from the first node
     std::vector<std::vector<int>> camera_nodes_;      // per glTF camera, the nodes placing it
     // What the walk met and drops or takes its own way, for add_feature_warnings.
     size_t skipped_point_line_primitives_ = 0;
     std::set<std::string> ignored_attributes_;      // attribute names read by nothing
+    std::set<std::string> skin_warnings_;           // skins and influences not applied, as worded
     std::set<int> solid_transmission_materials_;    // on closed meshes without KHR_materials_volume
     size_t node_visits_ = 0;
     size_t triangle_count_ = 0;

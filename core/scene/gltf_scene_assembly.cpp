@@ -211,45 +211,65 @@ Status GltfSceneReader::add_light(const tinygltf::Node& node, int node_index, co
 }
 
 Status GltfSceneReader::add_node_mesh(const tinygltf::Node& node, int node_index, const Mat4& world) {
-    const std::string context = "node " + std::to_string(node_index) + quoted(node.name) + ": ";
+    const std::string node_what = "node " + std::to_string(node_index) + quoted(node.name);
+    const std::string context = node_what + ": ";
     auto& cached = meshes_[static_cast<size_t>(node.mesh)];
     if (!cached) {
         if (Status st = load_mesh(node.mesh); !st) return st;
     }
     // Morph targets blended by the node's weights, then its skin (glTF 2.0 section 3.7.3: a
     // skinned mesh is placed by its joints alone, not by its node's transform).
+    const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(node.mesh)];
+    const std::string mesh_what = "mesh " + std::to_string(node.mesh) + quoted(mesh.name);
     Expected<std::vector<float>> weights = morph_weights(node, node_index);
     if (!weights) return weights.error();
-    const bool morphs = std::any_of(weights->begin(), weights->end(), [](float w) { return w != 0.0f; });
-    std::vector<Mat4> joints;
+    const size_t active_targets =
+        size_t(std::count_if(weights->begin(), weights->end(), [](float w) { return w != 0.0f; }));
+    const std::vector<Mat4>* joints = nullptr;
+    const bool influenced = std::any_of(cached->begin(), cached->end(),
+                                        [](const DecodedPrimitive& prim) { return !prim.joints[0].empty(); });
     if (node.skin >= 0) {
-        Expected<std::vector<Mat4>> matrices = joint_matrices(node, node_index);
+        Expected<const std::vector<Mat4>*> matrices = joint_matrices(node, node_index);
         if (!matrices) return matrices.error();
-        joints = std::move(matrices).value();
+        joints = *matrices;
+        if (!influenced)
+            skin_warnings_.insert(context + "skin " + std::to_string(node.skin) + " is not applied: " + mesh_what +
+                                  " has no JOINTS_0 (drawn where the node puts it)");
+    } else if (influenced) {
+        skin_warnings_.insert(mesh_what + " has skin influences (JOINTS_0) but " + node_what +
+                              " places it without a skin: drawn unskinned where the node puts it");
     }
     for (size_t p = 0; p < cached->size(); ++p) {
         const DecodedPrimitive* placed = &(*cached)[p];
         if (placed->triangles.empty()) continue;
-        const bool skinned = !joints.empty() && !placed->joints[0].empty();
-        DecodedPrimitive deformed;
-        if (morphs && !placed->targets.empty()) {
-            deformed = morphed(*placed, *weights);
-            placed = &deformed;
-        }
-        if (skinned) {
-            if (placed != &deformed) deformed = *placed;
-            if (Status st = skin_in_place(deformed, joints, world, context + "skin " + std::to_string(node.skin) + ": ");
-                !st)
-                return fail(st.error().message);
-            placed = &deformed;
-        }
-        const DecodedPrimitive& prim = *placed;
-        const size_t new_vertices = prim.normals.empty() ? 3 * prim.triangles.size() : prim.positions.size();
-        triangle_count_ += prim.triangles.size();
+        const size_t new_vertices = placed->normals.empty() ? 3 * placed->triangles.size() : placed->positions.size();
+        triangle_count_ += placed->triangles.size();
         vertex_count_ += new_vertices;
         if (triangle_count_ > kMaxSceneTriangles || vertex_count_ > kMaxSceneVertices)
             return fail("the scene has more than " + std::to_string(kMaxSceneTriangles) + " triangles or " +
                         std::to_string(kMaxSceneVertices) + " vertices");
+        const bool skinned = joints && !placed->joints[0].empty();
+        if (skinned && placed->largest_joint >= joints->size()) {
+            const tinygltf::Skin& skin = model_.skins[static_cast<size_t>(node.skin)];
+            return fail(placed->largest_joint_at + " names joint " + std::to_string(placed->largest_joint) +
+                        ", but skin " + std::to_string(node.skin) + quoted(skin.name) + " of " + node_what +
+                        " has " + std::to_string(joints->size()) + " joints");
+        }
+        DecodedPrimitive deformed;
+        if (active_targets > 0 && !placed->targets.empty()) {
+            morph_work_ += placed->positions.size() * active_targets;
+            if (morph_work_ > kMaxMorphWork)
+                return fail(context + "morphing its meshes would add more than " + std::to_string(kMaxMorphWork) +
+                            " displacements");
+            deformed = morphed(*placed, *weights);
+            placed = &deformed;
+        }
+        if (skinned) {
+            if (placed != &deformed) static_cast<PrimitiveVertices&>(deformed) = *placed;
+            skin_in_place(deformed, *joints, world);
+            placed = &deformed;
+        }
+        const DecodedPrimitive& prim = *placed;
         SceneBuilder::MeshExtras extras;
         extras.uvs1 = prim.uvs1;
         extras.colors = prim.colors;
@@ -257,9 +277,7 @@ Status GltfSceneReader::add_node_mesh(const tinygltf::Node& node, int node_index
         if (Status st = builder_.add_mesh(prim.positions, prim.normals, prim.uvs, prim.triangles, prim.material,
                                           skinned ? Mat4(1.0f) : world, extras);
             !st) {
-            const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(node.mesh)];
-            return fail(context + "mesh " + std::to_string(node.mesh) + quoted(mesh.name) + " primitive " +
-                        std::to_string(p) + ": " + st.error().message);
+            return fail(context + mesh_what + " primitive " + std::to_string(p) + ": " + st.error().message);
         }
     }
     return Status::ok();
@@ -289,6 +307,12 @@ Status GltfSceneReader::visit_node(int node_index, const Mat4& parent, int depth
         // node's, and not at the node's alone.
         Expected<std::vector<Mat4>> instances = instance_transforms(node, node_index);
         if (!instances) return instances.error();
+        if (node.skin >= 0 && instances->size() > 1) {
+            // Its joints place a skinned mesh: every instance would land in one place.
+            builder_.add_warning(context + "EXT_mesh_gpu_instancing is ignored on a skinned mesh: it is drawn "
+                                 "once, where its joints put it");
+            instances->resize(1);
+        }
         for (const Mat4& instance : *instances)
             if (Status st = add_node_mesh(node, node_index, world * instance); !st) return st;
     } else if (node.extensions.count("EXT_mesh_gpu_instancing")) {
@@ -329,6 +353,7 @@ Expected<Scene> GltfSceneReader::read() {
             if (child >= 0 && static_cast<size_t>(child) < parents_.size() && parents_[static_cast<size_t>(child)] < 0)
                 parents_[static_cast<size_t>(child)] = static_cast<int>(i);
     node_worlds_.assign(model_.nodes.size(), std::nullopt);
+    skin_matrices_.assign(model_.skins.size(), std::nullopt);
     cameras_.assign(model_.cameras.size(), std::nullopt);
     camera_nodes_.assign(model_.cameras.size(), {});
 

@@ -3,7 +3,6 @@
 #include "core/scene/gltf_reader.h"
 
 #include <array>
-#include <cstdlib>
 
 namespace photond::gltf {
 namespace {
@@ -21,12 +20,12 @@ std::string name_list(const std::vector<std::string>& names) {
 }  // namespace
 
 void GltfSceneReader::note_dropped_primitive_features(const tinygltf::Primitive& prim) {
-    const auto set_index = [](const std::string& name) { return std::atoi(name.c_str() + name.find('_') + 1); };
     for (const auto& [name, accessor] : prim.attributes) {
         // COLOR_0 multiplies the base colour; further colour sets are read by nothing.
         if (name.rfind("COLOR_", 0) == 0 && name != "COLOR_0") ignored_attributes_.insert("COLOR");
         // Skins read JOINTS_0/WEIGHTS_0 and JOINTS_1/WEIGHTS_1 (read_skin_influences).
-        if ((name.rfind("JOINTS_", 0) == 0 || name.rfind("WEIGHTS_", 0) == 0) && set_index(name) >= 2)
+        if ((name.rfind("JOINTS_", 0) == 0 || name.rfind("WEIGHTS_", 0) == 0) && name != "JOINTS_0" &&
+            name != "JOINTS_1" && name != "WEIGHTS_0" && name != "WEIGHTS_1")
             ignored_attributes_.insert("JOINTS");
     }
 }
@@ -41,10 +40,14 @@ void GltfSceneReader::add_feature_warnings() {
         else if (what == "JOINTS")
             builder_.add_warning("skin influences after JOINTS_1 and WEIGHTS_1 (more than eight joints a "
                                  "vertex) are ignored");
+        else if (what == "JOINTS_1 alone")
+            builder_.add_warning("skin influences JOINTS_1 and WEIGHTS_1 without JOINTS_0 and WEIGHTS_0 are "
+                                 "ignored");
         else  // "morph target TEXCOORD", ...
             builder_.add_warning(what + "_n displacements are ignored (a morph target moves POSITION, "
                                  "NORMAL and TANGENT here)");
     }
+    for (const std::string& warning : skin_warnings_) builder_.add_warning(warning);
     if (!model_.animations.empty())
         builder_.add_warning(std::to_string(model_.animations.size()) +
                              " animation(s) are ignored: the nodes' own transforms and morph weights are "

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <limits>
+#include <span>
 #include <string>
 
 namespace photond {
@@ -162,14 +163,97 @@ TEST(GltfDeformation, SkinsPlaceVerticesByTheirJointsAndIgnoreTheNodesTransform)
     EXPECT_TRUE(scene.warnings.empty()) << all_warnings(scene);
 }
 
+TEST(GltfDeformation, SkinInfluencesMayComeInTwoSets) {
+    // skin_two_sets.gltf: skin.gltf with the middle row's J1 half in JOINTS_1/WEIGHTS_1; the mesh
+    // is placed again by a root node without a skin, which draws it unskinned (its bind-space
+    // vertices moved 5 in z) and is named in a warning.
+    const Scene scene = load_ok("skin_two_sets.gltf");
+    ASSERT_EQ(scene.positions.size(), 14u);
+    const Vec3 expected[7] = {{10, 0, 0}, {10.5f, 0, 0}, {10, 1, 0},   {10.25f, 1.25f, 0},
+                              {9, 1, 0},  {9, 1.5f, 0},  {110, 3, 0}};
+    const Vec3 bind[7] = {{10, 0, 0}, {10.5f, 0, 0}, {10, 1, 0}, {10.5f, 1, 0}, {10, 2, 0}, {10.5f, 2, 0}, {0, 3, 0}};
+    for (int v = 0; v < 7; ++v) {
+        expect_near(scene.positions[v], expected[v], "skinned vertex " + std::to_string(v));
+        expect_near(scene.positions[7 + v], bind[v] + Vec3(0, 0, 5), "unskinned vertex " + std::to_string(v));
+    }
+    ASSERT_EQ(scene.warnings.size(), 1u) << all_warnings(scene);
+    EXPECT_NE(scene.warnings[0].find("mesh 0 'Strip' has skin influences (JOINTS_0) but node 4 'Unskinned' places "
+                                     "it without a skin"),
+              std::string::npos)
+        << all_warnings(scene);
+}
+
+TEST(GltfDeformation, AFlatNormalMappedPrimitiveIsMorphedAndSkinnedWithItsFacesNormals) {
+    // morph_skin_flat.gltf: a normal-mapped quad without NORMAL (unwelded for its tangents), its
+    // far edge lifted by 1 (quantized morph displacements, weight 1), then turned 90 degrees
+    // about z and raised by 3 in y by its joint: the plane z = y becomes z = -x below y = 3..4.
+    const Scene scene = load_ok("morph_skin_flat.gltf");
+    ASSERT_EQ(scene.triangles.size(), 2u);
+    ASSERT_EQ(scene.positions.size(), 6u);
+    const Vec3 corners[2][3] = {{{0, 3, 0}, {0, 4, 0}, {-1, 4, 1}}, {{0, 3, 0}, {-1, 4, 1}, {-1, 3, 1}}};
+    const Vec3 normal = glm::normalize(Vec3(1, 0, 1));
+    for (int t = 0; t < 2; ++t) {
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t v = scene.triangles[t][k];
+            const std::string what = "triangle " + std::to_string(t) + " corner " + std::to_string(k);
+            expect_near(scene.positions[v], corners[t][k], what);
+            expect_near(scene.normals[v], normal, what + " normal");
+            ASSERT_EQ(scene.tangents.size(), scene.positions.size());
+            // The tangent, made anew for the morphed face, lies in it.
+            EXPECT_NEAR(glm::length(Vec3(scene.tangents[v])), 1.0f, 1e-5f) << what;
+            EXPECT_NEAR(glm::dot(Vec3(scene.tangents[v]), normal), 0.0f, 1e-5f) << what;
+        }
+    }
+    EXPECT_TRUE(scene.warnings.empty()) << all_warnings(scene);
+}
+
+TEST(GltfDeformation, AMirroringJointFlipsTheTangentsBitangentSign) {
+    // skin_mirrored.gltf: a triangle in the xy plane, normal +z, tangent +x with w = 1, bound to
+    // a joint of scale (-1, 1, 1).
+    const Scene scene = load_ok("skin_mirrored.gltf");
+    ASSERT_EQ(scene.positions.size(), 3u);
+    ASSERT_EQ(scene.tangents.size(), 3u);
+    const Vec3 mirrored[3] = {{0, 0, 0}, {-1, 0, 0}, {0, 1, 0}};
+    for (int v = 0; v < 3; ++v) {
+        expect_near(scene.positions[v], mirrored[v], "vertex " + std::to_string(v));
+        expect_near(scene.normals[v], Vec3(0, 0, 1), "normal " + std::to_string(v));
+        expect_near(Vec3(scene.tangents[v]), Vec3(-1, 0, 0), "tangent " + std::to_string(v));
+        EXPECT_EQ(scene.tangents[v].w, -1.0f) << "vertex " << v;
+    }
+}
+
+TEST(GltfDeformation, MorphTargetsBeyondTheLimitAreRefusedBeforeTheyAreDecoded) {
+    // 900 targets that all name the 21,000 positions of the mesh itself: 18.9 M displacements to
+    // decode from a file of 350 kB. Refused by count before any is decoded.
+    constexpr int kVertices = 21000, kTargets = 900;
+    const std::string buffer(size_t(kVertices) * 12, '\0');
+    std::string targets;
+    for (int t = 0; t < kTargets; ++t) targets += std::string(t ? "," : "") + "{\"POSITION\":0}";
+    const std::string json =
+        "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":" + std::to_string(buffer.size()) +
+        ",\"uri\":\"data:application/octet-stream;base64," + std::string(buffer.size() / 3 * 4, 'A') +
+        "\"}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":" + std::to_string(buffer.size()) +
+        "}],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":" + std::to_string(kVertices) +
+        ",\"type\":\"VEC3\"}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"targets\":[" +
+        targets + "]}]}],\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]}";
+    const std::span<const uint8_t> bytes(reinterpret_cast<const uint8_t*>(json.data()), json.size());
+    const Expected<Scene> scene = load_gltf_memory(bytes, "many_targets.gltf");
+    ASSERT_FALSE(scene.has_value());
+    EXPECT_NE(scene.error().message.find("the file's morph targets hold more than 16777216 displacements"),
+              std::string::npos)
+        << scene.error().message;
+}
+
 TEST(GltfDeformation, BrokenSkinsAndMorphWeightsAreRefusedSayingWhy) {
     EXPECT_NE(load_error("broken/morph_weights_count.gltf")
                   .find("mesh 0 'Quad' gives 1 morph weights, but primitive 0 of mesh 0 'Quad' has 2 morph targets"),
               std::string::npos);
     EXPECT_NE(load_error("broken/skin_joint_out_of_range.gltf")
-                  .find("node 3 'Skinned': skin 0: vertex 2 has weight on joint 2 of a skin with 2 joints"),
+                  .find("mesh 0 'Strip' primitive 0: accessor 3 (JOINTS_0), vertex 2 names joint 2, but skin 0 "
+                        "'Rig' of node 3 'Skinned' has 2 joints"),
               std::string::npos);
-    EXPECT_NE(load_error("broken/skin_inverse_bind_count.gltf").find("skin 0 'Rig' has 2 joints but 1 inverse bind matrices"),
+    EXPECT_NE(load_error("broken/skin_inverse_bind_count.gltf")
+                  .find("skin 0 'Rig' has 2 joints but 1 inverse bind matrices"),
               std::string::npos);
     EXPECT_NE(load_error("broken/skin_joints_without_weights.gltf").find("JOINTS_0 has no WEIGHTS_0"),
               std::string::npos);

@@ -1047,7 +1047,7 @@ def morph_and_skin():
     write("morph.gltf", morph())
     write("broken/morph_weights_count.gltf", morph(weights_count=1))
 
-    def skin(joint=1, bind_matrices=2, weights=True):
+    def skin(joint=1, bind_matrices=2, weights=True, two_sets=False):
         b = Builder()
         # Three rows of two vertices in the bind pose (x = 10, 10.5; y = 0, 1, 2), and one more.
         positions = [10, 0, 0, 10.5, 0, 0, 10, 1, 0, 10.5, 1, 0, 10, 2, 0, 10.5, 2, 0, 0, 3, 0]
@@ -1060,6 +1060,15 @@ def morph_and_skin():
         attributes = {"POSITION": pos, "NORMAL": nrm, "JOINTS_0": j}
         if weights:
             attributes["WEIGHTS_0"] = w
+        if two_sets:
+            # The middle row's second joint from the second set: the same influences.
+            attributes["JOINTS_0"] = b.accessor(b.view(struct.pack("<28B", *[0 if k % 4 else joints[k] for k in
+                                                                             range(28)])), U8, 7, "VEC4")
+            attributes["WEIGHTS_0"] = b.floats([1, 0, 0, 0] * 2 + [0.5, 0, 0, 0] * 2 + [1, 0, 0, 0] * 2 +
+                                               [0, 0, 0, 0], "VEC4")
+            attributes["JOINTS_1"] = b.accessor(b.view(struct.pack("<28B", *([0] * 8 + [1, 0, 0, 0] * 2 +
+                                                                             [0] * 12))), U8, 7, "VEC4")
+            attributes["WEIGHTS_1"] = b.floats([0] * 8 + [0.5, 0, 0, 0] * 2 + [0] * 12, "VEC4")
         b.doc["meshes"] = [{"name": "Strip", "primitives": [{"attributes": attributes, "indices": idx}]}]
         # Inverse bind matrices (column-major): J0 bound at (10, 0, 0), J1 at (10, 1, 0).
         ibm = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -10, 0, 0, 1,
@@ -1072,11 +1081,59 @@ def morph_and_skin():
                           {"name": "J1", "translation": [0, 1, 0], "rotation": quarter},
                           {"name": "Skinned", "mesh": 0, "skin": 0, "translation": [100, 0, 0]}]
         b.doc["scenes"] = [{"nodes": [0]}]
+        if two_sets:
+            # The mesh placed once more by a node without a skin: drawn unskinned, with a warning.
+            b.doc["nodes"].append({"name": "Unskinned", "mesh": 0, "translation": [0, 0, 5]})
+            b.doc["scenes"] = [{"nodes": [0, 4]}]
         return b.finish()
     write("skin.gltf", skin())
+    write("skin_two_sets.gltf", skin(two_sets=True))
     write("broken/skin_joint_out_of_range.gltf", skin(joint=2))
     write("broken/skin_inverse_bind_count.gltf", skin(bind_matrices=1))
     write("broken/skin_joints_without_weights.gltf", skin(weights=False))
+
+    # A normal-mapped quad without NORMAL (flat: unwelded for its tangents), lifted by a morph
+    # target of quantized displacements (normalized SHORT, KHR_mesh_quantization) at weight 1,
+    # then turned 90 degrees about z and raised by 3 in y by its one joint.
+    b = Builder()
+    b.doc["extensionsUsed"] = ["KHR_mesh_quantization"]
+    b.doc["extensionsRequired"] = ["KHR_mesh_quantization"]
+    b.doc["images"] = [{"uri": png_data_uri(png(1, 1, [[(128, 128, 255)]]))}]
+    b.doc["textures"] = [{"source": 0}]
+    b.doc["materials"] = [{"name": "Bumpy", "normalTexture": {"index": 0}}]
+    pos = b.floats(QUAD_POSITIONS, "VEC3")
+    uv = b.floats(QUAD_UVS, "VEC2")
+    idx = b.indices(QUAD_INDICES, U16)
+    lift = b.accessor(b.view(struct.pack("<12h", 0, 0, 0, 0, 0, 0, 0, 0, 32767, 0, 0, 32767)), 5122, 4, "VEC3",
+                      normalized=True)
+    j = b.accessor(b.view(bytes(16)), U8, 4, "VEC4")
+    w = b.floats([1, 0, 0, 0] * 4, "VEC4")
+    b.doc["meshes"] = [{"name": "FlatQuad", "weights": [1], "primitives": [{
+        "attributes": {"POSITION": pos, "TEXCOORD_0": uv, "JOINTS_0": j, "WEIGHTS_0": w}, "indices": idx,
+        "material": 0, "targets": [{"POSITION": lift}]}]}]
+    b.doc["skins"] = [{"joints": [1]}]
+    b.doc["nodes"] = [{"name": "Quad", "mesh": 0, "skin": 0},
+                      {"name": "Joint", "translation": [0, 3, 0],
+                       "rotation": [0, 0, math.sin(math.pi / 4), math.cos(math.pi / 4)]}]
+    b.doc["scenes"] = [{"nodes": [0, 1]}]
+    write("morph_skin_flat.gltf", b.finish())
+
+    # A normal-mapped triangle with TANGENT, bound to a joint that mirrors x: the tangent turns
+    # with it and its bitangent sign flips.
+    b = Builder()
+    b.doc["images"] = [{"uri": png_data_uri(png(1, 1, [[(128, 128, 255)]]))}]
+    b.doc["textures"] = [{"source": 0}]
+    b.doc["materials"] = [{"name": "Bumpy", "normalTexture": {"index": 0}}]
+    attrs = triangle(b)
+    attrs["TEXCOORD_0"] = b.floats([0, 0, 1, 0, 0, 1], "VEC2")
+    attrs["TANGENT"] = b.floats([1, 0, 0, 1] * 3, "VEC4")
+    attrs["JOINTS_0"] = b.accessor(b.view(bytes(12)), U8, 3, "VEC4")
+    attrs["WEIGHTS_0"] = b.floats([1, 0, 0, 0] * 3, "VEC4")
+    b.doc["meshes"] = [{"name": "Tri", "primitives": [{"attributes": attrs, "material": 0}]}]
+    b.doc["skins"] = [{"joints": [1]}]
+    b.doc["nodes"] = [{"name": "Mirrored", "mesh": 0, "skin": 0}, {"name": "Mirror", "scale": [-1, 1, 1]}]
+    b.doc["scenes"] = [{"nodes": [0, 1]}]
+    write("skin_mirrored.gltf", b.finish())
 
 
 def main():
