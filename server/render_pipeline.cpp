@@ -479,7 +479,8 @@ Expected<AddedLighting> job_lighting(const protocol::Job& job, const Scene& scen
                 // Only emissive surfaces: a lamp's glow, a screen, a label. Unless they could
                 // light the scene as well as a sky would, the model is shown under the sky too,
                 // as glTF viewers do.
-                const float own = average(LightSet(scene).total_power());
+                // By power alone: the light tree is no part of the total.
+                const float own = average(LightSet(scene, LightSelection::Power).total_power());
                 const float radius = std::max(scene.bounds.radius(), 1e-6f);
                 const float sky = 4.0f * kPi * kPi * radius * radius;  // radiance 1 through the scene's disc
                 if (own >= kEmissiveOnlyShareOfSky * sky) {

@@ -148,8 +148,8 @@ private:
     /// The emissive texture's value (without the factor) on triangle light `e` at barycentrics b.
     Color emissive_texel(const Entry& e, Vec2 b) const;
     /// Mean emissive texture value over a triangle (without the factor), for its power: the
-    /// mean of a grid of points on it, read at the mip level where the triangle covers about 256
-    /// texels (levels are box means, so no emitting texel is missed between the points).
+    /// mean of a grid of points on it, read at the mip level where the triangle covers at most
+    /// about 16 texels (levels are box means, so no emitting texel is missed between the points).
     Color mean_emissive_texel(uint32_t triangle) const;
     const Scene* scene_;
     std::vector<Entry> lights_;

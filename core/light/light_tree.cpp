@@ -1,5 +1,7 @@
 #include "core/light/light_tree.h"
 
+#include <tbb/parallel_invoke.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -14,6 +16,8 @@ constexpr uint64_t kNotInTree = ~uint64_t(0);
 /// 64 choices (a trail's bits) for up to 2^32 lights.
 constexpr int kCostSplitDepth = 32;
 constexpr int kBuckets = 12;
+// Subtrees of this many lights or more build their two halves in parallel.
+constexpr size_t kParallelBuildLights = 4096;
 constexpr float kOneMinusEpsilon = 0x1.fffffep-1f;
 
 /// cos(max(0, a - b)) and sin(max(0, a - b)) from the sines and cosines of a and b (pbrt-v4,
@@ -62,6 +66,14 @@ LightBounds light_bounds_union(const LightBounds& a, const LightBounds& b) {
     u.intensity = a.intensity + b.intensity;
     u.cos_theta_e = std::min(a.cos_theta_e, b.cos_theta_e);
     u.two_sided = a.two_sided || b.two_sided;
+    // A single direction well inside a's cone (most of a build's unions): a's cone, as the exact
+    // test below finds (the margin, far above its rounding, keeps the two from disagreeing), but
+    // without its inverse cosines.
+    if (b.cos_theta_o >= 1.0f && glm::dot(a.w, b.w) >= a.cos_theta_o + 1e-5f) {
+        u.w = a.w;
+        u.cos_theta_o = a.cos_theta_o;
+        return u;
+    }
     // The cone around both cones (pbrt-v4 `DirectionCone::Union`).
     const float theta_a = std::acos(std::clamp(a.cos_theta_o, -1.0f, 1.0f));
     const float theta_b = std::acos(std::clamp(b.cos_theta_o, -1.0f, 1.0f));
@@ -142,21 +154,18 @@ LightTree::LightTree(std::span<const LightBounds> lights) {
     }
     light_count_ = indices.size();
     if (indices.empty()) return;
-    nodes_.reserve(2 * indices.size() - 1);
-    build(lights, indices, 0, indices.size(), 0, 0);
+    nodes_.resize(2 * indices.size() - 1);
+    depth_ = build(lights, indices, 0, indices.size(), 0, 0, 0);
 }
 
-uint32_t LightTree::build(std::span<const LightBounds> all, std::vector<uint32_t>& lights, size_t begin,
-                          size_t end, uint64_t trail, int depth) {
-    const uint32_t index = static_cast<uint32_t>(nodes_.size());
-    nodes_.emplace_back();
-    depth_ = std::max(depth_, depth);
+int LightTree::build(std::span<const LightBounds> all, std::vector<uint32_t>& lights, size_t begin, size_t end,
+                     uint32_t index, uint64_t trail, int depth) {
     if (end - begin == 1) {
         nodes_[index].bounds = ImportanceBounds(all[lights[begin]]);
         nodes_[index].leaf = true;
         nodes_[index].light = lights[begin];
         trails_[lights[begin]] = trail;
-        return index;
+        return depth;
     }
     LightBounds node_bounds;
     Bounds3 centroids;
@@ -212,10 +221,22 @@ uint32_t LightTree::build(std::span<const LightBounds> all, std::vector<uint32_t
                          });
     }
     nodes_[index].bounds = ImportanceBounds(node_bounds);
-    build(all, lights, begin, middle, trail, depth + 1);
-    const uint32_t second = build(all, lights, middle, end, trail | (uint64_t(1) << depth), depth + 1);
+    // The subtrees own disjoint ranges of `lights`, of nodes_ and of trails_: the tree is the same
+    // built in parallel or not.
+    const uint32_t second = index + 2 * static_cast<uint32_t>(middle - begin);
     nodes_[index].second_child = second;
-    return index;
+    int first_depth = 0, second_depth = 0;
+    const auto first_subtree = [&] { first_depth = build(all, lights, begin, middle, index + 1, trail, depth + 1); };
+    const auto second_subtree = [&] {
+        second_depth = build(all, lights, middle, end, second, trail | (uint64_t(1) << depth), depth + 1);
+    };
+    if (end - begin >= kParallelBuildLights) {
+        tbb::parallel_invoke(first_subtree, second_subtree);
+    } else {
+        first_subtree();
+        second_subtree();
+    }
+    return std::max(first_depth, second_depth);
 }
 
 void LightTree::child_probabilities(const Node& node, uint32_t index, const Vec3& p, float* p0, float* p1) const {

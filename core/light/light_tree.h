@@ -94,9 +94,11 @@ private:
         uint32_t light = 0;         // leaves: the light's index
         bool leaf = false;
     };
-    /// Builds the subtree over lights[begin, end) (indices into `all`) at node index returned.
-    uint32_t build(std::span<const LightBounds> all, std::vector<uint32_t>& lights, size_t begin, size_t end,
-                   uint64_t trail, int depth);
+    /// Builds the subtree over lights[begin, end) (indices into `all`) into nodes
+    /// [index, index + 2 (end - begin) - 1), depth first (a node, its first subtree, its second),
+    /// large subtrees in parallel; returns the depth of its deepest leaf.
+    int build(std::span<const LightBounds> all, std::vector<uint32_t>& lights, size_t begin, size_t end,
+              uint32_t index, uint64_t trail, int depth);
     /// The probabilities of a node's two children at p (both zero: neither can reach p).
     void child_probabilities(const Node& node, uint32_t index, const Vec3& p, float* p0, float* p1) const;
 
