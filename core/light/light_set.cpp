@@ -43,9 +43,30 @@ LightSet::LightSet(const Scene& scene, LightSelection selection)
     : LightSet(scene, scene.environment ? &*scene.environment : nullptr, selection) {}
 
 LightSet::LightSet(const Scene& scene, const Environment* environment, LightSelection selection)
+    : LightSet(scene, environment, selection, nullptr) {}
+
+LightSet::LightSet(const Scene& scene, const Environment* environment, LightSelection selection,
+                   const LightSet& same_scene)
+    : LightSet(scene, environment, selection, &same_scene) {}
+
+LightSet::LightSet(const Scene& scene, const Environment* environment, LightSelection selection,
+                   const LightSet* same_scene)
     : scene_(&scene), selection_mode_(selection) {
     scene_center_ = scene.bounds.empty() ? Vec3(0.0f) : scene.bounds.center();
     scene_radius_ = std::max(scene.bounds.radius(), 1e-6f);
+    if (same_scene) {
+        lights_.assign(same_scene->lights_.begin(),
+                       same_scene->lights_.begin() + static_cast<std::ptrdiff_t>(same_scene->scene_light_count_));
+        for (Entry& e : lights_) e.emission_weight = Color(0.0f);  // by this set's choice, below
+        light_of_triangle_ = same_scene->light_of_triangle_;
+    } else {
+        add_scene_lights(scene);
+    }
+    scene_light_count_ = lights_.size();
+    finish(environment, same_scene);
+}
+
+void LightSet::add_scene_lights(const Scene& scene) {
     for (uint32_t i = 0; i < scene.lights.size(); ++i) {
         const PunctualLight& l = scene.lights[i];
         Entry e{LightKind::Point, i, Color(0.0f), 0.0f};
@@ -113,6 +134,10 @@ LightSet::LightSet(const Scene& scene, const Environment* environment, LightSele
             lights_[first_emitter + k] = e;
         }
     });
+}
+
+void LightSet::finish(const Environment* environment, const LightSet* same_scene) {
+    const Scene& scene = *scene_;
     if (environment) {
         environment_.emplace(*environment);
         Entry e{LightKind::Environment, 0, Color(0.0f), 0.0f};
@@ -161,10 +186,10 @@ LightSet::LightSet(const Scene& scene, const Environment* environment, LightSele
             }
         }
     }
-    if (selection_mode_ == LightSelection::Tree) build_tree();
+    if (selection_mode_ == LightSelection::Tree) build_tree(same_scene ? same_scene->tree_ : nullptr);
 }
 
-void LightSet::build_tree() {
+void LightSet::build_tree(std::shared_ptr<const LightTree> same_tree) {
     std::vector<LightBounds> bounds;
     std::vector<float> weights(lights_.size() + 1, 0.0f);
     tree_index_of_light_.assign(lights_.size(), -1);
@@ -213,7 +238,8 @@ void LightSet::build_tree() {
         tree_power += average(e.power);
     }
     weights.back() = tree_power;
-    tree_ = LightTree(bounds);
+    // The tree holds no distant light: a set of the same scene lights built it already.
+    tree_ = same_tree ? std::move(same_tree) : std::make_shared<const LightTree>(bounds);
     tree_or_distant_ = DiscreteDistribution(weights);
     tree_only_ = !tree_or_distant_.empty() && tree_or_distant_.probability(static_cast<uint32_t>(lights_.size())) == 1.0f;
 }
@@ -233,7 +259,7 @@ std::optional<uint32_t> LightSet::choose_incident(const Vec3& p, float u_select,
         return index;
     }
     float tree_pmf = 0.0f;
-    const std::optional<uint32_t> picked = tree_.sample(p, u_tree, &tree_pmf);
+    const std::optional<uint32_t> picked = tree_->sample(p, u_tree, &tree_pmf);
     if (!picked) return std::nullopt;
     *choice_pdf = group_pdf * tree_pmf;
     return tree_lights_[*picked];
@@ -244,7 +270,7 @@ float LightSet::incident_choice_probability(uint32_t light, const Vec3& p) const
     const int32_t in_tree = tree_index_of_light_[light];
     if (in_tree < 0) return tree_or_distant_.probability(light);
     const float tree_share = tree_only_ ? 1.0f : tree_or_distant_.probability(static_cast<uint32_t>(lights_.size()));
-    return tree_share * tree_.pmf(p, static_cast<uint32_t>(in_tree));
+    return tree_share * tree_->pmf(p, static_cast<uint32_t>(in_tree));
 }
 
 std::optional<LightSample> LightSet::sample_incident(const Vec3& p, float u_select,

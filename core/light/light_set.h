@@ -4,6 +4,7 @@
 // Immutable after construction; safe to share between threads.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -53,6 +54,12 @@ public:
     /// The scene's lights with `environment` in place of the scene's own (null: none); it must
     /// outlive the set.
     LightSet(const Scene& scene, const Environment* environment, LightSelection selection = LightSelection::Tree);
+    /// The same with the scene's own lights (points, spots, suns, emitting triangles) and their
+    /// light tree taken from `same_scene`, a set of the same scene and selection whose
+    /// environment alone differs: they are the same, and a scene of a million emitting
+    /// triangles takes seconds to make them.
+    LightSet(const Scene& scene, const Environment* environment, LightSelection selection,
+             const LightSet& same_scene);
 
     bool empty() const { return lights_.empty() || selection_.empty(); }
     size_t size() const { return lights_.size(); }
@@ -64,7 +71,7 @@ public:
     float selection_probability(uint32_t light) const { return selection_.probability(light); }
     /// How sample_incident picks lights, and the tree it uses (empty with Power).
     LightSelection selection() const { return selection_mode_; }
-    const LightTree& tree() const { return tree_; }
+    const LightTree& tree() const { return *tree_; }
     /// The probability with which sample_incident(p, ...) picks `light`.
     float incident_choice_probability(uint32_t light, const Vec3& p) const;
 
@@ -122,8 +129,9 @@ private:
     /// The light sample_incident samples from p, and its choice probability.
     std::optional<uint32_t> choose_incident(const Vec3& p, float u_select, float* choice_pdf) const;
     /// The light tree over the lights with a position (point, spot, triangles), and the
-    /// distribution over the distant lights by power with the tree's lights as its last entry.
-    void build_tree();
+    /// distribution over the distant lights by power with the tree's lights as its last entry;
+    /// the tree is `same_tree` when given (a set of the same scene lights built it).
+    void build_tree(std::shared_ptr<const LightTree> same_tree);
 
     struct Entry {
         LightKind kind;
@@ -151,6 +159,12 @@ private:
     /// mean of a grid of points on it, read at the mip level where the triangle covers at most
     /// about 16 texels (levels are box means, so no emitting texel is missed between the points).
     Color mean_emissive_texel(uint32_t triangle) const;
+    LightSet(const Scene& scene, const Environment* environment, LightSelection selection, const LightSet* same_scene);
+    /// The scene's punctual lights and emitting triangles (before the environment).
+    void add_scene_lights(const Scene& scene);
+    /// The environment's entry, the choice by power, the flux weights and the tree (taken from
+    /// `same_scene` when given).
+    void finish(const Environment* environment, const LightSet* same_scene);
     const Scene* scene_;
     std::vector<Entry> lights_;
     std::vector<int32_t> light_of_triangle_;  // -1 when the triangle emits nothing
@@ -158,7 +172,8 @@ private:
     std::optional<EnvironmentLight> environment_;
     DiscreteDistribution selection_;
     LightSelection selection_mode_ = LightSelection::Tree;
-    LightTree tree_;
+    std::shared_ptr<const LightTree> tree_ = std::make_shared<const LightTree>();  // shared by sets of one scene
+    size_t scene_light_count_ = 0;             // lights_ before the environment's entry
     std::vector<uint32_t> tree_lights_;        // the tree's light i is lights_[tree_lights_[i]]
     std::vector<int32_t> tree_index_of_light_;  // -1: a distant light
     DiscreteDistribution tree_or_distant_;      // lights_.size() + 1 entries; the last: the tree

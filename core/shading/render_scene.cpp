@@ -18,7 +18,9 @@ Expected<std::shared_ptr<const RenderScene>> RenderScene::create(std::shared_ptr
             render_scene->diffuse_sky_environment = std::make_unique<const Environment>(std::move(*split.diffuse));
             render_scene->diffuse_sky = std::make_unique<EnvironmentLight>(*render_scene->diffuse_sky_environment);
         }
-        render_scene->lights_with_sky_peaks = std::make_unique<LightSet>(*scene, render_scene->sky_peaks.get(), selection);
+        // The scene's own lights and their tree as `lights` has them: only the sky differs.
+        render_scene->lights_with_sky_peaks =
+            std::make_unique<LightSet>(*scene, render_scene->sky_peaks.get(), selection, *render_scene->lights);
     }
     render_scene->bsdf_materials.reserve(scene->materials.size());
     for (const Material& material : scene->materials) {
