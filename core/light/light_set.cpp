@@ -186,7 +186,8 @@ void LightSet::finish(const Environment* environment, const LightSet* same_scene
             }
         }
     }
-    if (selection_mode_ == LightSelection::Tree) build_tree(same_scene ? same_scene->tree_ : nullptr);
+    if (selection_mode_ == LightSelection::Tree)
+        build_tree(same_scene && same_scene->selection_mode_ == LightSelection::Tree ? same_scene->tree_ : nullptr);
 }
 
 void LightSet::build_tree(std::shared_ptr<const LightTree> same_tree) {

@@ -272,6 +272,46 @@ TEST(LightSelection, ChoiceProbabilitiesSumToAtMostOneAndMisPdfEqualsTheSamplesP
     }
 }
 
+TEST(LightSelection, ASetSharingAnotherSetsSceneLightsChoosesAsOneBuiltAlone) {
+    // RenderScene's second set (the sky's peaks in place of the sky) takes the first one's
+    // emitters and tree: its choices must be those of a set made from the scene alone.
+    const Scene scene = many_lights_scene();
+    Environment sky, peaks;
+    sky.color = Color(0.2f);
+    peaks.color = Color(3.0f, 2.0f, 1.0f);
+    for (const LightSelection selection : {LightSelection::Tree, LightSelection::Power}) {
+        const LightSet first(scene, &sky, selection);
+        const LightSet shared(scene, &peaks, selection, first);
+        const LightSet alone(scene, &peaks, selection);
+        ASSERT_EQ(shared.size(), alone.size());
+        EXPECT_EQ(shared.total_power(), alone.total_power());
+        Rng rng(43, 44);
+        for (int point = 0; point < 20; ++point) {
+            const Vec3 p(24.0f * rng.next_float() - 12.0f, 4.0f * rng.next_float(), 24.0f * rng.next_float() - 12.0f);
+            for (uint32_t l = 0; l < alone.size(); ++l)
+                ASSERT_EQ(shared.incident_choice_probability(l, p), alone.incident_choice_probability(l, p))
+                    << "light " << l;
+            const float u = rng.next_float();
+            const Vec2 u2 = rng.next_vec2();
+            const std::optional<LightSample> a = shared.sample_incident(p, u, u2), b = alone.sample_incident(p, u, u2);
+            ASSERT_EQ(a.has_value(), b.has_value());
+            if (a) EXPECT_EQ(a->pdf, b->pdf);
+        }
+        for (uint32_t l = 0; l < alone.size(); ++l) EXPECT_EQ(shared.selection_probability(l), alone.selection_probability(l));
+        // Photons leave both alike (the flux weights are this set's own, by its choice).
+        for (int k = 0; k < 200; ++k) {
+            const float u = rng.next_float();
+            const Vec2 u_position = rng.next_vec2(), u_direction = rng.next_vec2();
+            const std::optional<EmissionSample> a = shared.sample_emission(u, u_position, u_direction);
+            const std::optional<EmissionSample> b = alone.sample_emission(u, u_position, u_direction);
+            ASSERT_EQ(a.has_value(), b.has_value());
+            if (!a) continue;
+            EXPECT_EQ(a->light, b->light);
+            EXPECT_EQ(a->flux_weight, b->flux_weight) << "light " << a->light;
+        }
+    }
+}
+
 /// Irradiance at p (normal n) from every light without occlusion: the triangles integrated on
 /// a fine grid of sub-triangles, the point lights exactly.
 double brute_force_irradiance(const Scene& scene, const Vec3& p, const Vec3& n) {
