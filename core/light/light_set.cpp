@@ -56,13 +56,12 @@ LightSet::LightSet(const Scene& scene, const Environment* environment, LightSele
     scene_radius_ = std::max(scene.bounds.radius(), 1e-6f);
     if (same_scene) {
         lights_.assign(same_scene->lights_.begin(),
-                       same_scene->lights_.begin() + static_cast<std::ptrdiff_t>(same_scene->scene_light_count_));
+                       same_scene->lights_.begin() + static_cast<std::ptrdiff_t>(same_scene->scene_light_count()));
         for (Entry& e : lights_) e.emission_weight = Color(0.0f);  // by this set's choice, below
         light_of_triangle_ = same_scene->light_of_triangle_;
     } else {
         add_scene_lights(scene);
     }
-    scene_light_count_ = lights_.size();
     finish(environment, same_scene);
 }
 

@@ -165,6 +165,8 @@ private:
     /// The environment's entry, the choice by power, the flux weights and the tree (taken from
     /// `same_scene` when given).
     void finish(const Environment* environment, const LightSet* same_scene);
+    /// The scene's own lights: lights_ before the environment's entry, which comes last.
+    size_t scene_light_count() const { return lights_.size() - (environment_ ? 1 : 0); }
     const Scene* scene_;
     std::vector<Entry> lights_;
     std::vector<int32_t> light_of_triangle_;  // -1 when the triangle emits nothing
@@ -173,7 +175,6 @@ private:
     DiscreteDistribution selection_;
     LightSelection selection_mode_ = LightSelection::Tree;
     std::shared_ptr<const LightTree> tree_ = std::make_shared<const LightTree>();  // shared by sets of one scene
-    size_t scene_light_count_ = 0;             // lights_ before the environment's entry
     std::vector<uint32_t> tree_lights_;        // the tree's light i is lights_[tree_lights_[i]]
     std::vector<int32_t> tree_index_of_light_;  // -1: a distant light
     DiscreteDistribution tree_or_distant_;      // lights_.size() + 1 entries; the last: the tree

@@ -39,18 +39,7 @@ Status GltfSceneReader::read_morph_targets(const tinygltf::Primitive& prim, cons
         if (morph_elements_ > kMaxMorphElements)
             return fail(context + "the file's morph targets hold more than " + std::to_string(kMaxMorphElements) +
                         " displacements");
-        Expected<PackedAccessor> packed = pack_accessor(accessor, context, role, rule);
-        if (!packed) return packed.error();
-        const auto& a = model_.accessors[static_cast<size_t>(accessor)];
-        const std::string what =
-            context + "accessor " + std::to_string(accessor) + quoted(a.name) + " (" + role + ")";
-        if (packed->count != vertex_count)
-            return fail(what + " has " + std::to_string(packed->count) + " elements but POSITION has " +
-                        std::to_string(vertex_count));
-        auto deltas = unpack_vectors<Vec3>(*packed, "");
-        if (!deltas) return fail(what + deltas.error().message);
-        target = std::move(deltas).value();
-        return Status::ok();
+        return read_vertex_accessor(accessor, context, role, rule, vertex_count, target);
     };
     out.targets.resize(prim.targets.size());
     for (size_t t = 0; t < prim.targets.size(); ++t) {
@@ -87,14 +76,10 @@ Status GltfSceneReader::read_skin_influences(const tinygltf::Primitive& prim, co
             ignored_attributes_.insert("JOINTS_1 alone");
             continue;
         }
-        Expected<PackedAccessor> packed = pack_accessor(joints->second, context, joints_name, kJointsRule);
+        std::string what;
+        Expected<PackedAccessor> packed =
+            pack_vertex_accessor(joints->second, context, joints_name, kJointsRule, vertex_count, &what);
         if (!packed) return packed.error();
-        const auto& a = model_.accessors[static_cast<size_t>(joints->second)];
-        const std::string what =
-            context + "accessor " + std::to_string(joints->second) + quoted(a.name) + " (" + joints_name + ")";
-        if (packed->count != vertex_count)
-            return fail(what + " has " + std::to_string(packed->count) + " elements but POSITION has " +
-                        std::to_string(vertex_count));
         if (Status st = read_attribute(prim, context, weights_name, kWeightsRule, vertex_count, out.weights[set]); !st)
             return st;
         const size_t component = size_t(component_size(packed->component_type));

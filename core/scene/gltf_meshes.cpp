@@ -304,20 +304,35 @@ Status GltfSceneReader::read_positions(const tinygltf::Primitive& prim, const st
     return Status::ok();
 }
 
+Expected<PackedAccessor> GltfSceneReader::pack_vertex_accessor(int accessor, const std::string& context,
+                                                               const std::string& role, const AccessorRule& rule,
+                                                               size_t vertex_count, std::string* what) {
+    Expected<PackedAccessor> packed = pack_accessor(accessor, context, role, rule);
+    if (!packed) return packed.error();
+    const auto& a = model_.accessors[static_cast<size_t>(accessor)];
+    *what = context + "accessor " + std::to_string(accessor) + quoted(a.name) + " (" + role + ")";
+    if (packed->count != vertex_count)
+        return fail(*what + " has " + std::to_string(packed->count) + " elements but POSITION has " +
+                    std::to_string(vertex_count));
+    return packed;
+}
+
 template <typename VecT>
 Status GltfSceneReader::read_attribute(const tinygltf::Primitive& prim, const std::string& context,
                                        const std::string& name, const AccessorRule& rule,
                                        size_t vertex_count, std::vector<VecT>& target) {
     const auto it = prim.attributes.find(name);
     if (it == prim.attributes.end()) return Status::ok();
-    Expected<PackedAccessor> packed = pack_accessor(it->second, context, name, rule);
+    return read_vertex_accessor(it->second, context, name, rule, vertex_count, target);
+}
+
+template <typename VecT>
+Status GltfSceneReader::read_vertex_accessor(int accessor, const std::string& context, const std::string& role,
+                                             const AccessorRule& rule, size_t vertex_count,
+                                             std::vector<VecT>& target) {
+    std::string what;
+    Expected<PackedAccessor> packed = pack_vertex_accessor(accessor, context, role, rule, vertex_count, &what);
     if (!packed) return packed.error();
-    const auto& a = model_.accessors[static_cast<size_t>(it->second)];
-    const std::string what =
-        context + "accessor " + std::to_string(it->second) + quoted(a.name) + " (" + name + ")";
-    if (packed->count != vertex_count)
-        return fail(what + " has " + std::to_string(packed->count) + " elements but POSITION has " +
-                    std::to_string(vertex_count));
     if constexpr (std::is_same_v<VecT, Vec4>) {
         if (packed->components == 3) {  // COLOR_0 as RGB: alpha 1
             auto rgb = unpack_vectors<Vec3>(*packed, "");
@@ -332,6 +347,12 @@ Status GltfSceneReader::read_attribute(const tinygltf::Primitive& prim, const st
     target = std::move(values).value();
     return Status::ok();
 }
+
+// Other parts of the reader (gltf_deformation.cpp) read attributes too.
+template Status GltfSceneReader::read_attribute(const tinygltf::Primitive&, const std::string&, const std::string&,
+                                                const AccessorRule&, size_t, std::vector<Vec4>&);
+template Status GltfSceneReader::read_vertex_accessor(int, const std::string&, const std::string&,
+                                                      const AccessorRule&, size_t, std::vector<Vec3>&);
 
 Expected<std::vector<uint32_t>> GltfSceneReader::read_indices(const tinygltf::Primitive& prim,
                                                              const std::string& context,

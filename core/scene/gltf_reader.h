@@ -255,6 +255,14 @@ private:
     Status read_attribute(const tinygltf::Primitive& prim, const std::string& context,
                           const std::string& name, const AccessorRule& rule, size_t vertex_count,
                           std::vector<VecT>& target);
+    /// Accessor `accessor` of a per-vertex attribute (`role`: "NORMAL", "targets[1] POSITION",
+    /// ...) read whole, with as many elements as POSITION.
+    template <typename VecT>
+    Status read_vertex_accessor(int accessor, const std::string& context, const std::string& role,
+                                const AccessorRule& rule, size_t vertex_count, std::vector<VecT>& target);
+    /// The same accessor packed, its element count checked; `what` names it for later messages.
+    Expected<PackedAccessor> pack_vertex_accessor(int accessor, const std::string& context, const std::string& role,
+                                                  const AccessorRule& rule, size_t vertex_count, std::string* what);
     /// The primitive's indices (0, 1, ... without an index accessor), each below vertex_count.
     Expected<std::vector<uint32_t>> read_indices(const tinygltf::Primitive& prim, const std::string& context,
                                                  size_t vertex_count);

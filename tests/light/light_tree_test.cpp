@@ -295,7 +295,9 @@ TEST(LightSelection, ASetSharingAnotherSetsSceneLightsChoosesAsOneBuiltAlone) {
             const Vec2 u2 = rng.next_vec2();
             const std::optional<LightSample> a = shared.sample_incident(p, u, u2), b = alone.sample_incident(p, u, u2);
             ASSERT_EQ(a.has_value(), b.has_value());
-            if (a) EXPECT_EQ(a->pdf, b->pdf);
+            if (a) {
+                EXPECT_EQ(a->pdf, b->pdf);
+            }
         }
         for (uint32_t l = 0; l < alone.size(); ++l) EXPECT_EQ(shared.selection_probability(l), alone.selection_probability(l));
         // Photons leave both alike (the flux weights are this set's own, by its choice).

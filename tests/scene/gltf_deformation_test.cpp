@@ -145,6 +145,10 @@ TEST(GltfDeformation, MorphTargetsAreBlendedByTheNodesOrTheMeshsWeights) {
     EXPECT_TRUE(scene.warnings.empty()) << all_warnings(scene);
 }
 
+// skin.gltf's strip as its skin places it (below).
+const Vec3 kSkinnedStrip[7] = {{10, 0, 0}, {10.5f, 0, 0}, {10, 1, 0}, {10.25f, 1.25f, 0},
+                               {9, 1, 0},  {9, 1.5f, 0},  {110, 3, 0}};
+
 TEST(GltfDeformation, SkinsPlaceVerticesByTheirJointsAndIgnoreTheNodesTransform) {
     // skin.gltf (generate.py): the strip's rows are bound to J0, to J0 and J1 half and half, and
     // to J1, which stands turned 90 degrees about z at (10, 1, 0); the skinned node's translation
@@ -152,12 +156,10 @@ TEST(GltfDeformation, SkinsPlaceVerticesByTheirJointsAndIgnoreTheNodesTransform)
     // places it (the root's 10 and the node's 100 in x).
     const Scene scene = load_ok("skin.gltf");
     ASSERT_EQ(scene.positions.size(), 7u);
-    const Vec3 expected[7] = {{10, 0, 0}, {10.5f, 0, 0}, {10, 1, 0},   {10.25f, 1.25f, 0},
-                              {9, 1, 0},  {9, 1.5f, 0},  {110, 3, 0}};
     const Vec3 diagonal = glm::normalize(Vec3(1, 1, 0));
     const Vec3 normals[7] = {{1, 0, 0}, {1, 0, 0}, diagonal, diagonal, {0, 1, 0}, {0, 1, 0}, {1, 0, 0}};
     for (int v = 0; v < 7; ++v) {
-        expect_near(scene.positions[v], expected[v], "vertex " + std::to_string(v));
+        expect_near(scene.positions[v], kSkinnedStrip[v], "vertex " + std::to_string(v));
         expect_near(scene.normals[v], normals[v], "normal " + std::to_string(v));
     }
     EXPECT_TRUE(scene.warnings.empty()) << all_warnings(scene);
@@ -169,11 +171,9 @@ TEST(GltfDeformation, SkinInfluencesMayComeInTwoSets) {
     // vertices moved 5 in z) and is named in a warning.
     const Scene scene = load_ok("skin_two_sets.gltf");
     ASSERT_EQ(scene.positions.size(), 14u);
-    const Vec3 expected[7] = {{10, 0, 0}, {10.5f, 0, 0}, {10, 1, 0},   {10.25f, 1.25f, 0},
-                              {9, 1, 0},  {9, 1.5f, 0},  {110, 3, 0}};
     const Vec3 bind[7] = {{10, 0, 0}, {10.5f, 0, 0}, {10, 1, 0}, {10.5f, 1, 0}, {10, 2, 0}, {10.5f, 2, 0}, {0, 3, 0}};
     for (int v = 0; v < 7; ++v) {
-        expect_near(scene.positions[v], expected[v], "skinned vertex " + std::to_string(v));
+        expect_near(scene.positions[v], kSkinnedStrip[v], "skinned vertex " + std::to_string(v));
         expect_near(scene.positions[7 + v], bind[v] + Vec3(0, 0, 5), "unskinned vertex " + std::to_string(v));
     }
     ASSERT_EQ(scene.warnings.size(), 1u) << all_warnings(scene);
