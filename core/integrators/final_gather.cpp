@@ -48,6 +48,10 @@ constexpr uint32_t kBentNormalPhotons = 32;
 constexpr int kGlossyRayShortRayBounces = 4;
 constexpr int kRecordShortRayBounces = 1;
 
+/// The cosine a gather ray's cell is taken to have at least, for its cone's spread: the cells
+/// next to the horizon are thin slivers, not the wide cones 1 / cos would make of them.
+constexpr float kMinGatherCosine = 0.1f;
+
 /// The nearest irradiance site on the side a hit is seen from (PhotonMap::nearest_irradiance).
 struct NearestSite {
     bool found = false;
@@ -114,12 +118,13 @@ Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si
 }  // namespace
 
 Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& counters, float* distance,
-                                         FirstHitEmission* emission) const {
-    return trace_gather_ray(ray, rng, counters, distance, emission, false, kGlossyRayShortRayBounces);
+                                         FirstHitEmission* emission, RayFootprint cone) const {
+    return trace_gather_ray(ray, rng, counters, distance, emission, false, kGlossyRayShortRayBounces, cone);
 }
 
 Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& counters, float* distance,
-                                      FirstHitEmission* emission, bool caustic_chains, int short_ray_bounces) const {
+                                      FirstHitEmission* emission, bool caustic_chains, int short_ray_bounces,
+                                      RayFootprint cone) const {
     const RenderScene& rs = *scene_;
     // Walk through ideal specular surfaces; `depth` counts them. At glossy surfaces the glossy
     // lobes are followed too, and rough glass (up to settings_.max_glossy_bounces): reading them
@@ -144,12 +149,16 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
             float pdf;
         };
         /// `first`: the gather ray itself (its hit's emission is reported to the caller).
-        Color along(const Ray& r, int depth, float* first_distance, bool first, int glossy_bounces = 0,
-                    const GlossyOrigin* from = nullptr) const {
+        /// `cone`: the ray's cone from r's origin on; its width at the hit picks the texture
+        /// level there, and the rays that go on from the hit widen it further (a glossy lobe
+        /// only widens it more: the cone is the narrowest it can be).
+        Color along(const Ray& r, RayFootprint cone, int depth, float* first_distance, bool first,
+                    int glossy_bounces = 0, const GlossyOrigin* from = nullptr) const {
             const std::optional<Hit> hit = trace_ray(rs, r, counters);
             if (first_distance) *first_distance = hit ? hit->t : std::numeric_limits<float>::infinity();
             std::optional<SurfaceInteraction> hit_point;
-            if (hit) hit_point = make_interaction(*rs.scene, *hit, r.direction);
+            if (hit) hit_point = make_interaction(*rs.scene, *hit, r.direction, cone.texture_at(hit->t), ConeKind::Wide);
+            const RayFootprint on = hit ? cone.from(hit->t) : cone;
             // The atmosphere on the way: what lies beyond is seen through it, and it adds all the
             // light it scatters towards the ray (the volume map, first events included).
             Color fog(1.0f), in_scattered(0.0f);
@@ -173,7 +182,7 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
                                                            g.settings_.k_volume, g.settings_.max_radius, 1, context);
                 }
             }
-            const Color beyond = from_surface(r, hit_point ? &*hit_point : nullptr, depth, first, glossy_bounces, from);
+            const Color beyond = from_surface(r, hit_point ? &*hit_point : nullptr, on, depth, first, glossy_bounces, from);
             if (first && emission) {
                 emission->radiance *= fog;  // the emitter is seen through the atmosphere too
                 emission->in_scattered = in_scattered;
@@ -181,7 +190,7 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
             return in_scattered + fog * beyond;
         }
         /// What the ray's hit sends back (null: it left the scene), before the atmosphere.
-        Color from_surface(const Ray& r, const SurfaceInteraction* hit_point, int depth, bool first,
+        Color from_surface(const Ray& r, const SurfaceInteraction* hit_point, RayFootprint cone, int depth, bool first,
                            int glossy_bounces, const GlossyOrigin* from) const {
             if (!hit_point) {
                 // After a glossy lobe, the whole sky and soft suns, weighted against the light
@@ -195,13 +204,13 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
             const SurfaceInteraction& si = *hit_point;
             const Vec3 wo = -r.direction;
             if (first && emission) {
-                emission->radiance = volume_transmittance(*rs.scene, si) * rs.lights->emitted_radiance(si, wo);
+                emission->radiance = volume_transmittance(*rs.scene, si) * emitted_radiance(si, wo);
                 emission->triangle = si.triangle;
                 emission->point = si.p;
             }
             Color radiance(0.0f);
             if (from) {
-                const Color emitted = rs.lights->emitted_radiance(si, wo);
+                const Color emitted = emitted_radiance(si, wo);
                 if (!is_black(emitted)) {
                     const float light_pdf =
                         from->pdf > 0.0f ? rs.lights->pdf_incident_triangle(si.triangle, from->point, si.p) : 0.0f;
@@ -226,44 +235,54 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
                 // The Lambertian lobe where the rough lobes are followed (none on pure glass).
                 const auto lambertian = [&] {
                     return max_component(bsdf.diffuse_reflectance()) > 0.0f
-                               ? photons_or_bounce(si, bsdf, wo, depth, kLambertianLobe)
+                               ? photons_or_bounce(si, bsdf, wo, cone, depth, kLambertianLobe)
                                : Color(0.0f);
                 };
                 if ((bsdf.lobes() & kGlossy) && (follows || (caustic_chain && takes_short_ray_bounce(si, wo, &site)))) {
-                    radiance += glossy_lobes(si, bsdf, wo, depth, glossy_bounces, caustic_chain,
+                    radiance += glossy_lobes(si, bsdf, wo, cone, depth, glossy_bounces, caustic_chain,
                                              follows_glass ? kGlossy | kRoughLobes : kGlossy);
-                    radiance += follows_glass ? lambertian() : photons_or_bounce(si, bsdf, wo, depth, kNonDeltaLobes & ~kGlossy);
+                    radiance += follows_glass ? lambertian() : photons_or_bounce(si, bsdf, wo, cone, depth, kNonDeltaLobes & ~kGlossy);
                 } else if ((bsdf.lobes() & kGlossy) && caustic_chain) {
                     // The chain's last glossy lobe: the photons that came to it through a diffuse
                     // surface (those straight from the lights or through caustic bounces would
                     // continue the caustic chain).
-                    radiance += photons_or_bounce(si, bsdf, wo, depth, kNonDeltaLobes & ~kGlossy);
+                    radiance += photons_or_bounce(si, bsdf, wo, cone, depth, kNonDeltaLobes & ~kGlossy);
                     radiance += radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_, g.site_reach_, rng, kGlossy,
                                                       photon_flags::kDirect | photon_flags::kCaustic);
                 } else if (follows_glass) {
-                    radiance += glossy_lobes(si, bsdf, wo, depth, glossy_bounces, false, kRoughLobes);
+                    radiance += glossy_lobes(si, bsdf, wo, cone, depth, glossy_bounces, false, kRoughLobes);
                     radiance += lambertian();
                 } else {
-                    radiance += photons_or_bounce(si, bsdf, wo, depth, kNonDeltaLobes);
+                    radiance += photons_or_bounce(si, bsdf, wo, cone, depth, kNonDeltaLobes);
                 }
             }
             if (bsdf.has_delta() && depth < g.settings_.max_specular_depth) {
                 // One lobe per gather ray is enough: the gather averages many rays.
                 const GlossyOrigin after_delta{si.p, 0.0f};
                 radiance += follow_delta_lobes(bsdf, wo, false, rng, [&](const BsdfSample& s) {
-                    return along(spawn_ray(rs, si, s.wi), depth + 1, nullptr, false, glossy_bounces,
+                    return along(spawn_ray(rs, si, s.wi), cone, depth + 1, nullptr, false, glossy_bounces,
                                  from ? &after_delta : nullptr);
                 });
             }
             return volume_transmittance(*rs.scene, si) * radiance;
         }
+        /// What the hit emits towards wo, its emissive texture read at the finest level, as
+        /// light sampling reads it (the rays' emission is weighted against light samples), not
+        /// over the cone: an emissive atlas's coarse levels blend its glowing islands with the
+        /// dark around them (LightsPunctualLamp's shade read 4 % dark).
+        Color emitted_radiance(const SurfaceInteraction& si, const Vec3& wo) const {
+            if (!(si.tex.footprint > 0.0f) && !(si.tex.footprint1 > 0.0f)) return rs.lights->emitted_radiance(si, wo);
+            SurfaceInteraction sharp = si;
+            sharp.tex.footprint = sharp.tex.footprint1 = 0.0f;
+            return rs.lights->emitted_radiance(sharp, wo);
+        }
         /// What `lobes` reflect at a non-delta hit of the light arriving from elsewhere: the
         /// photons' estimate, or one bounce traced where the ray that came is short.
-        Color photons_or_bounce(const SurfaceInteraction& si, const Bsdf& bsdf, const Vec3& wo, int depth,
-                                LobeMask lobes) const {
+        Color photons_or_bounce(const SurfaceInteraction& si, const Bsdf& bsdf, const Vec3& wo, RayFootprint cone,
+                                int depth, LobeMask lobes) const {
             if (!(bsdf.lobes() & lobes)) return Color(0.0f);
             NearestSite site;
-            if (takes_short_ray_bounce(si, wo, &site)) return short_ray_bounce(si, bsdf, wo, depth, lobes);
+            if (takes_short_ray_bounce(si, wo, &site)) return short_ray_bounce(si, bsdf, wo, cone, depth, lobes);
             return radiance_from_photons(*g.maps_, si, bsdf, wo, g.settings_, g.site_reach_, rng, lobes, 0,
                                          site.found ? &site : nullptr);
         }
@@ -297,8 +316,8 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
         /// holds that light) and none straight ahead (the light sample, unweighted, does);
         /// without one it is weighted against the light sample by the power heuristic, as
         /// glossy lobes are.
-        Color short_ray_bounce(const SurfaceInteraction& si, const Bsdf& bsdf, const Vec3& wo, int depth,
-                               LobeMask lobes) const {
+        Color short_ray_bounce(const SurfaceInteraction& si, const Bsdf& bsdf, const Vec3& wo, RayFootprint cone,
+                               int depth, LobeMask lobes) const {
             SampleContext context{rng, counters};
             const bool caustics = g.maps_->caustic != nullptr;
             Color radiance(0.0f);
@@ -316,7 +335,7 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
             if (s && s->pdf > 0.0f && !is_black(s->weight)) {
                 const GlossyOrigin origin{si.p, s->pdf};
                 const Walker on{g, rs, rng, counters, nullptr, caustics, short_ray_budget};
-                radiance += s->weight * on.along(spawn_ray(rs, si, s->wi), depth, nullptr, false, 0,
+                radiance += s->weight * on.along(spawn_ray(rs, si, s->wi), cone, depth, nullptr, false, 0,
                                                  caustics ? nullptr : &origin);
             }
             // Last, so that what the hit sends otherwise is known: the caustic map's estimate
@@ -346,8 +365,8 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
         /// The glossy lobes' reflection at a gather hit (or `lobes`', rough glass's), as a path
         /// tracer takes it: a light sample and a lobe sample, weighted by the power heuristic. In
         /// a caustic chain, the lobe sample alone, and the chain goes on.
-        Color glossy_lobes(const SurfaceInteraction& si, const Bsdf& bsdf, const Vec3& wo, int depth,
-                           int glossy_bounces, bool caustic_chain,
+        Color glossy_lobes(const SurfaceInteraction& si, const Bsdf& bsdf, const Vec3& wo, RayFootprint cone,
+                           int depth, int glossy_bounces, bool caustic_chain,
                            LobeMask lobes = mask_of(LobeKind::Glossy)) const {
             SampleContext context{rng, counters};
             Color radiance(0.0f);
@@ -357,7 +376,7 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
             const std::optional<BsdfSample> s = bsdf.sample(wo, u_lobe, u, TransportMode::Radiance, lobes);
             if (s && s->pdf > 0.0f && !is_black(s->weight)) {
                 const GlossyOrigin origin{si.p, s->pdf};
-                radiance += s->weight * along(spawn_ray(rs, si, s->wi), depth, nullptr, false, glossy_bounces + 1,
+                radiance += s->weight * along(spawn_ray(rs, si, s->wi), cone, depth, nullptr, false, glossy_bounces + 1,
                                               caustic_chain ? nullptr : &origin);
             }
             return radiance;
@@ -365,7 +384,7 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
     };
     if (emission) *emission = FirstHitEmission{};
     int short_ray_budget = short_ray_bounces;
-    return Walker{*this, rs, rng, counters, emission, caustic_chains, short_ray_budget}.along(ray, 0, distance, true);
+    return Walker{*this, rs, rng, counters, emission, caustic_chains, short_ray_budget}.along(ray, cone, 0, distance, true);
 }
 
 GatherResult FinalGatherer::gather(const Vec3& p, const Vec3& n, const Vec3& geometric_normal, Rng& rng,
@@ -392,8 +411,13 @@ GatherResult FinalGatherer::gather(const Vec3& p, const Vec3& n, const Vec3& geo
             // Directions under the geometric surface (tilted shading normals) see nothing.
             if (glm::dot(direction, geometric_normal) <= 0.0f) continue;
             float d = 0.0f;
+            // The ray stands for its cell, of projected solid angle pi / cells (solid angle
+            // pi / (cells cos theta)): its cone's spread, which filters the textures it meets.
+            const float cell_solid_angle = kPi / (static_cast<float>(m * cells_n) * std::max(cos_theta, kMinGatherCosine));
+            const RayFootprint cone{0.0f, std::sqrt(cell_solid_angle), 1.0f};
             const Color L = trace_gather_ray(Ray{rs.tracer->offset_origin(p, geometric_normal, direction), direction},
-                                             rng, counters, &d, nullptr, maps_->caustic != nullptr, kRecordShortRayBounces);
+                                             rng, counters, &d, nullptr, maps_->caustic != nullptr, kRecordShortRayBounces,
+                                             cone);
             radiance[cell(j, k)] = L;
             distance[cell(j, k)] = d;
             sum += DVec3(L);

@@ -110,8 +110,10 @@ public:
     /// glossy lobes met on the way count all the light they reflect, emitters included, so the
     /// point reads the caustic map's glossy photons by its Lambertian lobe only
     /// (photon_flags::kGlossyCaustic).
+    /// `cone`: the ray's cone (its width at the ray's origin and its spread), which picks the
+    /// texture level at the surfaces it meets (RayFootprint; zero: the finest level).
     Color gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& counters, float* distance,
-                              FirstHitEmission* emission = nullptr) const;
+                              FirstHitEmission* emission = nullptr, RayFootprint cone = {}) const;
 
     const GatherSettings& settings() const { return settings_; }
     const RenderScene& scene() const { return *scene_; }
@@ -120,9 +122,10 @@ private:
     /// gather_ray_radiance; `caustic_chains`: the light that reaches the ray's origin from an
     /// emitter through specular and glossy bounces alone is the caustic map's (a gather for
     /// irradiance at a diffuse point, when there is a caustic map). `short_ray_bounces`: the
-    /// bounces the short-ray rule may trace for this ray.
+    /// bounces the short-ray rule may trace for this ray. `cone`: as gather_ray_radiance's.
     Color trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& counters, float* distance,
-                           FirstHitEmission* emission, bool caustic_chains, int short_ray_bounces) const;
+                           FirstHitEmission* emission, bool caustic_chains, int short_ray_bounces,
+                           RayFootprint cone) const;
 
     std::shared_ptr<const RenderScene> scene_;
     std::shared_ptr<const PhotonMaps> maps_;

@@ -119,10 +119,23 @@ struct RayFootprint {
     float at(float distance) const { return width + distance * spread; }
     /// The footprint a texture lookup filters over there.
     float texture_at(float distance) const { return texture_scale * at(distance); }
+    /// The same cone from the point `distance` along the ray on (a ray continued there).
+    RayFootprint from(float distance) const { return {at(distance), spread, texture_scale}; }
 };
 
 inline RayFootprint camera_footprint(const CameraRay& ray) {
     return {ray.pixel_width, pixel_spread(ray), ray.texture_footprint_scale};
+}
+
+/// The cone of a ray sampled from a lobe at a point `distance` along a camera path of cone
+/// `footprint`, one of `rays` such rays there: it goes on from the path's width at the point,
+/// spread over the solid angle the sample stands for, 1 / (rays pdf) (a sharp lobe's rays stay
+/// narrow). The path's texture scale carries over: the pixel's samples average what their rays
+/// meet, as they do at the visible point.
+inline RayFootprint glossy_ray_cone(const RayFootprint& footprint, float distance, const BsdfSample& sample,
+                                    float rays) {
+    const float spread = sample.kind != LobeKind::Delta && sample.pdf > 0.0f ? std::sqrt(1.0f / (rays * sample.pdf)) : 0.0f;
+    return {footprint.at(distance), spread, footprint.texture_scale};
 }
 
 /// The ray of a camera sample: from the camera itself, which RayTracer::intersect puts on the front

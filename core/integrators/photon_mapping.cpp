@@ -373,7 +373,8 @@ RadianceParts PhotonMapIntegrator::surface_radiance(const Ray& ray, const Surfac
                     float distance = 0.0f;
                     FinalGatherer::FirstHitEmission emitted;
                     Color gathered = gatherer_->gather_ray_radiance(spawn_ray(rs, si, s->wi), context.rng,
-                                                                    context.counters, &distance, &emitted);
+                                                                    context.counters, &distance, &emitted,
+                                                                    glossy_ray_cone(footprint, length, *s, rays));
                     // A ray that left the scene at once saw the diffuse sky (weighted against the
                     // sky's light sample above) and the fog's light on the way (not weighted: the
                     // light sample finds none of it).

@@ -66,6 +66,9 @@ RadianceGather gather_radiance_record(const FinalGatherer& gatherer, const Diffu
     const RenderScene& rs = gatherer.scene();
     const GatherGrid grid = GatherGrid::for_rays(rays);
     const int m = grid.m, cells_n = grid.n;
+    // Each ray stands for its cell of the uniformly sampled hemisphere: its cone spreads over
+    // the cell's solid angle, 2 pi / cells, and filters the textures it meets.
+    const RayFootprint cone{0.0f, std::sqrt(2.0f * kPi / static_cast<float>(m * cells_n)), 1.0f};
     const int count = harmonics_count(order);
     RadianceGather result;
     RadianceRecord& record = result.record;
@@ -94,7 +97,7 @@ RadianceGather gather_radiance_record(const FinalGatherer& gatherer, const Diffu
             float d = 0.0f;
             const Color L = gatherer.gather_ray_radiance(
                 Ray{rs.tracer->offset_origin(point.position, point.geometric_normal, direction), direction}, rng,
-                counters, &d);
+                counters, &d, nullptr, cone);
             radiance[cell(j, k)] = L;
             distance[cell(j, k)] = d;
             ++result.rays;

@@ -220,7 +220,9 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
             if (is_black(flux)) return;
         }
         const Bsdf bsdf = make_bsdf(rs, si, wo);
-        if (bsdf.has_non_delta()) {
+        // Stored where the material reflects diffusely anywhere, not only where this texel does:
+        // an estimate elsewhere on the surface counts the photons of the texels around it.
+        if (rs.photon_storing_materials[si.material]) {
             const bool caustic_path = specular_bounces > 0 && !diffuse_seen;
             const uint8_t flags = static_cast<uint8_t>(
                 (bounce == 0 ? photon_flags::kDirect : 0) | (caustic_path ? photon_flags::kCaustic : 0) |

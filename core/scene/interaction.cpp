@@ -27,7 +27,8 @@ Vec3 apply_normal_texture(const Scene& scene, const Material& material, const gl
 }
 
 void set_texture_footprint(const Scene& scene, const glm::uvec3& tri, const Vec3& ray_direction,
-                           const Vec3& geometric_normal, float footprint_width, TexturePoint& tp) {
+                           const Vec3& geometric_normal, float footprint_width, TexturePoint& tp,
+                           bool within_triangle) {
     const Vec3 e1 = scene.positions[tri.y] - scene.positions[tri.x];
     const Vec3 e2 = scene.positions[tri.z] - scene.positions[tri.x];
     const float world_area = glm::length(glm::cross(e1, e2));
@@ -42,8 +43,13 @@ void set_texture_footprint(const Scene& scene, const glm::uvec3& tri, const Vec3
         const Vec2 a = uvs[tri.y] - uvs[tri.x], b = uvs[tri.z] - uvs[tri.x];
         return std::abs(a.x * b.y - a.y * b.x);
     };
-    tp.footprint = width * std::sqrt(uv_area(scene.uvs) / world_area);
-    if (!scene.uvs1.empty()) tp.footprint1 = width * std::sqrt(uv_area(scene.uvs1) / world_area);
+    const auto footprint = [&](const std::vector<Vec2>& uvs) {
+        const float area = uv_area(uvs);
+        const float f = width * std::sqrt(area / world_area);
+        return within_triangle ? std::min(f, std::sqrt(area)) : f;
+    };
+    tp.footprint = footprint(scene.uvs);
+    if (!scene.uvs1.empty()) tp.footprint1 = footprint(scene.uvs1);
     if (!std::isfinite(tp.footprint)) tp.footprint = 0.0f;
     if (!std::isfinite(tp.footprint1)) tp.footprint1 = 0.0f;
 }

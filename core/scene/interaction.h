@@ -60,18 +60,35 @@ inline Color volume_transmittance(const Scene& scene, const SurfaceInteraction& 
 Vec3 apply_normal_texture(const Scene& scene, const Material& material, const glm::uvec3& tri,
                           float u, float v, const TexturePoint& tp, const Vec3& normal);
 
+/// What a ray cone stands for, which decides how the textures at its hits are filtered.
+enum class ConeKind : uint8_t {
+    /// A camera path's: a pixel's footprint (or a share of it). Every texture, the normal map
+    /// included, is filtered over it.
+    Pixel,
+    /// A gather or glossy ray's: the solid angle of one of a few hundred rays, far wider than a
+    /// pixel. Filtered over at most the triangle's own extent in texture space, as the coarse mip
+    /// levels of a texture atlas blend its islands beyond it (LightsPunctualLamp's shade read
+    /// 7 % dark), and the normal map at its finest level, as an averaged normal map is a flatter
+    /// surface, not the mean of the bumps' shading (a bumpy floor lit through a lattice read
+    /// 3.6 % bright).
+    Wide,
+};
+
 /// The ray cone's footprint (width `footprint_width` in world units at the hit) in texture
 /// coordinates of both slots: width / |cos| scaled by sqrt(uv area / world area) of the triangle
 /// (Akenine-Moeller et al. 2019, "Texture Level of Detail Strategies for Real-Time Ray Tracing",
-/// Ray Tracing Gems ch. 20, eq. 34 and 36).
+/// Ray Tracing Gems ch. 20, eq. 34 and 36). `within_triangle`: at most sqrt(uv area), the
+/// triangle's own extent (ConeKind::Wide).
 void set_texture_footprint(const Scene& scene, const glm::uvec3& tri, const Vec3& ray_direction,
-                           const Vec3& geometric_normal, float footprint_width, TexturePoint& tp);
+                           const Vec3& geometric_normal, float footprint_width, TexturePoint& tp,
+                           bool within_triangle = false);
 
 /// Computes the interaction at `hit` of a ray with direction `ray_direction`. Inline: it runs at
 /// every hit of every integrator and photon, whose callers use only some of its fields.
-/// `footprint_width` is the ray cone's width at the hit (0: textures at their finest level).
+/// `footprint_width` is the ray cone's width at the hit (0: textures at their finest level), of
+/// the kind `cone` says.
 inline SurfaceInteraction make_interaction(const Scene& scene, const Hit& hit, const Vec3& ray_direction,
-                                           float footprint_width = 0.0f) {
+                                           float footprint_width = 0.0f, ConeKind cone = ConeKind::Pixel) {
     const glm::uvec3& tri = scene.triangles[hit.triangle];
     const float w = 1.0f - hit.u - hit.v;
     SurfaceInteraction si;
@@ -96,10 +113,14 @@ inline SurfaceInteraction make_interaction(const Scene& scene, const Hit& hit, c
     if (material.textured() || !scene.colors.empty()) {
         si.tex = scene.texture_point(hit.triangle, hit.u, hit.v);
         if (footprint_width > 0.0f && material.textured())
-            set_texture_footprint(scene, tri, ray_direction, si.geometric_normal, footprint_width, si.tex);
+            set_texture_footprint(scene, tri, ray_direction, si.geometric_normal, footprint_width, si.tex,
+                                  cone == ConeKind::Wide);
+        si.tex.one_level = cone == ConeKind::Wide;
         if (material.normal_texture.present() && !scene.tangents.empty()) {
             si.surface_normal = oriented_shading_normal(shading, si.geometric_normal);
-            shading = apply_normal_texture(scene, material, tri, hit.u, hit.v, si.tex, shading);
+            TexturePoint normal_point = si.tex;
+            if (cone == ConeKind::Wide) normal_point.footprint = normal_point.footprint1 = 0.0f;
+            shading = apply_normal_texture(scene, material, tri, hit.u, hit.v, normal_point, shading);
             si.shading_normal = oriented_shading_normal(shading, si.geometric_normal);
             si.front_face = glm::dot(ray_direction, si.geometric_normal) < 0.0f;
             si.distance = hit.t;

@@ -181,6 +181,7 @@ Vec4 Scene::sample(const TextureRef& ref, const TexturePoint& tp) const {
         // The footprint's width in level-0 texels (isotropic: the geometric mean of the sides).
         const float texels = footprint * ref.scale() * std::sqrt(static_cast<float>(t.width) * t.height);
         lod = texels > 1.0f ? std::log2(texels) : 0.0f;
+        if (tp.one_level) lod = std::round(lod);
     }
     return t.sample_rgba(ref.apply(ref.slot == 0 ? tp.uv : tp.uv1), lod);
 }

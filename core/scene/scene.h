@@ -190,6 +190,9 @@ struct TexturePoint {
     Vec4 color{1.0f};  // COLOR_0
     float footprint = 0.0f;
     float footprint1 = 0.0f;
+    /// Read the footprint's nearest mip level alone, not a blend of the two around it: for the
+    /// wide cones of gather rays (ConeKind::Wide), whose level need not be exact.
+    bool one_level = false;
 };
 
 enum class PunctualLightType : uint8_t { Point, Spot, Directional };

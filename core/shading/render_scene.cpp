@@ -31,6 +31,7 @@ Expected<std::shared_ptr<const RenderScene>> RenderScene::create(std::shared_ptr
     // The caustic casters: surfaces with an ideal specular lobe, or sharp glossy ones only.
     std::vector<bool> casts(scene->materials.size());
     render_scene->sharp_glossy_materials.resize(scene->materials.size());
+    render_scene->photon_storing_materials.resize(scene->materials.size());
     for (size_t i = 0; i < casts.size(); ++i) {
         const Material& m = scene->materials[i];
         bool sharp_glossy = render_scene->bsdf_materials[i].sharp_glossy;
@@ -38,6 +39,11 @@ Expected<std::shared_ptr<const RenderScene>> RenderScene::create(std::shared_ptr
                                                 : render_scene->bsdf_materials[i].other_lobes;
         render_scene->sharp_glossy_materials[i] = sharp_glossy;
         casts[i] = (lobes & mask_of(LobeKind::Delta)) || sharp_glossy;
+        // The Lambertian lobe is there wherever the base colour is not black: by its factor, as
+        // its texture and vertex colours only darken it.
+        const LobeMask with_lambert =
+            lobes | Bsdf(render_scene->bsdf_materials[i], m.base_color, Frame(Vec3(0, 0, 1)), Vec3(0, 0, 1)).lobes();
+        render_scene->photon_storing_materials[i] = (with_lambert & kNonDeltaLobes) != 0;
     }
     for (uint32_t t = 0; t < scene->triangles.size(); ++t) {
         if (casts[scene->triangle_materials[t]]) specular.push_back(t);

@@ -1,9 +1,15 @@
-// Final gathering: irradiance against a brute-force hemisphere estimate, and the rotation and
-// translation gradients against finite differences of brute-force gathers.
+// Final gathering: irradiance against a brute-force hemisphere estimate, the rotation and
+// translation gradients against finite differences of brute-force gathers, and gather rays'
+// cones filtering the textures they meet.
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
 
 #include "core/integrators/final_gather.h"
 #include "core/scene/builtin_scenes.h"
+#include "core/scene/shapes.h"
+#include "tests/support/render_fixtures.h"
 
 namespace photond {
 namespace {
@@ -128,6 +134,133 @@ TEST(FinalGather, RotationGradientMatchesFiniteDifferences) {
                     predicted, fd.x);
         EXPECT_NEAR(predicted, fd.x, 0.25f * std::abs(fd.x) + 0.02f);
     }
+}
+
+/// A 4 x 4 floor at z = 0 of a checkerboard albedo (0 and 1) in checks of 1/32, under a sun
+/// straight down of irradiance pi (radiance = albedo), with its photon maps.
+const Fixture& checkered_floor() {
+    static Fixture f = [] {
+        SceneBuilder builder("checkered floor");
+        // Checks of 4 x 4 texels: bilinear lookups blend neighbouring checks only near their edges.
+        Texture t;
+        t.width = t.height = 32;
+        for (int y = 0; y < 32; ++y)
+            for (int x = 0; x < 32; ++x) t.texels.push_back(Color(float((x / 4 + y / 4) % 2)));
+        Material m = test_support::lambertian(Color(1.0f));
+        m.base_color_texture.texture = static_cast<int>(builder.add_texture(std::move(t)));
+        m.base_color_texture.transformed = true;  // uv * 16: 128 checks across
+        m.base_color_texture.m0 = Vec2(16.0f, 0.0f);
+        m.base_color_texture.m1 = Vec2(0.0f, 16.0f);
+        const uint32_t material = builder.add_material(m);
+        const MeshData q = make_quad(Vec3(-2, -2, 0), Vec3(4, 0, 0), Vec3(0, 4, 0));
+        EXPECT_TRUE(builder.add_mesh(q.positions, q.normals, q.uvs, q.triangles, material).is_ok());
+        PunctualLight sun;
+        sun.type = PunctualLightType::Directional;
+        sun.direction = Vec3(0, 0, -1);
+        sun.intensity = Color(kPi);
+        builder.add_light(sun);
+        Fixture f;
+        f.scene = test_support::make_render_scene(builder.build().value());
+        PhotonTracingSettings settings;
+        settings.global_photons = 200000;
+        settings.caustic_photons = 0;
+        f.maps = std::make_shared<const PhotonMaps>(trace_photons(*f.scene, settings).value());
+        return f;
+    }();
+    return f;
+}
+
+/// Mean and relative standard deviation of the first channel.
+struct Spread {
+    double mean = 0.0;
+    double relative_deviation = 0.0;
+};
+Spread spread_of(const std::vector<double>& values) {
+    double sum = 0.0, sum2 = 0.0;
+    for (double v : values) {
+        sum += v;
+        sum2 += v * v;
+    }
+    const double n = static_cast<double>(values.size());
+    const double mean = sum / n;
+    return {mean, std::sqrt(std::max(sum2 / n - mean * mean, 0.0)) / mean};
+}
+
+TEST(FinalGather, PhotonsAreStoredOnTheBlackChecksToo) {
+    // A photon that lands on a black check is absorbed, but stored first: the estimates at the
+    // white checks beside it, whose discs span several checks, count the photons of all of them
+    // against the disc's area. Stored on the white checks alone, the floor read 0.69 of its
+    // irradiance.
+    const Fixture& f = checkered_floor();
+    size_t parity[2] = {0, 0};
+    for (const Photon& photon : f.maps->global->tree().photons()) {
+        const int i = static_cast<int>(std::floor((photon.position.x + 2.0f) * 32.0f));
+        const int j = static_cast<int>(std::floor((photon.position.y + 2.0f) * 32.0f));
+        ++parity[(i + j) & 1];
+    }
+    const double share = static_cast<double>(parity[0]) / static_cast<double>(parity[0] + parity[1]);
+    std::printf("photons on the checks of either colour: %zu and %zu\n", parity[0], parity[1]);
+    EXPECT_NEAR(share, 0.5, 0.02);
+}
+
+TEST(FinalGather, GatherRayConesFilterTheTexturesTheyMeet) {
+    const Fixture& f = checkered_floor();
+    const FinalGatherer gatherer(f.scene, f.maps, GatherSettings{});
+    // Rays from 1 above the floor to points of its middle: at level 0 each sees a check's albedo,
+    // 0 or 1 (bilinear between them at their edges); a cone of spread 0.1 is some three checks
+    // wide there and reads their mean, 1/2, whatever check it lands in. The photons' estimates
+    // vary from point to point as well (about 1/sqrt(k)), alike for both.
+    const Vec3 p(0.0f, 0.0f, 1.0f);
+    std::vector<double> sharp, filtered;
+    Rng points(5, 6);
+    for (int i = 0; i < 2000; ++i) {
+        const Vec2 u = points.next_vec2();
+        const Vec3 target(2.0f * u.x - 1.0f, 2.0f * u.y - 1.0f, 0.0f);
+        const Ray ray{p, glm::normalize(target - p)};
+        float distance = 0.0f;
+        Rng rng(7, static_cast<uint64_t>(i));
+        RayCounters counters;
+        sharp.push_back(gatherer.gather_ray_radiance(ray, rng, counters, &distance).x);
+        filtered.push_back(gatherer.gather_ray_radiance(ray, rng, counters, &distance, nullptr, RayFootprint{0.0f, 0.1f, 1.0f}).x);
+    }
+    const Spread at_level_zero = spread_of(sharp), over_cones = spread_of(filtered);
+    std::printf("gather rays onto the checks: mean %.4f, relative deviation %.3f at level 0; mean %.4f, %.3f over cones\n",
+                at_level_zero.mean, at_level_zero.relative_deviation, over_cones.mean, over_cones.relative_deviation);
+    EXPECT_GT(at_level_zero.relative_deviation, 0.6);
+    EXPECT_LT(over_cones.relative_deviation, 0.3);
+    // Filtering moves no light: the checks' mean either way, and their mean albedo times E / pi
+    // = 1/2 (PhotonsAreStoredOnTheBlackChecksToo: else 0.35).
+    EXPECT_NEAR(over_cones.mean, at_level_zero.mean, 0.08 * at_level_zero.mean);
+    EXPECT_NEAR(at_level_zero.mean, 0.5, 0.04);
+
+    // A gather's rays each stand for their cell: the irradiance the floor sends up to a point
+    // above it varies from gather to gather by the photons' noise alone, not by which checks its
+    // 256 rays happened to land on (3.7 % at level 0).
+    std::vector<double> gathers;
+    for (uint64_t seed = 0; seed < 12; ++seed)
+        gathers.push_back(gather_at(gatherer, p, Vec3(0.0f, 0.0f, -1.0f), 200 + seed, false).irradiance.x);
+    const Spread of_gathers = spread_of(gathers);
+    std::printf("gathers: mean irradiance %.4f, relative deviation %.4f\n", of_gathers.mean, of_gathers.relative_deviation);
+    EXPECT_LT(of_gathers.relative_deviation, 0.02);
+    EXPECT_NEAR(of_gathers.mean, over_cones.mean * kPi * 0.8, 0.15 * over_cones.mean * kPi);
+}
+
+TEST(FinalGather, AGlossyRaysConeGoesOnFromThePathsWidthOverItsSamplesSolidAngle) {
+    // A camera path's cone 0.01 wide at its origin, spreading 0.002 a unit, at distance 5 (width
+    // 0.02), with textures filtered over a quarter of it (16 samples a pixel): a lobe sample of
+    // pdf 4 among 2 rays stands for a solid angle of 1/8.
+    const RayFootprint path{0.01f, 0.002f, 0.25f};
+    BsdfSample sample;
+    sample.kind = LobeKind::Glossy;
+    sample.pdf = 4.0f;
+    const RayFootprint cone = glossy_ray_cone(path, 5.0f, sample, 2.0f);
+    EXPECT_FLOAT_EQ(cone.width, 0.02f);
+    EXPECT_FLOAT_EQ(cone.spread, std::sqrt(0.125f));
+    EXPECT_FLOAT_EQ(cone.texture_scale, 0.25f);
+    EXPECT_FLOAT_EQ(cone.texture_at(2.0f), 0.25f * (0.02f + 2.0f * std::sqrt(0.125f)));
+    // An ideal specular sample's pdf is its lobe's choice: its cone goes on unspread.
+    sample.kind = LobeKind::Delta;
+    EXPECT_FLOAT_EQ(glossy_ray_cone(path, 5.0f, sample, 2.0f).spread, 0.0f);
 }
 
 }  // namespace
