@@ -204,13 +204,13 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
             const SurfaceInteraction& si = *hit_point;
             const Vec3 wo = -r.direction;
             if (first && emission) {
-                emission->radiance = volume_transmittance(*rs.scene, si) * emitted_radiance(si, wo);
+                emission->radiance = volume_transmittance(*rs.scene, si) * rs.lights->emitted_radiance(si, wo);
                 emission->triangle = si.triangle;
                 emission->point = si.p;
             }
             Color radiance(0.0f);
             if (from) {
-                const Color emitted = emitted_radiance(si, wo);
+                const Color emitted = rs.lights->emitted_radiance(si, wo);
                 if (!is_black(emitted)) {
                     const float light_pdf =
                         from->pdf > 0.0f ? rs.lights->pdf_incident_triangle(si.triangle, from->point, si.p) : 0.0f;
@@ -265,16 +265,6 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
                 });
             }
             return volume_transmittance(*rs.scene, si) * radiance;
-        }
-        /// What the hit emits towards wo, its emissive texture read at the finest level, as
-        /// light sampling reads it (the rays' emission is weighted against light samples), not
-        /// over the cone: an emissive atlas's coarse levels blend its glowing islands with the
-        /// dark around them (LightsPunctualLamp's shade read 4 % dark).
-        Color emitted_radiance(const SurfaceInteraction& si, const Vec3& wo) const {
-            if (!(si.tex.footprint > 0.0f) && !(si.tex.footprint1 > 0.0f)) return rs.lights->emitted_radiance(si, wo);
-            SurfaceInteraction sharp = si;
-            sharp.tex.footprint = sharp.tex.footprint1 = 0.0f;
-            return rs.lights->emitted_radiance(sharp, wo);
         }
         /// What `lobes` reflect at a non-delta hit of the light arriving from elsewhere: the
         /// photons' estimate, or one bounce traced where the ray that came is short.

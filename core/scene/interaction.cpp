@@ -46,6 +46,7 @@ void set_texture_footprint(const Scene& scene, const glm::uvec3& tri, const Vec3
     const auto footprint = [&](const std::vector<Vec2>& uvs) {
         const float area = uv_area(uvs);
         const float f = width * std::sqrt(area / world_area);
+        // sqrt of the uv parallelogram's area: about the triangle's edge length in texture space.
         return within_triangle ? std::min(f, std::sqrt(area)) : f;
     };
     tp.footprint = footprint(scene.uvs);

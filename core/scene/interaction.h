@@ -66,19 +66,20 @@ enum class ConeKind : uint8_t {
     /// included, is filtered over it.
     Pixel,
     /// A gather or glossy ray's: the solid angle of one of a few hundred rays, far wider than a
-    /// pixel. Filtered over at most the triangle's own extent in texture space, as the coarse mip
-    /// levels of a texture atlas blend its islands beyond it (LightsPunctualLamp's shade read
-    /// 7 % dark), and the normal map at its finest level, as an averaged normal map is a flatter
-    /// surface, not the mean of the bumps' shading (a bumpy floor lit through a lattice read
-    /// 3.6 % bright).
+    /// pixel. Filtered at one mip level over at most about the triangle's edge length in texture
+    /// space (so on a finely tessellated mesh hardly at all), as the coarse levels of a texture
+    /// atlas blend its islands beyond it; the normal map at its finest level, as an averaged
+    /// normal map is a flatter surface, not the mean of the bumps' shading (a bumpy floor lit
+    /// through a lattice read 3.6 % bright: EnvironmentInterior's lattice test); the emission
+    /// at its finest level too (TexturePoint::wide_cone).
     Wide,
 };
 
 /// The ray cone's footprint (width `footprint_width` in world units at the hit) in texture
 /// coordinates of both slots: width / |cos| scaled by sqrt(uv area / world area) of the triangle
 /// (Akenine-Moeller et al. 2019, "Texture Level of Detail Strategies for Real-Time Ray Tracing",
-/// Ray Tracing Gems ch. 20, eq. 34 and 36). `within_triangle`: at most sqrt(uv area), the
-/// triangle's own extent (ConeKind::Wide).
+/// Ray Tracing Gems ch. 20, eq. 34 and 36). `within_triangle`: at most the square root of
+/// the uv parallelogram's area, about the triangle's edge length in texture space (ConeKind::Wide).
 void set_texture_footprint(const Scene& scene, const glm::uvec3& tri, const Vec3& ray_direction,
                            const Vec3& geometric_normal, float footprint_width, TexturePoint& tp,
                            bool within_triangle = false);
@@ -115,7 +116,7 @@ inline SurfaceInteraction make_interaction(const Scene& scene, const Hit& hit, c
         if (footprint_width > 0.0f && material.textured())
             set_texture_footprint(scene, tri, ray_direction, si.geometric_normal, footprint_width, si.tex,
                                   cone == ConeKind::Wide);
-        si.tex.one_level = cone == ConeKind::Wide;
+        si.tex.wide_cone = cone == ConeKind::Wide;
         if (material.normal_texture.present() && !scene.tangents.empty()) {
             si.surface_normal = oriented_shading_normal(shading, si.geometric_normal);
             TexturePoint normal_point = si.tex;

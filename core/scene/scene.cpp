@@ -181,7 +181,7 @@ Vec4 Scene::sample(const TextureRef& ref, const TexturePoint& tp) const {
         // The footprint's width in level-0 texels (isotropic: the geometric mean of the sides).
         const float texels = footprint * ref.scale() * std::sqrt(static_cast<float>(t.width) * t.height);
         lod = texels > 1.0f ? std::log2(texels) : 0.0f;
-        if (tp.one_level) lod = std::round(lod);
+        if (tp.wide_cone) lod = std::round(lod);
     }
     return t.sample_rgba(ref.apply(ref.slot == 0 ? tp.uv : tp.uv1), lod);
 }
@@ -216,6 +216,11 @@ MaterialPoint Scene::material_point(uint32_t material, const TexturePoint& tp) c
 Color Scene::emission_at(uint32_t material, const TexturePoint& tp) const {
     const Material& m = materials[material];
     if (!m.emissive_texture.present()) return m.emission;
+    if (tp.wide_cone) {
+        TexturePoint finest = tp;
+        finest.footprint = finest.footprint1 = 0.0f;
+        return m.emission * Color(sample(m.emissive_texture, finest));
+    }
     return m.emission * Color(sample(m.emissive_texture, tp));
 }
 

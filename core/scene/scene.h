@@ -190,9 +190,12 @@ struct TexturePoint {
     Vec4 color{1.0f};  // COLOR_0
     float footprint = 0.0f;
     float footprint1 = 0.0f;
-    /// Read the footprint's nearest mip level alone, not a blend of the two around it: for the
-    /// wide cones of gather rays (ConeKind::Wide), whose level need not be exact.
-    bool one_level = false;
+    /// Read for a gather or glossy ray's wide cone (ConeKind::Wide): the footprint's nearest mip
+    /// level alone, not a blend of the two around it (the level need not be exact there), and
+    /// the emission at level 0, as light sampling reads it: the rays' emission is weighted
+    /// against light samples, and an emissive atlas's coarse levels blend its glowing islands
+    /// with the dark around them (LightsPunctualLamp's shade read 4 % dark).
+    bool wide_cone = false;
 };
 
 enum class PunctualLightType : uint8_t { Point, Spot, Directional };

@@ -31,9 +31,10 @@ struct RenderScene {
     /// bounces continue caustic paths; a material sharp only in parts is gathered as before
     /// (caustic photons aimed at it would mostly die on its other parts).
     std::vector<bool> sharp_glossy_materials;
-    /// Per material: photons are stored on it, as it has a non-delta lobe somewhere on its
-    /// surface (its textures' and vertex colours' black parts included: a photon estimate's disc
-    /// spans texels, and counts the photons that landed on all of them).
+    /// Per material: photons are stored on it, as it has a non-delta lobe (diffuse or glossy)
+    /// somewhere on its surface: on all of it, its textures' and vertex colours' black parts
+    /// included, as a photon estimate's disc spans texels and counts the photons that landed on
+    /// all of them.
     std::vector<bool> photon_storing_materials;
     /// The triangles a caustic path (LS+D) can start on: those whose material has a delta lobe or
     /// sharp glossy ones only; null when there are none. Photons emitted for the caustic map alone that miss

@@ -263,5 +263,72 @@ TEST(FinalGather, AGlossyRaysConeGoesOnFromThePathsWidthOverItsSamplesSolidAngle
     EXPECT_FLOAT_EQ(glossy_ray_cone(path, 5.0f, sample, 2.0f).spread, 0.0f);
 }
 
+TEST(FinalGather, WideConesFilterAlbedoAtOneLevelButNotEmissionAndStayWithinTheTriangle) {
+    // A 4 x 4 quad whose base colour and emission are the same checks (4 x 4 texels each, 128
+    // across), seen through a cone 0.5 wide at the hit: far coarser than the checks.
+    SceneBuilder builder("checks that glow");
+    Texture t;
+    t.width = t.height = 32;
+    for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 32; ++x) t.texels.push_back(Color(float((x / 4 + y / 4) % 2)));
+    const int texture = static_cast<int>(builder.add_texture(std::move(t)));
+    Material m = test_support::lambertian(Color(1.0f));
+    m.emission = Color(1.0f);
+    for (TextureRef* ref : {&m.base_color_texture, &m.emissive_texture}) {
+        ref->texture = texture;
+        ref->transformed = true;
+        ref->m0 = Vec2(16.0f, 0.0f);
+        ref->m1 = Vec2(0.0f, 16.0f);
+    }
+    const uint32_t material = builder.add_material(m);
+    const MeshData q = make_quad(Vec3(-2, -2, 0), Vec3(4, 0, 0), Vec3(0, 4, 0));
+    ASSERT_TRUE(builder.add_mesh(q.positions, q.normals, q.uvs, q.triangles, material).is_ok());
+    const Scene scene = builder.build().value();
+    // A hit inside a check, where level 0 reads 0 or 1 (not a blend at a check's edge).
+    Hit hit{1.0f, 0, 0.0f, 0.0f};
+    float level_zero = 0.5f;
+    for (int i = 1; i < 64 && std::abs(level_zero - 0.5f) < 0.49f; ++i) {
+        hit.u = 0.013f * static_cast<float>(i);
+        hit.v = 0.007f * static_cast<float>(i);
+        level_zero = scene.emission_at(material, make_interaction(scene, hit, Vec3(0, 0, -1)).tex).x;
+    }
+    ASSERT_GT(std::abs(level_zero - 0.5f), 0.49f);
+    const SurfaceInteraction wide = make_interaction(scene, hit, Vec3(0, 0, -1), 0.5f, ConeKind::Wide);
+    const SurfaceInteraction pixel = make_interaction(scene, hit, Vec3(0, 0, -1), 0.5f, ConeKind::Pixel);
+    // The albedo is the checks' mean either way; the emission a wide cone reads is level 0's, as
+    // light sampling reads it, where a pixel's cone averages it too.
+    EXPECT_NEAR(scene.material_point(material, wide.tex).base_color.x, 0.5f, 0.01f);
+    EXPECT_NEAR(scene.material_point(material, pixel.tex).base_color.x, 0.5f, 0.01f);
+    EXPECT_EQ(scene.emission_at(material, wide.tex).x, level_zero);
+    EXPECT_NEAR(scene.emission_at(material, pixel.tex).x, 0.5f, 0.01f);
+
+    // Between two levels a wide cone reads the nearer alone: at a check's centre level 2 (a texel
+    // a check) reads the check's value, level 3 (a texel four checks) 1/2, a blend of them
+    // neither. Level 2.4 is a footprint of 2^2.4 level-0 texels, 2^2.4 / 512 in uv, 0.0103 in
+    // uv units of the quad's 0.25 per world unit: a cone 0.0413 wide.
+    TexturePoint centre = wide.tex;
+    centre.uv = Vec2(6.0f, 2.0f) / 512.0f;  // the centre of the second check along u, level 2
+    centre.footprint = std::exp2(2.4f) / 512.0f;
+    const float one_level = scene.material_point(material, centre).base_color.x;
+    centre.wide_cone = false;
+    const float blended = scene.material_point(material, centre).base_color.x;
+    EXPECT_TRUE(one_level == 0.0f || one_level == 1.0f) << one_level;
+    EXPECT_NEAR(blended, 0.6f * one_level + 0.4f * 0.5f, 0.02f);
+
+    // On a triangle a hundredth as wide in texture space, the cone's footprint stops at the
+    // triangle's extent there (square root of its uv parallelogram's area); a pixel's does not.
+    SceneBuilder small_builder("small triangles in texture space");
+    small_builder.add_texture(Texture(*scene.textures[0]));
+    const uint32_t small_material = small_builder.add_material(m);
+    std::vector<Vec2> small_uvs = q.uvs;
+    for (Vec2& uv : small_uvs) uv *= 0.01f;
+    ASSERT_TRUE(small_builder.add_mesh(q.positions, q.normals, small_uvs, q.triangles, small_material).is_ok());
+    const Scene small = small_builder.build().value();
+    const float extent = 0.01f;  // sqrt of the parallelogram (0.01 x 0.01) of each half of the quad
+    EXPECT_NEAR(make_interaction(small, hit, Vec3(0, 0, -1), 8.0f, ConeKind::Wide).tex.footprint, extent, 1e-5f);
+    EXPECT_NEAR(make_interaction(small, hit, Vec3(0, 0, -1), 8.0f, ConeKind::Pixel).tex.footprint, 8.0f * 0.01f / 4.0f,
+                1e-5f);
+}
+
 }  // namespace
 }  // namespace photond
