@@ -220,8 +220,8 @@ void trace_one_photon(const RenderScene& rs, const PhotonTracingSettings& settin
             if (is_black(flux)) return;
         }
         const Bsdf bsdf = make_bsdf(rs, si, wo);
-        // Stored where the material reflects diffusely anywhere, not only where this texel does:
-        // an estimate elsewhere on the surface counts the photons of the texels around it.
+        // Stored wherever the material has a non-delta lobe somewhere, not only where this texel
+        // has one: an estimate elsewhere on the surface counts the photons of the texels around it.
         if (rs.photon_storing_materials[si.material]) {
             const bool caustic_path = specular_bounces > 0 && !diffuse_seen;
             const uint8_t flags = static_cast<uint8_t>(

@@ -119,9 +119,8 @@ inline SurfaceInteraction make_interaction(const Scene& scene, const Hit& hit, c
         si.tex.wide_cone = cone == ConeKind::Wide;
         if (material.normal_texture.present() && !scene.tangents.empty()) {
             si.surface_normal = oriented_shading_normal(shading, si.geometric_normal);
-            TexturePoint normal_point = si.tex;
-            if (cone == ConeKind::Wide) normal_point.footprint = normal_point.footprint1 = 0.0f;
-            shading = apply_normal_texture(scene, material, tri, hit.u, hit.v, normal_point, shading);
+            shading = apply_normal_texture(scene, material, tri, hit.u, hit.v,
+                                           si.tex.wide_cone ? si.tex.at_finest_level() : si.tex, shading);
             si.shading_normal = oriented_shading_normal(shading, si.geometric_normal);
             si.front_face = glm::dot(ray_direction, si.geometric_normal) < 0.0f;
             si.distance = hit.t;

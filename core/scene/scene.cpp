@@ -216,12 +216,7 @@ MaterialPoint Scene::material_point(uint32_t material, const TexturePoint& tp) c
 Color Scene::emission_at(uint32_t material, const TexturePoint& tp) const {
     const Material& m = materials[material];
     if (!m.emissive_texture.present()) return m.emission;
-    if (tp.wide_cone) {
-        TexturePoint finest = tp;
-        finest.footprint = finest.footprint1 = 0.0f;
-        return m.emission * Color(sample(m.emissive_texture, finest));
-    }
-    return m.emission * Color(sample(m.emissive_texture, tp));
+    return m.emission * Color(sample(m.emissive_texture, tp.wide_cone ? tp.at_finest_level() : tp));
 }
 
 TexturePoint Scene::texture_point(uint32_t triangle, float u, float v) const {

@@ -196,6 +196,13 @@ struct TexturePoint {
     /// against light samples, and an emissive atlas's coarse levels blend its glowing islands
     /// with the dark around them (LightsPunctualLamp's shade read 4 % dark).
     bool wide_cone = false;
+
+    /// The same point read at the finest level (no footprint).
+    TexturePoint at_finest_level() const {
+        TexturePoint finest = *this;
+        finest.footprint = finest.footprint1 = 0.0f;
+        return finest;
+    }
 };
 
 enum class PunctualLightType : uint8_t { Point, Spot, Directional };
