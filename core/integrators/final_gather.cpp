@@ -117,6 +117,10 @@ Color radiance_from_photons(const PhotonMaps& maps, const SurfaceInteraction& si
 
 }  // namespace
 
+Color FinalGatherer::photon_radiance(const SurfaceInteraction& si, const Bsdf& bsdf, const Vec3& wo, Rng& rng) const {
+    return radiance_from_photons(*maps_, si, bsdf, wo, settings_, site_reach_, rng);
+}
+
 Color FinalGatherer::gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& counters, float* distance,
                                          FirstHitEmission* emission, RayFootprint cone) const {
     return trace_gather_ray(ray, rng, counters, distance, emission, false, kGlossyRayShortRayBounces, cone);

@@ -138,6 +138,18 @@ inline RayFootprint glossy_ray_cone(const RayFootprint& footprint, float distanc
     return {footprint.at(distance), spread, footprint.texture_scale};
 }
 
+/// A camera path's share of its pixel after ideal specular bounces: the product of their lobes'
+/// weights (largest channel). Under kApproximateImportance, `photon-map` reads a visible point's
+/// light from the photon maps at once, as a gather ray's hit reads it (FinalGatherer::
+/// photon_radiance), and its irradiance cache places no record there: Jensen (1996) evaluates the
+/// photon map approximately where a ray's contribution is small. A glass sphere's reflection
+/// (a Fresnel weight of 0.04 head-on) and what its inner reflections show took a quarter of
+/// TransmissionTest's records and a sixth of its render pass's rays (README, *The pipeline*).
+inline constexpr float kApproximateImportance = 0.1f;
+inline float path_importance(float importance, const BsdfSample& delta_sample) {
+    return importance * max_component(delta_sample.weight);
+}
+
 /// The ray of a camera sample: from the camera itself, which RayTracer::intersect puts on the front
 /// side of a surface it lies on (so a camera on a floor sees the room, and the floor below it).
 inline Ray primary_ray(const CameraRay& ray) {

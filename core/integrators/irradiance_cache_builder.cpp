@@ -29,11 +29,12 @@ constexpr float kCandidateY = 0.5f + 1.0f / 2048.0f;
 
 /// The points a camera ray sees through ideal specular surfaces where `kind` wants a record:
 /// every delta lobe for the first kBranchDepth bounces, then the heaviest one (deterministic, no
-/// random numbers).
+/// random numbers), as long as the path's importance (path_importance) keeps the render pass
+/// reading the cache there (CacheBuildSettings::approximate_importance).
 void collect_points(const RenderScene& rs, const CacheRecordKind& kind, const Ray& ray, float path_length,
-                    RayFootprint footprint, int depth, int max_depth, RayCounters& counters,
-                    std::vector<CachePoint>& out) {
-    if (out.size() >= kMaxPointsPerPixel) return;
+                    RayFootprint footprint, int depth, const CacheBuildSettings& settings, float importance,
+                    RayCounters& counters, std::vector<CachePoint>& out) {
+    if (out.size() >= kMaxPointsPerPixel || importance < settings.approximate_importance) return;
     const std::optional<Hit> hit = trace_ray(rs, ray, counters);
     if (!hit) return;
     const SurfaceInteraction si = make_interaction(*rs.scene, *hit, ray.direction);
@@ -48,7 +49,7 @@ void collect_points(const RenderScene& rs, const CacheRecordKind& kind, const Ra
         point.footprint = footprint.at(length);
         out.push_back(point);
     }
-    if (!bsdf.has_delta() || depth >= max_depth) return;
+    if (!bsdf.has_delta() || depth >= settings.max_specular_depth) return;
     std::array<BsdfSample, 2> lobes;
     const int count = bsdf.delta_lobes(wo, lobes);
     if (count == 0) return;
@@ -59,7 +60,8 @@ void collect_points(const RenderScene& rs, const CacheRecordKind& kind, const Ra
     }
     for (int i = first; i < last; ++i) {
         if (is_black(lobes[i].weight)) continue;
-        collect_points(rs, kind, spawn_ray(rs, si, lobes[i].wi), length, footprint, depth + 1, max_depth, counters, out);
+        collect_points(rs, kind, spawn_ray(rs, si, lobes[i].wi), length, footprint, depth + 1, settings,
+                       path_importance(importance, lobes[i]), counters, out);
     }
 }
 
@@ -191,8 +193,8 @@ void fill_cache_in_waves(const RenderScene& rs, const Camera& camera, const Cach
                     const PixelCandidate& c = candidates[i];
                     const CameraRay ray = camera.generate_ray(c.x + kCandidateX, c.y + kCandidateY);
                     points.clear();
-                    collect_points(rs, kind, primary_ray(ray), 0.0f, camera_footprint(ray), 0,
-                                   settings.max_specular_depth, chunk.counters, points);
+                    collect_points(rs, kind, primary_ray(ray), 0.0f, camera_footprint(ray), 0, settings, 1.0f,
+                                   chunk.counters, points);
                     chunk.points += points.size();
                     for (size_t k = 0; k < points.size(); ++k) {
                         Color unused;

@@ -30,6 +30,9 @@ struct CacheBuildSettings {
     float max_spacing_px = 24.0f;
     uint64_t seed = 1;
     int max_specular_depth = 16;
+    /// Points whose camera path's importance is under this get no record (the render pass reads
+    /// the photon maps there: kApproximateImportance, core/integrators/integrator.h).
+    float approximate_importance = kApproximateImportance;
     int threads = 0;
     std::optional<PixelRect> region;
     const std::atomic<bool>* cancel = nullptr;

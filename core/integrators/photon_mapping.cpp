@@ -73,6 +73,7 @@ void PhotonMapIntegrator::build_radiance_cache(const Camera& camera, CacheBuildS
     if (!uses_radiance_cache_) return;
     CacheBuildSettings build = settings_.irradiance_cache;
     build.max_specular_depth = settings_.max_specular_depth;
+    build.approximate_importance = settings_.approximate_importance;
     radiance_cache_ = photond::build_radiance_cache(*scene_, *gatherer_, camera, build, settings_.radiance_cache, statistics);
 }
 
@@ -81,6 +82,7 @@ void PhotonMapIntegrator::build_cache(const Camera& camera, CacheBuildStatistics
     if (!gatherer_ || !settings_.use_irradiance_cache) return;
     CacheBuildSettings build = settings_.irradiance_cache;
     build.max_specular_depth = settings_.max_specular_depth;
+    build.approximate_importance = settings_.approximate_importance;
     cache_ = build_irradiance_cache(*scene_, *gatherer_, camera, build, statistics, start);
 }
 
@@ -189,6 +191,7 @@ std::string PhotonMapIntegrator::render_cache_key(const std::string& photon_map_
     hash_float(cache.max_spacing_px);
     hasher.update_value(uint64_t(cache.seed));
     hasher.update_value(int32_t(settings_.max_specular_depth));
+    hash_float(settings_.approximate_importance);
     const GatherSettings& gather = gatherer_ ? gatherer_->settings() : settings_.gather;
     hasher.update_value(uint32_t(gather.rays));
     hasher.update_value(int32_t(gather.max_specular_depth));
@@ -222,7 +225,7 @@ bool PhotonMapIntegrator::radiance_field(const Vec3& p, const Vec3& normal, Radi
 }
 
 RadianceParts PhotonMapIntegrator::radiance_parts(const CameraRay& ray, SampleContext& context) const {
-    return radiance_along(primary_ray(ray), 0, 0.0f, camera_footprint(ray), context);
+    return radiance_along(primary_ray(ray), 0, 0.0f, camera_footprint(ray), 1.0f, context);
 }
 
 Color PhotonMapIntegrator::indirect_irradiance(const DiffusePoint& point, SampleContext& context) const {
@@ -243,13 +246,15 @@ Color PhotonMapIntegrator::indirect_irradiance(const DiffusePoint& point, Sample
 }
 
 RadianceParts PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, float path_length,
-                                                  RayFootprint footprint, SampleContext& context) const {
+                                                  RayFootprint footprint, float importance,
+                                                  SampleContext& context) const {
     const RenderScene& rs = *scene_;
     const std::optional<Hit> hit = trace_ray(rs, ray, context.counters);
     std::optional<SurfaceInteraction> hit_point;
     // The camera's ray cone, widened along ideal specular bounces, picks the texture level.
     if (hit) hit_point = make_interaction(*rs.scene, *hit, ray.direction, footprint.texture_at(path_length + hit->t));
-    RadianceParts radiance = surface_radiance(ray, hit_point ? &*hit_point : nullptr, depth, path_length, footprint, context);
+    RadianceParts radiance =
+        surface_radiance(ray, hit_point ? &*hit_point : nullptr, depth, path_length, footprint, importance, context);
     // Inside a solid that scatters, all its light comes from the volume map (light samples from
     // inside are blocked by its surface); surface_radiance attenuated what lies beyond.
     if (hit_point && maps_->volume && rs.scattering_interiors) {
@@ -276,7 +281,7 @@ RadianceParts PhotonMapIntegrator::radiance_along(const Ray& ray, int depth, flo
 }
 
 RadianceParts PhotonMapIntegrator::surface_radiance(const Ray& ray, const SurfaceInteraction* hit_point, int depth,
-                                                    float path_length, RayFootprint footprint,
+                                                    float path_length, RayFootprint footprint, float importance,
                                                     SampleContext& context) const {
     const RenderScene& rs = *scene_;
     // A camera ray or a delta bounce that leaves the scene sees the sky whole.
@@ -290,7 +295,11 @@ RadianceParts PhotonMapIntegrator::surface_radiance(const Ray& ray, const Surfac
     const Vec3 wo = -ray.direction;
     radiance.add_emission(rs.lights->emitted_radiance(si, wo));
     const Bsdf bsdf = make_bsdf(rs, si, wo);
-    if (bsdf.has_non_delta()) {
+    if (bsdf.has_non_delta() && gatherer_ && importance < settings_.approximate_importance) {
+        // A point of small share in its pixel: its light as a gather ray's hit reads it (no
+        // light samples, no cache record, no glossy rays), counted as indirect.
+        radiance.add_indirect(gatherer_->photon_radiance(si, bsdf, wo, context.rng));
+    } else if (bsdf.has_non_delta()) {
         // Glossy and rough lobes are also BSDF-sampled below: emitters those rays hit are
         // weighted against light sampling (multiple importance sampling).
         const bool glossy = gatherer_ && bsdf.has_non_lambertian_non_delta();
@@ -419,7 +428,8 @@ RadianceParts PhotonMapIntegrator::surface_radiance(const Ray& ray, const Surfac
     }
     if (bsdf.has_delta() && depth < settings_.max_specular_depth) {
         radiance += follow_delta_lobes(bsdf, wo, depth < kBranchDepth, context.rng, [&](const BsdfSample& s) {
-            return radiance_along(spawn_ray(rs, si, s.wi), depth + 1, length, footprint, context);
+            return radiance_along(spawn_ray(rs, si, s.wi), depth + 1, length, footprint, path_importance(importance, s),
+                                  context);
         });
     }
     return volume_transmittance(*rs.scene, si) * radiance;

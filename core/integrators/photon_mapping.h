@@ -34,6 +34,9 @@ struct PhotonMapIntegratorSettings {
     bool use_irradiance_cache = true;
     CacheBuildSettings irradiance_cache;
     int glossy_rays = 1;  // BSDF-sampled rays per visible point for non-Lambertian lobes
+    /// Visible points whose camera path's importance (path_importance) is under this read their
+    /// light from the photon maps at once, as gather hits do (kApproximateImportance; 0: never).
+    float approximate_importance = kApproximateImportance;
     /// Glossy lobes from radiance records instead of glossy rays (needs final gathering).
     RadianceCacheSettings radiance_cache;
 };
@@ -48,8 +51,9 @@ struct PhotonMapIntegratorSettings {
 /// to the map; 9: a gather hit whose nearest irradiance sites face away reads a farther one that covers it
 /// (PhotonMap::nearest_irradiance) instead of a full photon estimate; 10: the nearest site that faces
 /// the hit's way and covers it, in one search, and the short-ray rule's caustic estimates only where
-/// they may show (CausticVisibility).
-inline constexpr uint32_t kRenderCacheAlgorithmVersion = 10;
+/// they may show (CausticVisibility); 11: no records where the camera path's importance is under
+/// approximate_importance (the render pass reads the photon maps there).
+inline constexpr uint32_t kRenderCacheAlgorithmVersion = 11;
 
 /// Nearest volume photons per estimate of the in-scattered light along a gather ray, at most.
 inline constexpr uint32_t kGatherVolumePhotons = 32;
@@ -113,11 +117,12 @@ public:
     const std::shared_ptr<const IrradianceCache>& shared_cache() const { return cache_; }
 
 private:
+    /// `importance`: the camera path's share of the pixel so far (path_importance).
     RadianceParts radiance_along(const Ray& ray, int depth, float path_length, RayFootprint footprint,
-                                 SampleContext& context) const;
+                                 float importance, SampleContext& context) const;
     /// What the ray's hit sends back (null: it left the scene), before the atmosphere on its way.
     RadianceParts surface_radiance(const Ray& ray, const SurfaceInteraction* hit_point, int depth, float path_length,
-                                   RayFootprint footprint, SampleContext& context) const;
+                                   RayFootprint footprint, float importance, SampleContext& context) const;
     Expected<PrepareReport> prepare_irradiance_cache(const PrepareContext& context);
     Color indirect_irradiance(const DiffusePoint& point, SampleContext& context) const;
     /// The radiance cache's field at a glossy point, extrapolating a little where no record is
