@@ -115,11 +115,12 @@ public:
     Color gather_ray_radiance(const Ray& ray, Rng& rng, RayCounters& counters, float* distance,
                               FirstHitEmission* emission = nullptr, RayFootprint cone = {}) const;
 
-    /// Radiance leaving a non-delta surface towards wo as a gather ray's hit reads it from the
-    /// photon maps, all light in one (direct, caustic and indirect; no emission): the nearest
-    /// irradiance site times the albedo where the lobes read as diffuse, both sides' sites for
-    /// rough glass, else the global map's estimate. For visible points of small contribution
-    /// (kApproximateImportance, core/integrators/integrator.h).
+    /// Radiance leaving a non-delta surface towards wo from the photon maps, all light in one
+    /// (direct, caustic and indirect; no emission), as a gather ray reads a surface where it
+    /// stops (without following glossy lobes or the short-ray rule): the nearest irradiance site
+    /// times the albedo where the lobes read as diffuse, for rough glass the site on the side one
+    /// lobe sample picks, else the global map's estimate through the BSDF. For visible points of
+    /// small importance (kApproximateImportance, core/integrators/integrator.h).
     Color photon_radiance(const SurfaceInteraction& si, const Bsdf& bsdf, const Vec3& wo, Rng& rng) const;
 
     const GatherSettings& settings() const { return settings_; }

@@ -138,16 +138,21 @@ inline RayFootprint glossy_ray_cone(const RayFootprint& footprint, float distanc
     return {footprint.at(distance), spread, footprint.texture_scale};
 }
 
-/// A camera path's share of its pixel after ideal specular bounces: the product of their lobes'
-/// weights (largest channel). Under kApproximateImportance, `photon-map` reads a visible point's
-/// light from the photon maps at once, as a gather ray's hit reads it (FinalGatherer::
-/// photon_radiance), and its irradiance cache places no record there: Jensen (1996) evaluates the
-/// photon map approximately where a ray's contribution is small. A glass sphere's reflection
-/// (a Fresnel weight of 0.04 head-on) and what its inner reflections show took a quarter of
-/// TransmissionTest's records and a sixth of its render pass's rays (README, *The pipeline*).
+/// A camera path's importance after ideal specular bounces: the product of their lobes'
+/// reflectances and transmittances (Fresnel, tint, coat; largest channel), which never grows
+/// along the path. A refraction's weight for radiance also holds 1/eta^2 (in, 0.44 for glass) or
+/// eta^2 (out): that is radiance compressed into a smaller solid angle, not a share of the pixel,
+/// and it is taken out here (a path into glass, reflected inside and out again, would otherwise
+/// fall under the threshold and rise above it). Under kApproximateImportance, `photon-map` reads
+/// a visible point's light from the photon maps at once (FinalGatherer::photon_radiance), and its
+/// irradiance cache places no record there: Jensen (1996) evaluates the photon map approximately
+/// where a ray's contribution is small. A glass sphere's reflection (a Fresnel weight of 0.04
+/// head-on) and what its inner reflections show took a quarter of TransmissionTest's records and
+/// a sixth of its render pass's rays (README, *The pipeline*).
 inline constexpr float kApproximateImportance = 0.1f;
 inline float path_importance(float importance, const BsdfSample& delta_sample) {
-    return importance * max_component(delta_sample.weight);
+    const float solid_angle = delta_sample.is_transmission ? delta_sample.eta * delta_sample.eta : 1.0f;
+    return importance * max_component(delta_sample.weight) * solid_angle;
 }
 
 /// The ray of a camera sample: from the camera itself, which RayTracer::intersect puts on the front

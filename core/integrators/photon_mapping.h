@@ -107,7 +107,8 @@ public:
     /// The parts by estimator: emission seen through ideal specular surfaces; direct from light
     /// sampling (and the emitters and the sky the glossy rays find at once); caustic from the
     /// caustic map; indirect from final gathering (or the global map read directly), which also
-    /// holds the diffuse part of a sky (final gathering collects it, light sampling only its peaks).
+    /// holds the diffuse part of a sky (final gathering collects it, light sampling only its peaks)
+    /// and all the light of points evaluated approximately (approximate_importance).
     RadianceParts radiance_parts(const CameraRay& ray, SampleContext& context) const override;
 
     const IrradianceCache* cache() const { return cache_.get(); }
