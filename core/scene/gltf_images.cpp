@@ -2,9 +2,11 @@
 // EXT_texture_webp) when a material uses them.
 #include "core/scene/gltf_reader.h"
 
+#include <stb_image.h>
 #include <webp/decode.h>
 
 #include <cstring>
+#include <memory>
 #include <span>
 
 namespace photond::gltf {
@@ -110,51 +112,58 @@ Expected<Texture> decode_image(const tinygltf::Image& image, int image_index, bo
                      std::to_string(height) + " (at most " + std::to_string(kMaxImageSide) +
                      " per side and " + std::to_string(kMaxImagePixels) + " pixels)"};
 
-    tinygltf::Image decoded;
+    // The decoded RGBA samples, 8 or 16 bits each: libwebp and stb_image decode into buffers of
+    // their own, which the texture copies once (through tinygltf's LoadImageData the pixels were
+    // copied once more, into a zero-filled vector: page faults and zeroing were a third of a
+    // scene's loading, AlphaBlendModeTest's three 2048 x 2048 maps).
+    std::unique_ptr<void, void (*)(void*)> pixels(nullptr, std::free);
+    int decoded_width = 0, decoded_height = 0, bits = 8;
     if (is_webp(bytes)) {
         WebPBitstreamFeatures features;
         if (WebPGetFeatures(bytes.data(), bytes.size(), &features) == VP8_STATUS_OK && features.has_animation)
             return Error{what + " is an animated WebP, which a texture cannot be"};
-        // Decoded straight into the texel array: nothing for libwebp to free.
-        decoded.width = int(width);
-        decoded.height = int(height);
-        decoded.component = 4;
-        decoded.bits = 8;
-        decoded.image.resize(size_t(width) * size_t(height) * 4);
-        if (!WebPDecodeRGBAInto(bytes.data(), bytes.size(), decoded.image.data(), decoded.image.size(),
-                                int(width) * 4))
-            return Error{what + " cannot be decoded: libwebp refused it (corrupt or truncated WebP)"};
+        pixels = std::unique_ptr<void, void (*)(void*)>(
+            WebPDecodeRGBA(bytes.data(), bytes.size(), &decoded_width, &decoded_height), WebPFree);
+        if (!pixels) return Error{what + " cannot be decoded: libwebp refused it (corrupt or truncated WebP)"};
     } else {
-        std::string err, warn;
-        // Without user data the decoder expands every image to RGBA, 8 or 16 bits per channel.
-        if (!tinygltf::LoadImageData(&decoded, image_index, &err, &warn, 0, 0, image.image.data(),
-                                     static_cast<int>(image.image.size()), nullptr))
-            return Error{what + " cannot be decoded: " + trim_trailing_whitespace(err)};
+        const auto* data = bytes.data();
+        const int size_bytes = static_cast<int>(bytes.size());
+        int channels = 0;
+        // 16-bit PNGs keep their precision; everything else is 8 bits, expanded to RGBA.
+        bits = stbi_is_16_bit_from_memory(data, size_bytes) ? 16 : 8;
+        void* raw = bits == 16 ? static_cast<void*>(stbi_load_16_from_memory(data, size_bytes, &decoded_width,
+                                                                             &decoded_height, &channels, 4))
+                               : static_cast<void*>(stbi_load_from_memory(data, size_bytes, &decoded_width,
+                                                                          &decoded_height, &channels, 4));
+        pixels = std::unique_ptr<void, void (*)(void*)>(raw, stbi_image_free);
+        if (!pixels) {
+            const char* reason = stbi_failure_reason();
+            return Error{what + " cannot be decoded: " + (reason ? reason : "stb_image refused it")};
+        }
     }
-    const size_t texel_count = size_t(decoded.width) * size_t(decoded.height);
-    const size_t bytes_per_channel = decoded.bits == 16 ? 2 : 1;
-    if (decoded.width <= 0 || decoded.height <= 0 || decoded.component != 4 ||
-        (decoded.bits != 8 && decoded.bits != 16) ||
-        decoded.image.size() < texel_count * 4 * bytes_per_channel)
-        return Error{what + " decoded to an unexpected pixel layout"};
+    if (decoded_width != int(width) || decoded_height != int(height))
+        return Error{what + " decoded to " + std::to_string(decoded_width) + "x" + std::to_string(decoded_height) +
+                     " pixels, not the " + std::to_string(width) + "x" + std::to_string(height) + " of its header"};
+    const size_t texel_count = size_t(width) * size_t(height);
 
     Texture texture;
-    texture.width = decoded.width;
-    texture.height = decoded.height;
-    if (decoded.bits == 8) {
+    texture.width = int(width);
+    texture.height = int(height);
+    if (bits == 8) {
         // Kept as the image holds it; Texture reads it through the sRGB curve or as data.
         texture.encoding = srgb ? TexelEncoding::Srgb8 : TexelEncoding::Linear8;
-        texture.rgba8.resize(texel_count);
-        const uint8_t* p = decoded.image.data();
+        const auto* p = static_cast<const uint8_t*>(pixels.get());
+        texture.rgba8.reserve(texel_count);
         for (size_t i = 0; i < texel_count; ++i, p += 4)
-            texture.rgba8[i] = uint32_t(p[0]) | (uint32_t(p[1]) << 8) | (uint32_t(p[2]) << 16) | (uint32_t(p[3]) << 24);
+            texture.rgba8.push_back(uint32_t(p[0]) | (uint32_t(p[1]) << 8) | (uint32_t(p[2]) << 16) |
+                                    (uint32_t(p[3]) << 24));
         return texture;
     }
     texture.texels.resize(texel_count);
     const auto curve = [srgb](float c) { return srgb ? srgb_to_linear(c) : c; };
     std::vector<float> alpha(texel_count);
     bool opaque = true;
-    const uint8_t* p = decoded.image.data();
+    const auto* p = static_cast<const uint8_t*>(pixels.get());
     for (size_t i = 0; i < texel_count; ++i, p += 8) {
         uint16_t rgba[4];
         std::memcpy(rgba, p, sizeof(rgba));  // stb returns native-endian 16-bit samples
