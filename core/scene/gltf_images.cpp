@@ -116,31 +116,32 @@ Expected<Texture> decode_image(const tinygltf::Image& image, int image_index, bo
     // their own, which the texture copies once (through tinygltf's LoadImageData the pixels were
     // copied once more, into a zero-filled vector: page faults and zeroing were a third of a
     // scene's loading, AlphaBlendModeTest's three 2048 x 2048 maps).
-    std::unique_ptr<void, void (*)(void*)> pixels(nullptr, std::free);
+    void* decoded = nullptr;
+    void (*release)(void*) = stbi_image_free;
     int decoded_width = 0, decoded_height = 0, bits = 8;
     if (is_webp(bytes)) {
         WebPBitstreamFeatures features;
         if (WebPGetFeatures(bytes.data(), bytes.size(), &features) == VP8_STATUS_OK && features.has_animation)
             return Error{what + " is an animated WebP, which a texture cannot be"};
-        pixels = std::unique_ptr<void, void (*)(void*)>(
-            WebPDecodeRGBA(bytes.data(), bytes.size(), &decoded_width, &decoded_height), WebPFree);
-        if (!pixels) return Error{what + " cannot be decoded: libwebp refused it (corrupt or truncated WebP)"};
+        decoded = WebPDecodeRGBA(bytes.data(), bytes.size(), &decoded_width, &decoded_height);
+        release = WebPFree;
+        if (!decoded) return Error{what + " cannot be decoded: libwebp refused it (corrupt or truncated WebP)"};
     } else {
         const auto* data = bytes.data();
         const int size_bytes = static_cast<int>(bytes.size());
         int channels = 0;
         // 16-bit PNGs keep their precision; everything else is 8 bits, expanded to RGBA.
         bits = stbi_is_16_bit_from_memory(data, size_bytes) ? 16 : 8;
-        void* raw = bits == 16 ? static_cast<void*>(stbi_load_16_from_memory(data, size_bytes, &decoded_width,
-                                                                             &decoded_height, &channels, 4))
-                               : static_cast<void*>(stbi_load_from_memory(data, size_bytes, &decoded_width,
-                                                                          &decoded_height, &channels, 4));
-        pixels = std::unique_ptr<void, void (*)(void*)>(raw, stbi_image_free);
-        if (!pixels) {
+        decoded = bits == 16 ? static_cast<void*>(stbi_load_16_from_memory(data, size_bytes, &decoded_width,
+                                                                           &decoded_height, &channels, 4))
+                             : static_cast<void*>(stbi_load_from_memory(data, size_bytes, &decoded_width,
+                                                                        &decoded_height, &channels, 4));
+        if (!decoded) {
             const char* reason = stbi_failure_reason();
             return Error{what + " cannot be decoded: " + (reason ? reason : "stb_image refused it")};
         }
     }
+    const std::unique_ptr<void, void (*)(void*)> pixels(decoded, release);
     if (decoded_width != int(width) || decoded_height != int(height))
         return Error{what + " decoded to " + std::to_string(decoded_width) + "x" + std::to_string(decoded_height) +
                      " pixels, not the " + std::to_string(width) + "x" + std::to_string(height) + " of its header"};

@@ -30,13 +30,7 @@ Scene glass_sphere_room() {
     Material light = test_support::lambertian(Color(0.0f));
     light.emission = Color(20.0f);
     const uint32_t lamp = builder.add_material(light);
-    Material glass;
-    glass.base_color = Color(1.0f);
-    glass.metallic = 0.0f;
-    glass.roughness = 0.0f;
-    glass.transmission = 1.0f;
-    glass.ior = 1.5f;
-    const uint32_t crystal = builder.add_material(glass);
+    const uint32_t crystal = builder.add_material(test_support::smooth_glass(1.5f));
     const auto add = [&](const MeshData& mesh, uint32_t material) {
         EXPECT_TRUE(builder.add_mesh(mesh.positions, mesh.normals, mesh.uvs, mesh.triangles, material).is_ok());
     };

@@ -162,12 +162,7 @@ TEST(Atmosphere, NonAbsorbingFogUnderAUniformSkyKeepsItsRadiance) {
 /// and 6 across, g 0.5) and absorbs nothing, in a scene of its own.
 Scene scattering_glass_sphere(float ior) {
     SceneBuilder builder("scattering-solid");
-    Material glass;
-    glass.base_color = Color(1.0f);
-    glass.metallic = 0.0f;
-    glass.roughness = 0.0f;
-    glass.transmission = 1.0f;
-    glass.ior = ior;
+    Material glass = test_support::smooth_glass(ior);
     glass.scattering = Color(1.0f, 2.5f, 6.0f);
     glass.phase_g = 0.5f;
     EXPECT_TRUE(add_mesh(builder, make_icosphere(Vec3(0.0f), 0.5f, 4), builder.add_material(glass)).is_ok());

@@ -34,13 +34,8 @@ CameraRay ray_from(const Vec3& origin, const Vec3& direction) {
 /// Smooth glass of index `ior` whose solid scatters (sigma_s per unit, g 0.5) and absorbs
 /// sigma_a.
 Material scattering_glass(float ior, const Color& sigma_s, const Color& sigma_a = Color(0.0f)) {
-    Material glass;
+    Material glass = test_support::smooth_glass(ior);
     glass.name = "glass";
-    glass.base_color = Color(1.0f);
-    glass.metallic = 0.0f;
-    glass.roughness = 0.0f;
-    glass.transmission = 1.0f;
-    glass.ior = ior;
     glass.scattering = sigma_s;
     glass.attenuation = sigma_a;
     glass.phase_g = 0.5f;

@@ -23,12 +23,7 @@ constexpr float kThickness = 0.6f;
 /// for photons, an emitter at z = 2 facing down and a floor at z = -1.
 Scene slab_scene(bool attenuating, bool photons) {
     SceneBuilder builder("volume");
-    Material glass;
-    glass.base_color = Color(1.0f);
-    glass.metallic = 0.0f;
-    glass.roughness = 0.0f;
-    glass.transmission = 1.0f;
-    glass.ior = 1.0f;
+    Material glass = test_support::smooth_glass(1.0f);
     if (attenuating) glass.attenuation = kSigma;
     const uint32_t slab = builder.add_material(glass);
     Material light = test_support::lambertian(Color(0.0f));

@@ -28,6 +28,17 @@ inline Material lambertian(Color albedo) {
     return m;
 }
 
+/// Clear, smooth glass of index `ior` (KHR_materials_transmission 1, roughness 0, white).
+inline Material smooth_glass(float ior) {
+    Material m;
+    m.base_color = Color(1.0f);
+    m.metallic = 0.0f;
+    m.roughness = 0.0f;
+    m.transmission = 1.0f;
+    m.ior = ior;
+    return m;
+}
+
 /// Mean radiance over `samples` camera samples along `ray`, sample s drawing stream (seed, s).
 inline Color mean_radiance(const Integrator& integrator, const CameraRay& ray, int samples, uint64_t seed = 1) {
     DVec3 sum(0.0);
