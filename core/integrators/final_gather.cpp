@@ -382,9 +382,10 @@ Color FinalGatherer::trace_gather_ray(const Ray& ray, Rng& rng, RayCounters& cou
 }
 
 GatherResult FinalGatherer::gather(const Vec3& p, const Vec3& n, const Vec3& geometric_normal, Rng& rng,
-                                   RayCounters& counters, bool compute_gradients) const {
+                                   RayCounters& counters, bool compute_gradients, uint32_t rays) const {
     const RenderScene& rs = *scene_;
-    const int m = grid_.m, cells_n = grid_.n;
+    const GatherGrid grid = rays > 0 ? GatherGrid::for_rays(rays) : grid_;
+    const int m = grid.m, cells_n = grid.n;
     const Frame frame(n);
     thread_local std::vector<Color> radiance;
     thread_local std::vector<float> distance;

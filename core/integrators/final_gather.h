@@ -91,9 +91,10 @@ public:
                   std::shared_ptr<const CausticVisibility> caustic_visibility = nullptr);
 
     /// Gathers at point p with unit normal n (the side light is gathered from), frame around n.
-    /// `compute_gradients` adds the rotation and translation gradients.
+    /// `compute_gradients` adds the rotation and translation gradients. `rays`: how many rays
+    /// (0: the settings' count).
     GatherResult gather(const Vec3& p, const Vec3& n, const Vec3& geometric_normal, Rng& rng,
-                        RayCounters& counters, bool compute_gradients) const;
+                        RayCounters& counters, bool compute_gradients, uint32_t rays = 0) const;
 
     /// Radiance leaving the first non-specular surface along a ray, from the photon maps (no
     /// emission); writes the hit distance (infinity on a miss).

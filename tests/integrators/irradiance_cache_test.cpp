@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <barrier>
+#include <cmath>
+#include <cstdio>
 #include <thread>
 
 #include "core/image/image_metrics.h"
@@ -176,6 +178,49 @@ TEST(IrradianceCache, ImagesAreBitIdenticalForOneTwoAndSevenThreads) {
     EXPECT_TRUE(one == render_with_threads(f, 2));
     EXPECT_TRUE(one == render_with_threads(f, 7));
     for (const Color& c : one.pixels()) ASSERT_TRUE(is_finite(c));
+}
+
+TEST(IrradianceCache, AMissGathersItsSamplesShareOfTheRays) {
+    EXPECT_EQ(miss_gather_rays(256, 16), 16u);
+    EXPECT_EQ(miss_gather_rays(256, 4), 64u);
+    EXPECT_EQ(miss_gather_rays(256, 1), 256u);
+    EXPECT_EQ(miss_gather_rays(256, 1024), kMinMissGatherRays);
+    EXPECT_EQ(miss_gather_rays(8, 16), 8u);  // never more than a record's
+
+    // With an empty cache every visible point misses: the pixels of 16 samples that gather 16
+    // rays each hold 256 rays in all, and must agree with those that gathered 256 per sample.
+    const Fixture& f = diffuse_box();
+    const Camera camera = Camera::create(f.scene->scene->cameras.at(0), 24, 24).value();
+    const auto empty = std::make_shared<const IrradianceCache>(f.scene->scene->bounds, IrradianceCacheSettings{});
+    const auto render = [&](uint32_t miss_rays) {
+        PhotonMapIntegratorSettings settings;
+        settings.gather.rays = 256;
+        settings.miss_gather_rays = miss_rays;
+        PhotonMapIntegrator integrator(f.scene, f.maps, settings);
+        integrator.use_cache(empty);
+        TileSettings tiles;
+        tiles.samples_per_pixel = 16;
+        tiles.seed = 5;
+        return render_tiles(integrator, camera, tiles);
+    };
+    const TileRenderResult share = render(miss_gather_rays(256, 16));
+    const TileRenderResult full = render(0);
+    ASSERT_GT(share.counters.irradiance_misses, 0u);
+    EXPECT_EQ(share.counters.irradiance_misses, full.counters.irradiance_misses);
+    // At least 240 rays fewer per miss (bounces of the short-ray rule come on top of both).
+    EXPECT_GE(static_cast<double>(full.counters.rays - share.counters.rays),
+              240.0 * static_cast<double>(share.counters.irradiance_misses));
+    const ImageError error = compare_images(share.layers.beauty, full.layers.beauty).value();
+    const ImageError blocks =
+        compare_images(downsample(share.layers.beauty, 4), downsample(full.layers.beauty, 4)).value();
+    std::printf("misses %llu, rays %llu vs %llu; relMSE %.5f, 4x4 blocks %.6f, mean %+.3f %%\n",
+                static_cast<unsigned long long>(share.counters.irradiance_misses),
+                static_cast<unsigned long long>(share.counters.rays),
+                static_cast<unsigned long long>(full.counters.rays), error.relative_mse, blocks.relative_mse,
+                100.0 * error.mean_bias);
+    EXPECT_LT(std::abs(error.mean_bias), 0.005);
+    EXPECT_LT(error.relative_mse, 0.004);
+    EXPECT_LT(blocks.relative_mse, 0.0004);
 }
 
 TEST(IrradianceCache, ConcurrentReadersBetweenWriterWavesSeeConsistentResults) {
