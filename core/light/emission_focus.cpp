@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
+#include <unordered_map>
 
 #include "core/math/frame.h"
+#include "core/math/rng.h"
 #include "core/math/sampling.h"
 #include "core/scene/scene.h"
 
@@ -75,6 +78,47 @@ bool inside(const Cone& cone, const Vec3& direction) {
     return cone.cos_max <= -1.0f || glm::dot(direction, cone.axis) >= cone.cos_max;
 }
 
+/// The objects among `triangles`: sets of triangles joined through shared vertex positions
+/// (compared exactly, so that a UV seam's duplicated vertices do not cut a sphere in two). Each
+/// object lists its triangles in their order in `triangles`; objects in order of their first.
+std::vector<std::vector<uint32_t>> objects_of(const Scene& scene, std::span<const uint32_t> triangles) {
+    std::vector<uint32_t> parent(triangles.size());
+    for (uint32_t i = 0; i < parent.size(); ++i) parent[i] = i;
+    const auto root = [&](uint32_t i) {
+        while (parent[i] != i) i = parent[i] = parent[parent[i]];
+        return i;
+    };
+    // A position's bits -> the first triangle with a vertex there.
+    using PositionBits = std::array<uint32_t, 3>;
+    struct PositionHash {
+        size_t operator()(const PositionBits& b) const { return static_cast<size_t>(hash_indices(b[0], b[1], b[2])); }
+    };
+    std::unordered_map<PositionBits, uint32_t, PositionHash> first_at;
+    first_at.reserve(triangles.size() * 2);
+    for (uint32_t i = 0; i < triangles.size(); ++i) {
+        const glm::uvec3& tri = scene.triangles[triangles[i]];
+        for (uint32_t v : {tri.x, tri.y, tri.z}) {
+            const Vec3& p = scene.positions[v];
+            const PositionBits bits{std::bit_cast<uint32_t>(p.x), std::bit_cast<uint32_t>(p.y), std::bit_cast<uint32_t>(p.z)};
+            const auto [it, inserted] = first_at.try_emplace(bits, i);
+            if (inserted) continue;
+            const uint32_t a = root(i), b = root(it->second);
+            if (a != b) parent[std::max(a, b)] = std::min(a, b);
+        }
+    }
+    std::vector<std::vector<uint32_t>> objects;
+    std::vector<uint32_t> object_of_root(triangles.size(), UINT32_MAX);
+    for (uint32_t i = 0; i < triangles.size(); ++i) {
+        uint32_t& object = object_of_root[root(i)];
+        if (object == UINT32_MAX) {
+            object = static_cast<uint32_t>(objects.size());
+            objects.emplace_back();
+        }
+        objects[object].push_back(triangles[i]);
+    }
+    return objects;
+}
+
 }  // namespace
 
 EmissionFocus focus_on_triangles(const Scene& scene, std::span<const uint32_t> triangles) {
@@ -85,40 +129,88 @@ EmissionFocus focus_on_triangles(const Scene& scene, std::span<const uint32_t> t
     focus.center = all.center;
     focus.radius = all.radius;
 
+    // Objects are kept whole while a group holds more than one: a split by triangles through a
+    // round object leaves two halves each about as wide as the object.
+    const std::vector<std::vector<uint32_t>> objects = objects_of(scene, triangles);
+    std::vector<FocusSphere> object_spheres;
+    object_spheres.reserve(objects.size());
+    for (const std::vector<uint32_t>& object : objects) object_spheres.push_back(sphere_of(scene, object, margin));
+
     struct Group {
-        std::vector<uint32_t> triangles;
+        std::vector<uint32_t> objects;    // more than one: split between objects
+        std::vector<uint32_t> triangles;  // one object or part of one: split between triangles
         FocusSphere sphere;
         bool final = false;  // splitting it would not narrow it
     };
+    const auto group_of_objects = [&](std::vector<uint32_t> ids) {
+        Group g;
+        if (ids.size() == 1) {
+            g.triangles = objects[ids[0]];
+            g.sphere = object_spheres[ids[0]];
+            return g;
+        }
+        for (uint32_t id : ids) g.triangles.insert(g.triangles.end(), objects[id].begin(), objects[id].end());
+        g.sphere = sphere_of(scene, g.triangles, margin);
+        g.objects = std::move(ids);
+        return g;
+    };
+    std::vector<uint32_t> every_object(objects.size());
+    for (uint32_t i = 0; i < every_object.size(); ++i) every_object[i] = i;
     std::vector<Group> groups;
-    groups.push_back({std::vector<uint32_t>(triangles.begin(), triangles.end()), all, false});
+    groups.push_back(group_of_objects(std::move(every_object)));
     while (groups.size() < kMaxFocusSpheres) {
         // The widest group that may still split (ties: the first, so the cover is deterministic).
         Group* widest = nullptr;
         for (Group& g : groups)
             if (!g.final && g.triangles.size() > 1 && (!widest || g.sphere.radius > widest->sphere.radius)) widest = &g;
         if (!widest) break;
-        Bounds3 centroids;
-        for (uint32_t t : widest->triangles) centroids.extend(centroid(scene, t));
-        const Vec3 extent = centroids.extent();
-        const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
-        std::vector<uint32_t> left = widest->triangles;
-        const auto middle = left.begin() + static_cast<std::ptrdiff_t>(left.size() / 2);
-        std::nth_element(left.begin(), middle, left.end(), [&](uint32_t a, uint32_t b) {
-            const float ca = centroid(scene, a)[axis], cb = centroid(scene, b)[axis];
-            return ca < cb || (ca == cb && a < b);
-        });
-        std::vector<uint32_t> right(middle, left.end());
-        left.erase(middle, left.end());
-        const FocusSphere left_sphere = sphere_of(scene, left, margin);
-        const FocusSphere right_sphere = sphere_of(scene, right, margin);
-        // Halves of one round object are each wider than the whole: keep it whole.
-        if (!(std::max(left_sphere.radius, right_sphere.radius) < widest->sphere.radius)) {
-            widest->final = true;
-            continue;
+        Group left, right;
+        if (widest->objects.size() > 1) {
+            // Objects by their spheres' centres: at the middle of their extent along its longest
+            // axis, or at the median where one side would be empty.
+            Bounds3 centers;
+            for (uint32_t id : widest->objects) centers.extend(object_spheres[id].center);
+            const Vec3 extent = centers.extent();
+            const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
+            std::vector<uint32_t> ids = widest->objects;
+            const float mid = centers.center()[axis];
+            auto middle = std::stable_partition(ids.begin(), ids.end(),
+                                                [&](uint32_t id) { return object_spheres[id].center[axis] < mid; });
+            if (middle == ids.begin() || middle == ids.end()) {
+                middle = ids.begin() + static_cast<std::ptrdiff_t>(ids.size() / 2);
+                std::nth_element(ids.begin(), middle, ids.end(), [&](uint32_t a, uint32_t b) {
+                    const float ca = object_spheres[a].center[axis], cb = object_spheres[b].center[axis];
+                    return ca < cb || (ca == cb && a < b);
+                });
+            }
+            left = group_of_objects(std::vector<uint32_t>(ids.begin(), middle));
+            right = group_of_objects(std::vector<uint32_t>(middle, ids.end()));
+        } else {
+            // Within one object: at the median of its triangles' centroids along their longest
+            // axis, kept only where that narrows it (a long rod, not a ball).
+            Bounds3 centroids;
+            for (uint32_t t : widest->triangles) centroids.extend(centroid(scene, t));
+            const Vec3 extent = centroids.extent();
+            const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
+            std::vector<uint32_t> part = widest->triangles;
+            const auto middle = part.begin() + static_cast<std::ptrdiff_t>(part.size() / 2);
+            std::nth_element(part.begin(), middle, part.end(), [&](uint32_t a, uint32_t b) {
+                const float ca = centroid(scene, a)[axis], cb = centroid(scene, b)[axis];
+                return ca < cb || (ca == cb && a < b);
+            });
+            right.triangles.assign(middle, part.end());
+            part.erase(middle, part.end());
+            left.triangles = std::move(part);
+            left.sphere = sphere_of(scene, left.triangles, margin);
+            right.sphere = sphere_of(scene, right.triangles, margin);
+            // Halves of one round object are each wider than the whole: keep it whole.
+            if (!(std::max(left.sphere.radius, right.sphere.radius) < widest->sphere.radius)) {
+                widest->final = true;
+                continue;
+            }
         }
-        *widest = {std::move(left), left_sphere, false};
-        groups.push_back({std::move(right), right_sphere, false});
+        *widest = std::move(left);
+        groups.push_back(std::move(right));
     }
     focus.spheres.reserve(groups.size());
     for (const Group& g : groups) focus.spheres.push_back(g.sphere);

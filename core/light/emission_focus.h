@@ -5,8 +5,11 @@
 // map alone only needs the directions in which a caster lies. Emitted over the light's whole
 // distribution, nearly all of them miss (a small emitter beside glass spheres: 4.5 M photons
 // emitted for 50,000 stored). Instead:
-//   - parallel photons (directional lights, suns, the environment) start on a disc of the
-//     casters' bounding sphere (LightSet::sample_emission, `center` and `radius`);
+//   - parallel photons (directional lights, suns, the environment) start on the disc, across
+//     their direction, of one of the spheres that cover the casters (`spheres`), chosen in
+//     proportion to its area, uniform in it, and carry the reciprocal of the discs' density
+//     there, covering / (sum of the discs' areas) (LightSet::sample_emission); on the disc of
+//     the casters' bounding sphere (`center`, `radius`) where that is smaller than the discs;
 //   - photons from a position (points, spots, emissive triangles) take a direction in the cone of
 //     one of up to kMaxFocusSpheres spheres that cover the casters (`spheres`), chosen in
 //     proportion to its solid angle times the emitter's largest cosine over it (none behind a
@@ -38,18 +41,21 @@ struct FocusSphere {
 inline constexpr size_t kMaxFocusSpheres = 32;
 
 struct EmissionFocus {
-    /// The bounding sphere of every caster: parallel photons are aimed at it.
+    /// The bounding sphere of every caster: parallel photons are aimed at it where its disc is
+    /// smaller than the spheres' discs together.
     Vec3 center{0.0f};
     float radius = 0.0f;
-    /// Spheres that together cover every caster: photons from a position are aimed at them.
-    /// Empty: such photons leave by the light's own distribution.
+    /// Spheres that together cover every caster: photons are aimed at them. Empty: photons from
+    /// a position leave by the light's own distribution, parallel ones from the bounding disc.
     std::vector<FocusSphere> spheres;
 };
 
 /// The focus of `triangles` of the scene: their bounding sphere, and a cover of at most
-/// kMaxFocusSpheres spheres built by splitting the group of widest sphere at the median of its
-/// triangles' centroids along its longest axis, as long as that narrows it. Each sphere is a
-/// little larger than its triangles, so that rounding cannot shave photons off their edges.
+/// kMaxFocusSpheres spheres built by splitting the group of widest sphere: one of several objects
+/// (triangles joined through shared vertex positions) between them, at the middle of their
+/// spheres' centres along the longest axis (the median where one side would be empty); one
+/// object at the median of its triangles' centroids, as long as that narrows it. Each sphere is
+/// a little larger than its triangles, so that rounding cannot shave photons off their edges.
 EmissionFocus focus_on_triangles(const Scene& scene, std::span<const uint32_t> triangles);
 
 /// How a light with a position sees the focus: where it emits from and what it covers.

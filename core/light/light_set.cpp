@@ -443,15 +443,48 @@ Color LightSet::mean_emissive_texel(uint32_t triangle) const {
     return glm::max(mean, 1e-3f * whole);
 }
 
-Vec3 LightSet::parallel_origin(const Vec3& direction, Vec2 u, const EmissionFocus* focus, float* area_ratio) const {
-    const Vec3 center = focus ? focus->center : scene_center_;
-    const float radius = focus ? std::min(focus->radius, scene_radius_) : scene_radius_;
-    *area_ratio = focus ? (radius * radius) / (scene_radius_ * scene_radius_) : 1.0f;
+Vec3 LightSet::parallel_origin(const Vec3& direction, Vec2 u, const EmissionFocus* focus, float u_focus,
+                               float* area_ratio) const {
     const Frame frame(direction);
-    const Vec2 d = sample_concentric_disk(u) * radius;
-    // On the disc, then back along the ray to outside the scene's bounding sphere, so that
-    // whatever lies in front of a focus still blocks the photon.
-    const Vec3 on_disc = center + frame.s * d.x + frame.t * d.y;
+    const float scene_area = scene_radius_ * scene_radius_;  // areas over pi
+    Vec3 on_disc;
+    float cover_area = 0.0f;
+    if (focus)
+        for (const FocusSphere& sphere : focus->spheres) cover_area += sphere.radius * sphere.radius;
+    const float focus_radius = focus ? std::min(focus->radius, scene_radius_) : scene_radius_;
+    if (focus && !focus->spheres.empty() && cover_area < focus_radius * focus_radius) {
+        // The discs of the focus spheres, perpendicular to the photon, together smaller than the
+        // focus's own disc: one of them, chosen by its area, and a point uniform in it. A point
+        // that `covering` discs hold has the density covering / cover_area over the plane.
+        const std::vector<FocusSphere>& spheres = focus->spheres;
+        size_t chosen = spheres.size() - 1;
+        float below = 0.0f;
+        const float target = u_focus * cover_area;
+        for (size_t i = 0; i < spheres.size(); ++i) {
+            below += spheres[i].radius * spheres[i].radius;
+            if (target < below) {
+                chosen = i;
+                break;
+            }
+        }
+        const Vec2 d = sample_concentric_disk(u) * spheres[chosen].radius;
+        on_disc = spheres[chosen].center + frame.s * d.x + frame.t * d.y;
+        int covering = 1;  // the chosen disc, whatever rounding says
+        for (size_t i = 0; i < spheres.size(); ++i) {
+            if (i == chosen) continue;
+            const Vec3 offset = on_disc - spheres[i].center;
+            const float along = glm::dot(offset, direction);
+            if (glm::dot(offset, offset) - along * along <= spheres[i].radius * spheres[i].radius) ++covering;
+        }
+        *area_ratio = cover_area / (static_cast<float>(covering) * scene_area);
+    } else {
+        const Vec3 center = focus ? focus->center : scene_center_;
+        const Vec2 d = sample_concentric_disk(u) * focus_radius;
+        on_disc = center + frame.s * d.x + frame.t * d.y;
+        *area_ratio = focus ? (focus_radius * focus_radius) / scene_area : 1.0f;
+    }
+    // Back along the ray to outside the scene's bounding sphere, so that whatever lies in front
+    // of a focus still blocks the photon.
     const float along = glm::dot(scene_center_ - on_disc, direction);
     return on_disc + direction * (along - 2.0f * scene_radius_);
 }
@@ -516,7 +549,7 @@ std::optional<EmissionSample> LightSet::sample_emission(float u_select, Vec2 u_p
                               ? Frame(l.direction).to_world(sample_uniform_cone(u_direction, std::cos(l.angular_radius)))
                               : l.direction;
             float area_ratio = 1.0f;
-            s.origin = parallel_origin(s.direction, u_position, focus, &area_ratio);
+            s.origin = parallel_origin(s.direction, u_position, focus, u_focus, &area_ratio);
             s.normal = s.direction;
             s.flux_weight = e.emission_weight * area_ratio;
             break;
@@ -527,7 +560,7 @@ std::optional<EmissionSample> LightSet::sample_emission(float u_select, Vec2 u_p
             if (!(pdf > 0.0f)) return std::nullopt;
             s.direction = -towards_sky;
             float area_ratio = 1.0f;
-            s.origin = parallel_origin(s.direction, u_position, focus, &area_ratio);
+            s.origin = parallel_origin(s.direction, u_position, focus, u_focus, &area_ratio);
             s.normal = s.direction;
             s.flux_weight = e.emission_weight * environment_->radiance(towards_sky) * (area_ratio / pdf);
             break;

@@ -102,9 +102,10 @@ public:
     /// triangles (uniform by area, cosine-weighted direction), the environment (directions by
     /// its importance distribution, parallel from a disc of the scene's bounding sphere).
     /// The random numbers by value: references would keep a caller's in memory.
-    /// With `focus` (core/light/emission_focus.h), parallel photons start on a disc of the focus
-    /// sphere's radius around its centre (still outside the scene's bounding sphere) and their
-    /// flux is scaled by the smaller disc's area; photons from a position take a direction towards
+    /// With `focus` (core/light/emission_focus.h), parallel photons start on the discs of the
+    /// focus spheres, one chosen by its area with `u_focus` (or on the disc of the casters'
+    /// bounding sphere where that is smaller; still outside the scene's bounding sphere), and
+    /// their flux is scaled by the reciprocal of their density; photons from a position take a direction towards
     /// the focus spheres (sample_focused_direction, choosing a sphere by `u_focus`) and carry the
     /// light's density of it over the one it was drawn with. Unbiased for every path whose first
     /// hit lies in a focus sphere.
@@ -124,8 +125,11 @@ private:
     float distant_pdf(uint32_t light, const Vec3& d, Color* radiance) const;
     /// The origin of a parallel photon travelling in `direction`: a point of a disc
     /// perpendicular to it, of the scene's bounding radius around its centre (or of `focus`,
-    /// when given), moved back outside the scene. Writes the disc's area over the scene's.
-    Vec3 parallel_origin(const Vec3& direction, Vec2 u, const EmissionFocus* focus, float* area_ratio) const;
+    /// when given: the discs of its spheres, one chosen by `u_focus`, where they are smaller
+    /// together than its bounding sphere's), moved back outside the scene. Writes the
+    /// reciprocal of the point's density over the plane as a share of the scene's disc.
+    Vec3 parallel_origin(const Vec3& direction, Vec2 u, const EmissionFocus* focus, float u_focus,
+                         float* area_ratio) const;
     /// The light sample_incident samples from p, and its choice probability.
     std::optional<uint32_t> choose_incident(const Vec3& p, float u_select, float* choice_pdf) const;
     /// The light tree over the lights with a position (point, spot, triangles), and the

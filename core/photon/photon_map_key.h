@@ -12,7 +12,7 @@ namespace photond {
 
 /// Bump when photon tracing changes what it stores for the same scene and settings (sampling,
 /// Russian roulette, flux encoding, kd-tree order): every cached photon map then misses.
-inline constexpr uint32_t kPhotonMapAlgorithmVersion = 13;  // 11: caustic photons from lights with a position aimed at their casters; 12: irradiance sites estimated without the photon on their disc's edge; 13: glossy lobes up to roughness 0.36 (was 0.25) continue caustic paths
+inline constexpr uint32_t kPhotonMapAlgorithmVersion = 14;  // 11: caustic photons from lights with a position aimed at their casters; 12: irradiance sites estimated without the photon on their disc's edge; 13: glossy lobes up to roughness 0.36 (was 0.25) continue caustic paths; 14: parallel caustic photons aimed at the discs of the casters' cover spheres
 
 /// The cache key of the photon maps trace_photons builds for (scene, settings):
 /// "pm1-" + 64 hex digits, from scene_content_hash, global_photons, caustic_photons, seed,

@@ -36,10 +36,11 @@ bool meets(const Vec3& origin, const Vec3& direction, const FocusSphere& sphere)
     return along > 0.0f && d2 - along * along <= r2;
 }
 
-/// Emits kSamples photons from the scene's one light, aimed at `focus` or not, and returns the
-/// mean flux per photon of those that meet one of its spheres; `meeting` counts them and
-/// `largest` (when given) is the largest flux one of them carries.
-DVec3 flux_into(const Scene& scene, const EmissionFocus& focus, bool aimed, int* meeting, double* largest = nullptr) {
+/// Emits kSamples photons from the scene's one light, aimed at `focus` (or at `aim` when given)
+/// or not, and returns the mean flux per photon of those that meet one of the spheres of `focus`;
+/// `meeting` counts them and `largest` (when given) is the largest flux one of them carries.
+DVec3 flux_into(const Scene& scene, const EmissionFocus& focus, bool aimed, int* meeting, double* largest = nullptr,
+                const EmissionFocus* aim = nullptr) {
     constexpr int kSamples = 1000000;
     const LightSet lights(scene);
     Rng rng(31, 32);
@@ -49,7 +50,7 @@ DVec3 flux_into(const Scene& scene, const EmissionFocus& focus, bool aimed, int*
         const float u_select = rng.next_float();
         const Vec2 u_position = rng.next_vec2(), u_direction = rng.next_vec2();
         const float u_focus = rng.next_float();
-        const auto e = lights.sample_emission(u_select, u_position, u_direction, aimed ? &focus : nullptr, u_focus);
+        const auto e = lights.sample_emission(u_select, u_position, u_direction, aimed ? (aim ? aim : &focus) : nullptr, u_focus);
         if (!e || is_black(e->flux_weight)) continue;
         EXPECT_NEAR(glm::length(e->direction), 1.0f, 1e-4f);
         bool hit = false;
@@ -140,6 +141,63 @@ TEST(EmissionFocus, TwoSidedTriangleBetweenLargeSpheresKeepsItsPhotonsLight) {
     expect_same_flux(scene_with({}, 2.0f, true), focus, "two-sided triangle between large spheres", false);
 }
 
+/// scene_with's triangle in bounds of radius about 8, where the spheres of two_spheres() are small.
+Scene wide_scene_with(const std::vector<PunctualLight>& lights) {
+    Scene scene = scene_with(lights, 0.0f, false);
+    scene.bounds.extend(Vec3(-4.0f, -4.0f, -4.0f));
+    scene.bounds.extend(Vec3(6.0f, 5.0f, 6.0f));
+    return scene;
+}
+
+/// Parallel photons (a sun, the sky) start on the discs of the focus spheres across their
+/// direction: the same flux into the spheres as from the scene's disc, and more of them meet a
+/// sphere than from the disc of the spheres' bounding sphere.
+void expect_parallel_photons_aimed_at_the_spheres(const Scene& scene, const char* what) {
+    expect_same_flux(scene, two_spheres(), what);
+    EmissionFocus bounding = two_spheres();
+    bounding.spheres.clear();
+    int from_bounding = 0, from_spheres = 0;
+    const DVec3 flux_bounding = flux_into(scene, two_spheres(), true, &from_bounding, nullptr, &bounding);
+    const DVec3 flux_spheres = flux_into(scene, two_spheres(), true, &from_spheres, nullptr);
+    // The discs' areas 0.25 (pi dropped) against the bounding disc's 4: a sixteenth of the
+    // bounding disc's photons pass through a sphere, nearly all of the spheres'.
+    EXPECT_GT(from_spheres, 950000) << what;
+    EXPECT_LT(from_bounding, 100000) << what;
+    const double tolerance = 4.0 / std::sqrt(static_cast<double>(from_bounding));
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(flux_spheres[c] / flux_bounding[c], 1.0, tolerance) << what;
+}
+
+TEST(EmissionFocus, ASunsPhotonsLeaveFromTheSpheresDiscs) {
+    PunctualLight sun;
+    sun.type = PunctualLightType::Directional;
+    sun.direction = glm::normalize(Vec3(0.3f, 0.2f, -1.0f));
+    sun.intensity = Color(4.0f, 3.0f, 2.0f);
+    sun.angular_radius = 0.05f;
+    expect_parallel_photons_aimed_at_the_spheres(wide_scene_with({sun}), "sun");
+}
+
+TEST(EmissionFocus, TheSkysPhotonsLeaveFromTheSpheresDiscs) {
+    Scene scene = wide_scene_with({});
+    Environment sky;
+    sky.color = Color(1.0f, 2.0f, 4.0f);
+    scene.environment = sky;
+    expect_parallel_photons_aimed_at_the_spheres(scene, "sky");
+}
+
+TEST(EmissionFocus, OverlappingDiscsCountEachPointOnce) {
+    // Two spheres, one inside the other's shadow for some directions: where discs overlap the
+    // density adds up, and the flux into the spheres stays that of the scene's disc.
+    Scene scene = wide_scene_with({});
+    Environment sky;
+    sky.color = Color(1.0f);
+    scene.environment = sky;
+    EmissionFocus focus;
+    focus.spheres = {{Vec3(0.5f, 0.5f, 2.0f), 0.5f}, {Vec3(0.9f, 0.6f, 2.3f), 0.4f}};
+    focus.center = Vec3(0.7f, 0.55f, 2.15f);
+    focus.radius = 1.5f;
+    expect_same_flux(scene, focus, "overlapping spheres under a sky");
+}
+
 TEST(EmissionFocus, NothingToAimAtCarriesNoFlux) {
     // A one-sided triangle facing +z and one sphere wholly behind it.
     EmissionFocus focus;
@@ -195,6 +253,38 @@ TEST(EmissionFocus, SeparateObjectsGetTheirOwnSpheres) {
     EXPECT_GT(focus.radius, 10.0f);
     ASSERT_EQ(focus.spheres.size(), 8u);
     for (const FocusSphere& s : focus.spheres) EXPECT_NEAR(s.radius, 0.25f, 0.01f);
+}
+
+TEST(EmissionFocus, ObjectsOfUnequalDetailAreNotCutInHalf) {
+    // A finely tessellated sphere between two coarse ones, all three in a row: a split of the
+    // row's triangles, by their median or at the middle of their extent, cuts the fine one in
+    // two, each half wider than it. Split between objects, each gets a sphere of its own.
+    const Scene scene = scene_of({make_icosphere(Vec3(0.0f, 0.0f, 0.0f), 0.25f, 1),
+                                  make_icosphere(Vec3(1.0f, 0.0f, 0.0f), 0.25f, 4),
+                                  make_icosphere(Vec3(2.0f, 0.0f, 0.0f), 0.25f, 1)});
+    const EmissionFocus focus = focus_on_triangles(scene, all_triangles(scene));
+    expect_covered(scene, focus);
+    ASSERT_EQ(focus.spheres.size(), 3u);
+    for (const FocusSphere& s : focus.spheres) EXPECT_NEAR(s.radius, 0.25f, 0.01f);
+}
+
+TEST(EmissionFocus, ASphereWithASeamIsOneObject) {
+    // The triangles of one half of a sphere on vertices of their own at the same positions (a UV
+    // seam): still one object, one sphere, not two halves each wider than the ball.
+    MeshData ball = make_icosphere(Vec3(0.0f), 0.5f, 3);
+    const size_t first_copy = ball.positions.size();
+    for (size_t v = 0; v < first_copy; ++v) {
+        ball.positions.push_back(ball.positions[v]);
+        ball.normals.push_back(ball.normals[v]);
+        ball.uvs.push_back(ball.uvs[v]);
+    }
+    for (size_t t = 0; t < ball.triangles.size(); ++t)
+        if (t % 2 == 0) ball.triangles[t] += glm::uvec3(static_cast<uint32_t>(first_copy));
+    const Scene scene = scene_of({ball});
+    const EmissionFocus focus = focus_on_triangles(scene, all_triangles(scene));
+    expect_covered(scene, focus);
+    ASSERT_EQ(focus.spheres.size(), 1u);
+    EXPECT_NEAR(focus.spheres[0].radius, 0.5f, 0.01f);
 }
 
 TEST(EmissionFocus, ALongObjectIsSplitAlongItsLength) {
