@@ -408,7 +408,10 @@ GatherResult FinalGatherer::gather(const Vec3& p, const Vec3& n, const Vec3& geo
             float d = 0.0f;
             // The ray stands for its cell, of projected solid angle pi / cells (solid angle
             // pi / (cells cos theta)): its cone's spread, which filters the textures it meets.
-            const float cell_solid_angle = kPi / (static_cast<float>(m * cells_n) * std::max(cos_theta, kMinGatherCosine));
+            // A record's cells, also in a gather of fewer rays at a cache miss: the pixel's
+            // samples together gather as many rays as a record does.
+            const float cell_solid_angle =
+                kPi / (static_cast<float>(grid_.m * grid_.n) * std::max(cos_theta, kMinGatherCosine));
             const RayFootprint cone{0.0f, std::sqrt(cell_solid_angle), 1.0f};
             const Color L = trace_gather_ray(Ray{rs.tracer->offset_origin(p, geometric_normal, direction), direction},
                                              rng, counters, &d, nullptr, maps_->caustic != nullptr, kRecordShortRayBounces,

@@ -98,7 +98,7 @@ std::vector<std::vector<uint32_t>> objects_of(const Scene& scene, std::span<cons
     for (uint32_t i = 0; i < triangles.size(); ++i) {
         const glm::uvec3& tri = scene.triangles[triangles[i]];
         for (uint32_t v : {tri.x, tri.y, tri.z}) {
-            const Vec3& p = scene.positions[v];
+            const Vec3 p = scene.positions[v] + Vec3(0.0f);  // -0 as +0
             const PositionBits bits{std::bit_cast<uint32_t>(p.x), std::bit_cast<uint32_t>(p.y), std::bit_cast<uint32_t>(p.z)};
             const auto [it, inserted] = first_at.try_emplace(bits, i);
             if (inserted) continue;
@@ -185,6 +185,11 @@ EmissionFocus focus_on_triangles(const Scene& scene, std::span<const uint32_t> t
             }
             left = group_of_objects(std::vector<uint32_t>(ids.begin(), middle));
             right = group_of_objects(std::vector<uint32_t>(middle, ids.end()));
+            // Objects one inside the other (a liquid in its glass): keep them together.
+            if (!(std::max(left.sphere.radius, right.sphere.radius) < widest->sphere.radius)) {
+                widest->final = true;
+                continue;
+            }
         } else {
             // Within one object: at the median of its triangles' centroids along their longest
             // axis, kept only where that narrows it (a long rod, not a ball).

@@ -54,8 +54,9 @@ struct EmissionFocus {
 /// kMaxFocusSpheres spheres built by splitting the group of widest sphere: one of several objects
 /// (triangles joined through shared vertex positions) between them, at the middle of their
 /// spheres' centres along the longest axis (the median where one side would be empty); one
-/// object at the median of its triangles' centroids, as long as that narrows it. Each sphere is
-/// a little larger than its triangles, so that rounding cannot shave photons off their edges.
+/// object at the median of its triangles' centroids; either only as long as that narrows it.
+/// Each sphere is a little larger than its triangles, so that rounding cannot shave photons off
+/// their edges.
 EmissionFocus focus_on_triangles(const Scene& scene, std::span<const uint32_t> triangles);
 
 /// How a light with a position sees the focus: where it emits from and what it covers.

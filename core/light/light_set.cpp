@@ -472,9 +472,10 @@ Vec3 LightSet::parallel_origin(const Vec3& direction, Vec2 u, const EmissionFocu
         int covering = 1;  // the chosen disc, whatever rounding says
         for (size_t i = 0; i < spheres.size(); ++i) {
             if (i == chosen) continue;
+            // In the disc's plane: |offset|^2 - along^2 loses a small disc far along the light.
             const Vec3 offset = on_disc - spheres[i].center;
-            const float along = glm::dot(offset, direction);
-            if (glm::dot(offset, offset) - along * along <= spheres[i].radius * spheres[i].radius) ++covering;
+            const float s_along = glm::dot(offset, frame.s), t_along = glm::dot(offset, frame.t);
+            if (s_along * s_along + t_along * t_along <= spheres[i].radius * spheres[i].radius) ++covering;
         }
         *area_ratio = cover_area / (static_cast<float>(covering) * scene_area);
     } else {

@@ -198,6 +198,20 @@ TEST(EmissionFocus, OverlappingDiscsCountEachPointOnce) {
     expect_same_flux(scene, focus, "overlapping spheres under a sky");
 }
 
+TEST(EmissionFocus, SpheresWiderTogetherThanTheirBoundLeaveParallelPhotonsOnItsDisc) {
+    // Two large spheres whose discs add up to more than their bounding sphere's: the sky's
+    // photons start on the bounding disc, with the same flux into the spheres.
+    Scene scene = wide_scene_with({});
+    Environment sky;
+    sky.color = Color(1.0f, 0.5f, 0.25f);
+    scene.environment = sky;
+    EmissionFocus focus;
+    focus.spheres = {{Vec3(0.3f, 0.3f, 2.0f), 1.0f}, {Vec3(0.8f, 0.3f, 2.0f), 1.0f}};
+    focus.center = Vec3(0.55f, 0.3f, 2.0f);
+    focus.radius = 1.3f;
+    expect_same_flux(scene, focus, "large spheres under a sky", false);
+}
+
 TEST(EmissionFocus, NothingToAimAtCarriesNoFlux) {
     // A one-sided triangle facing +z and one sphere wholly behind it.
     EmissionFocus focus;
@@ -281,6 +295,16 @@ TEST(EmissionFocus, ASphereWithASeamIsOneObject) {
     for (size_t t = 0; t < ball.triangles.size(); ++t)
         if (t % 2 == 0) ball.triangles[t] += glm::uvec3(static_cast<uint32_t>(first_copy));
     const Scene scene = scene_of({ball});
+    const EmissionFocus focus = focus_on_triangles(scene, all_triangles(scene));
+    expect_covered(scene, focus);
+    ASSERT_EQ(focus.spheres.size(), 1u);
+    EXPECT_NEAR(focus.spheres[0].radius, 0.5f, 0.01f);
+}
+
+TEST(EmissionFocus, AnObjectInsideAnotherSharesItsSphere) {
+    // A liquid inside its glass: two objects, but a sphere for the inner one would only add to
+    // the cover's discs.
+    const Scene scene = scene_of({make_icosphere(Vec3(0.0f), 0.5f, 3), make_icosphere(Vec3(0.05f, 0.0f, 0.0f), 0.3f, 3)});
     const EmissionFocus focus = focus_on_triangles(scene, all_triangles(scene));
     expect_covered(scene, focus);
     ASSERT_EQ(focus.spheres.size(), 1u);

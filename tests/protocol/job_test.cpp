@@ -12,6 +12,7 @@
 #include <set>
 
 #include "protocol/presets.h"
+#include "protocol/render_settings.h"
 
 namespace photond::protocol {
 namespace {
@@ -102,6 +103,15 @@ TEST(JobPresets, FinalIsTheDefaultPresetWithItsValues) {
     EXPECT_TRUE(job.output.aovs.empty());
     EXPECT_EQ(job.priority, 50);
     EXPECT_EQ(job.seed, 1u);
+}
+
+TEST(JobPresets, CacheMissesGatherTheSamplesShareOfTheRays) {
+    Job job = preset_defaults("final").value();
+    EXPECT_EQ(to_render_settings(job).photon_map.miss_gather_rays, 16u);  // 256 rays, 16 spp
+    job.image.spp = 4;
+    EXPECT_EQ(to_render_settings(job).photon_map.miss_gather_rays, 64u);
+    job.gather.rays = 8;
+    EXPECT_EQ(to_render_settings(job).photon_map.miss_gather_rays, 8u);
 }
 
 TEST(JobPresets, PreviewIsCheaper) {
