@@ -1,6 +1,5 @@
 #include "protocol/render_settings.h"
 
-#include <algorithm>
 #include <stdexcept>
 
 namespace photond::protocol {
@@ -22,8 +21,7 @@ RenderSettings to_render_settings(const Job& job) {
     photon_map.k_volume = job.photons.k_volume;
     photon_map.gather.rays = job.gather.rays;
     photon_map.gather.short_ray_radii = static_cast<float>(job.gather.short_ray_radii);
-    photon_map.miss_gather_rays =
-        miss_gather_rays(static_cast<uint32_t>(job.gather.rays), static_cast<uint32_t>(std::max(job.image.spp, 1)));
+    photon_map.miss_gather_rays = miss_gather_rays(job.gather.rays, static_cast<uint32_t>(job.image.spp));
     photon_map.use_irradiance_cache = job.irradiance_cache.enabled;
     CacheBuildSettings& cache = photon_map.irradiance_cache;
     cache.accuracy = static_cast<float>(job.irradiance_cache.a);

@@ -239,9 +239,8 @@ Color PhotonMapIntegrator::indirect_irradiance(const DiffusePoint& point, Sample
         ++context.counters.irradiance_misses;
     }
     // No record covers the point (or no cache): gather here, without storing, so the cache stays
-    // as the prepass left it and the image independent of tile order; with the sample's share
-    // of the rays (miss_gather_rays).
-    // Without a cache every sample gathers with all the rays, as a record would.
+    // as the prepass left it and the image independent of tile order; a miss with the sample's
+    // share of the rays (miss_gather_rays), without a cache every sample with all of them.
     const GatherResult g = gatherer_->gather(point.position, point.normal, point.geometric_normal, context.rng,
                                              context.counters, false, cache_ ? settings_.miss_gather_rays : 0);
     return g.irradiance;

@@ -2,13 +2,11 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cmath>
-#include <unordered_map>
 
 #include "core/math/frame.h"
-#include "core/math/rng.h"
 #include "core/math/sampling.h"
+#include "core/scene/position_weld.h"
 #include "core/scene/scene.h"
 
 namespace photond {
@@ -88,21 +86,18 @@ std::vector<std::vector<uint32_t>> objects_of(const Scene& scene, std::span<cons
         while (parent[i] != i) i = parent[i] = parent[parent[i]];
         return i;
     };
-    // A position's bits -> the first triangle with a vertex there.
-    using PositionBits = std::array<uint32_t, 3>;
-    struct PositionHash {
-        size_t operator()(const PositionBits& b) const { return static_cast<size_t>(hash_indices(b[0], b[1], b[2])); }
-    };
-    std::unordered_map<PositionBits, uint32_t, PositionHash> first_at;
-    first_at.reserve(triangles.size() * 2);
+    PositionWelder welder;
+    welder.reserve(triangles.size());
+    std::vector<uint32_t> first_at;  // welded position -> the first triangle with a corner there
     for (uint32_t i = 0; i < triangles.size(); ++i) {
         const glm::uvec3& tri = scene.triangles[triangles[i]];
         for (uint32_t v : {tri.x, tri.y, tri.z}) {
-            const Vec3 p = scene.positions[v] + Vec3(0.0f);  // -0 as +0
-            const PositionBits bits{std::bit_cast<uint32_t>(p.x), std::bit_cast<uint32_t>(p.y), std::bit_cast<uint32_t>(p.z)};
-            const auto [it, inserted] = first_at.try_emplace(bits, i);
-            if (inserted) continue;
-            const uint32_t a = root(i), b = root(it->second);
+            const uint32_t position = welder.id(scene.positions[v]);
+            if (position == first_at.size()) {
+                first_at.push_back(i);
+                continue;
+            }
+            const uint32_t a = root(i), b = root(first_at[position]);
             if (a != b) parent[std::max(a, b)] = std::min(a, b);
         }
     }

@@ -9,6 +9,7 @@
 #include <type_traits>
 
 #include "core/math/frame.h"
+#include "core/scene/position_weld.h"
 
 namespace photond::gltf {
 namespace {
@@ -156,16 +157,12 @@ namespace {
 /// Whether the triangles of `parts` together close a volume: every edge (vertices welded by
 /// position, across the parts) is shared by exactly two triangles.
 bool is_closed_surface(const std::vector<const DecodedPrimitive*>& parts) {
-    std::map<std::array<float, 3>, uint32_t> welded;
+    PositionWelder welder;
     std::map<std::pair<uint32_t, uint32_t>, int> edges;
     size_t triangles = 0;
     for (const DecodedPrimitive* part : parts) {
         std::vector<uint32_t> vertex(part->positions.size());
-        for (size_t i = 0; i < part->positions.size(); ++i) {
-            const Vec3& p = part->positions[i];
-            vertex[i] = welded.emplace(std::array<float, 3>{p.x, p.y, p.z}, static_cast<uint32_t>(welded.size()))
-                            .first->second;
-        }
+        for (size_t i = 0; i < part->positions.size(); ++i) vertex[i] = welder.id(part->positions[i]);
         for (const glm::uvec3& t : part->triangles) {
             const uint32_t v[3] = {vertex[t.x], vertex[t.y], vertex[t.z]};
             // A triangle with a repeated corner has no area and closes nothing: it would count an
