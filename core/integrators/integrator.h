@@ -1,7 +1,9 @@
 // The interface every integrator implements, and the per-sample context it receives.
 #pragma once
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -27,6 +29,13 @@ namespace photond {
 /// next_1d/next_2d come from scrambled Sobol' points shared out over the pixel's samples (one
 /// independent pattern per draw), so the pixel's samples of, say, the light at the first hit are
 /// stratified; later draws, and contexts without a pattern, use the random stream.
+/// Which samples of a pixel evaluate a part of its light, and the weight that keeps the pixel's
+/// mean unbiased (SampleContext::pixel_share).
+struct PixelShare {
+    bool taken = true;
+    float weight = 1.0f;
+};
+
 struct SampleContext {
     static constexpr uint32_t kStratifiedDraws = 8;  // deeper dimensions gain little
 
@@ -34,7 +43,22 @@ struct SampleContext {
     RayCounters& counters;
     uint64_t pattern_seed = 0;  // 0: no pattern (not a camera sample)
     uint32_t sample_index = 0;  // this sample's index within its pixel
+    uint32_t sample_count = 0;  // the pixel's samples (0: not a camera sample)
     uint32_t draws = 0;         // next_1d/next_2d calls so far
+
+    /// A part of the pixel's light that `fraction` (in (0, 1]) of its samples evaluate: the
+    /// first c = ceil(fraction * N) of its N samples, each weighted N / c; a context outside a
+    /// pixel's samples always evaluates it, with weight 1. The pixel's mean stays unbiased even
+    /// where the fraction depends on the sample's own point: its samples are identically
+    /// distributed, and for any c the weights of the N samples sum to N. The first samples of a
+    /// pixel's pattern are the best stratified over it (a (0, 2)-sequence's prefix). Worth it
+    /// for a part that is costly and varies little across a pixel, or is a small share of it.
+    PixelShare pixel_share(float fraction) const {
+        if (sample_count <= 1 || !(fraction < 1.0f)) return {};
+        const float wanted = std::ceil(std::max(fraction, 0.0f) * static_cast<float>(sample_count));
+        const uint32_t count = std::clamp(static_cast<uint32_t>(wanted), 1u, sample_count);
+        return {sample_index < count, static_cast<float>(sample_count) / static_cast<float>(count)};
+    }
 
     float next_1d() {
         if (pattern_seed == 0 || draws >= kStratifiedDraws) return rng.next_float();

@@ -288,6 +288,16 @@ Color Bsdf::diffuse_like_reflectance(const Vec3& wo) const {
     return rho;
 }
 
+float Bsdf::glossy_share(const Vec3& wo) const {
+    Vec3 o = frame_.to_local(wo);
+    if (!(o.z != 0.0f) || !is_finite(o)) return 1.0f;
+    const bool outside = o.z > 0.0f;
+    if (!outside) o.z = -o.z;
+    const SlotProbabilities slots = slot_probabilities(o, outside, kNonDeltaLobes);
+    const float sum = slots[0] + slots[1] + slots[2] + slots[3];
+    return sum > 0.0f ? 1.0f - slots[kSlotDiffuse] : 1.0f;
+}
+
 bool Bsdf::has_non_lambertian_non_delta() const {
     return sharpest_reflection_alpha() > 0.0f || transmits_non_delta();
 }

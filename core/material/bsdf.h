@@ -213,6 +213,10 @@ public:
     /// Whether a non-delta lobe other than the Lambertian one exists (rough metal, rough
     /// dielectric layer, rough transmission): then L_o is not rho / pi * E.
     bool has_non_lambertian_non_delta() const;
+    /// The share of the non-delta lobes' estimated albedo towards wo (the lobe choice's
+    /// probabilities in sample()) held by the lobes other than the Lambertian one: 1 where there
+    /// is no Lambertian lobe, and for a wo the frame cannot take.
+    float glossy_share(const Vec3& wo) const;
     /// The GGX alpha of the sharpest non-delta reflection lobe other than the Lambertian one
     /// (rough metal, rough dielectric layer, rough coat); 0 when there is none. Rough
     /// transmission is not among them (transmits_non_delta).

@@ -63,7 +63,7 @@ TileRenderResult render_tiles(const Integrator& integrator, const Camera& camera
                 const uint64_t pattern_seed = hash_indices(settings.seed, pixel, kPatternStream) | 1u;
                 for (int s = 0; s < spp; ++s) {
                     Rng rng = Rng::for_stream(settings.seed, pixel, static_cast<uint64_t>(s));
-                    SampleContext context{rng, local, pattern_seed, static_cast<uint32_t>(s)};
+                    SampleContext context{rng, local, pattern_seed, static_cast<uint32_t>(s), static_cast<uint32_t>(spp)};
                     const Vec2 jitter = context.next_2d();
                     CameraRay ray = camera.generate_ray(static_cast<float>(x) + jitter.x,
                                                         static_cast<float>(y) + jitter.y);

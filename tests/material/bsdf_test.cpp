@@ -729,6 +729,34 @@ TEST(BsdfGeometry, ShadingNormalsDoNotLeakLight) {
     EXPECT_GT(transmitted, 10000);
 }
 
+// glossy_share is the share of sample()'s lobe choice (non-delta lobes) that goes to lobes other
+// than the Lambertian one: the sampling density of every non-delta lobe is the Lambertian lobe's
+// cos / pi and the other lobes' density, mixed in those shares.
+TEST(BsdfLobes, GlossyShareIsTheLobeChoicesShareOfTheNonLambertianLobes) {
+    const Bsdf lambert = make_bsdf(make_material(0.0f, 1.0f, 0.0f, 1.5f, 0.0f), Color(0.7f));
+    EXPECT_EQ(lambert.glossy_share(direction(30.0)), 0.0f);
+    const Bsdf metal = make_bsdf(make_material(1.0f, 0.4f), Color(0.9f));
+    EXPECT_EQ(metal.glossy_share(direction(30.0)), 1.0f);
+    const Bsdf plastic = make_bsdf(make_material(0.0f, 0.4f), Color(0.8f));
+    float previous = 0.0f;
+    for (const double theta : {0.0, 45.0, 75.0, 85.0}) {
+        const Vec3 wo = direction(theta, 0.7);
+        const float share = plastic.glossy_share(wo);
+        for (const double theta_i : {5.0, 40.0, 70.0}) {
+            const Vec3 wi = direction(theta_i, 0.7 + kPiD);
+            const float all = plastic.pdf(wo, wi, kNonDeltaLobes);
+            const float glossy = plastic.pdf(wo, wi, kNonDeltaLobes | kExcludeLambertian);
+            const float lambertian = wi.z / static_cast<float>(kPiD);
+            EXPECT_NEAR(all, (1.0f - share) * lambertian + share * glossy, 1e-4f * all) << theta << " / " << theta_i;
+        }
+        EXPECT_GT(share, previous) << "Fresnel: more glossy towards grazing, " << theta << " degrees";
+        previous = share;
+    }
+    EXPECT_LT(plastic.glossy_share(direction(0.0)), 0.25f);
+    // A wo the frame cannot take: all of it counts as glossy (nothing is left out).
+    EXPECT_EQ(plastic.glossy_share(Vec3(1.0f, 0.0f, 0.0f)), 1.0f);
+}
+
 TEST(BsdfGeometry, InvalidInputsGiveNothing) {
     const Bsdf bsdf = make_bsdf(make_material(0.0f, 0.5f), Color(0.5f));
     const Vec3 grazing(1.0f, 0.0f, 0.0f);

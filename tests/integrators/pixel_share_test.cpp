@@ -1,0 +1,190 @@
+// Parts of a pixel's light that only a share of its samples evaluate (SampleContext::pixel_share):
+// the glossy rays, by the glossy lobes' share of a point's reflectance, and the caustic estimate.
+// The pixel's mean must stay what every sample evaluating them gives, for fewer rays and
+// estimates.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "core/integrators/photon_mapping.h"
+#include "core/photon/photon_tracer.h"
+#include "core/scene/builtin_scenes.h"
+#include "core/scene/shapes.h"
+#include "tests/support/render_fixtures.h"
+
+namespace photond {
+namespace {
+
+using test_support::lambertian;
+using test_support::make_render_scene;
+
+constexpr uint32_t kSpp = 16;
+
+TEST(PixelShare, TheFirstSamplesTakeThePartAndTheWeightsSumToTheSampleCount) {
+    Rng rng = Rng::for_stream(1, 0, 0);
+    RayCounters counters;
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    for (uint32_t n = 2; n <= 20; ++n) {
+        for (const float fraction : {0.01f, 0.25f, 0.3f, 0.5f, 0.99f, 1.0f, 2.0f, 0.0f, -1.0f, nan}) {
+            uint32_t taken = 0;
+            double weights = 0.0;
+            bool prefix = true;
+            for (uint32_t s = 0; s < n; ++s) {
+                const SampleContext context{rng, counters, 1, s, n};
+                const PixelShare share = context.pixel_share(fraction);
+                if (share.taken) {
+                    prefix = prefix && taken == s;
+                    ++taken;
+                    weights += share.weight;
+                }
+            }
+            const uint32_t expected =
+                fraction >= 1.0f ? n : std::max(1u, static_cast<uint32_t>(std::ceil(std::max(fraction, 0.0f) * n)));
+            EXPECT_EQ(taken, std::isnan(fraction) ? n : expected) << n << " samples, share " << fraction;
+            EXPECT_TRUE(prefix) << "the pattern's first samples, the best stratified";
+            EXPECT_NEAR(weights, n, 1e-4 * n) << n << " samples, share " << fraction;
+        }
+    }
+    // Outside a pixel's samples (a gather, a preview's single sample) every context takes it whole.
+    for (const uint32_t count : {0u, 1u}) {
+        const SampleContext context{rng, counters, 1, 0, count};
+        const PixelShare share = context.pixel_share(0.1f);
+        EXPECT_TRUE(share.taken);
+        EXPECT_EQ(share.weight, 1.0f);
+    }
+}
+
+/// The radiance along `ray` summed over `pixels` pixels of kSpp samples each, every sample with
+/// its pixel's pattern; `in_pixel` false: the same samples as contexts outside a pixel, which
+/// evaluate every part.
+struct PixelSums {
+    DVec3 total{0.0};
+    DVec3 caustic{0.0};
+    RayCounters counters;
+    std::vector<double> pixel_means;  // the luminance of each pixel's mean
+};
+PixelSums sum_pixels(const Integrator& integrator, const CameraRay& ray, int pixels, bool in_pixel) {
+    PixelSums sums;
+    for (int p = 0; p < pixels; ++p) {
+        DVec3 pixel(0.0);
+        const uint64_t pattern = hash_indices(7, static_cast<uint64_t>(p)) | 1u;
+        for (uint32_t s = 0; s < kSpp; ++s) {
+            Rng rng = Rng::for_stream(3, static_cast<uint64_t>(p), s);
+            SampleContext context{rng, sums.counters, pattern, s, in_pixel ? kSpp : 0u};
+            const RadianceParts parts = integrator.radiance_parts(ray, context);
+            pixel += DVec3(parts.total);
+            sums.caustic += DVec3(parts.caustic);
+        }
+        sums.total += pixel;
+        sums.pixel_means.push_back(luminance(Color(pixel / double(kSpp))));
+    }
+    return sums;
+}
+
+/// A white plastic floor (a rough dielectric layer over a Lambertian base) reflecting a bright
+/// square lamp, beside a grey box, under a uniform sky: the camera looks at the lamp's glossy
+/// reflection, whose light comes by the light sample and the glossy ray (MIS).
+TEST(PixelShare, GlossyRaysAtAShareOfThePixelsSamplesKeepItsMean) {
+    SceneBuilder builder("plastic floor");
+    Material plastic;
+    plastic.base_color = Color(0.8f);
+    plastic.metallic = 0.0f;
+    plastic.roughness = 0.3f;
+    const uint32_t floor = builder.add_material(plastic);
+    const uint32_t grey = builder.add_material(lambertian(Color(0.5f)));
+    Material lamp = lambertian(Color(0.0f));
+    lamp.emission = Color(20.0f);
+    const uint32_t emitter = builder.add_material(lamp);
+    ASSERT_TRUE(add_mesh(builder, make_quad(Vec3(-4, 0, -4), Vec3(8, 0, 0), Vec3(0, 0, 8), Vec3(0, 1, 0)), floor).is_ok());
+    ASSERT_TRUE(add_mesh(builder, make_box(Vec3(0.6f, 0.0f, -0.6f), Vec3(1.2f, 0.8f, 0.2f)), grey).is_ok());
+    ASSERT_TRUE(add_mesh(builder, make_quad(Vec3(-0.5f, 1.5f, -1.5f), Vec3(1, 0, 0), Vec3(0, 0, 1), Vec3(0, -1, 0)), emitter).is_ok());
+    Scene scene = builder.build().value();
+    scene.environment = Environment{};
+    const auto rs = make_render_scene(std::move(scene));
+
+    PhotonTracingSettings tracing;
+    tracing.global_photons = 20000;
+    tracing.caustic_photons = 0;
+    auto maps = trace_photons(*rs, tracing);
+    ASSERT_TRUE(maps) << maps.error().message;
+    PhotonMapIntegratorSettings settings;
+    settings.gather.rays = 64;
+    settings.use_irradiance_cache = false;
+    const PhotonMapIntegrator integrator(rs, std::make_shared<const PhotonMaps>(std::move(maps).value()), settings);
+
+    // From (0, 1, 1.2) towards the floor's point under the lamp's mirror image.
+    CameraRay ray;
+    ray.origin = Vec3(0.0f, 1.0f, 1.2f);
+    ray.direction = glm::normalize(Vec3(0.0f, 0.0f, -0.57f) - ray.origin);
+    const std::optional<Hit> hit = rs->tracer->intersect(Ray{ray.origin, ray.direction});
+    ASSERT_TRUE(hit);
+    const SurfaceInteraction si = make_interaction(*rs->scene, *hit, ray.direction);
+    ASSERT_EQ(si.material, floor);
+    const float share = make_bsdf(*rs, si, -ray.direction).glossy_share(-ray.direction);
+    ASSERT_GT(share, 0.0f);
+    ASSERT_LT(4.0f * share, 1.0f) << "the lobes' share must leave samples without rays";
+    const auto expected_count = static_cast<uint32_t>(std::ceil(4.0f * share * kSpp));
+
+    constexpr int kPixels = 600;
+    const PixelSums shared = sum_pixels(integrator, ray, kPixels, true);
+    const PixelSums every = sum_pixels(integrator, ray, kPixels, false);
+    // Each pixel's two means draw the same numbers for the rays both trace: their difference is
+    // what the rays the share leaves out would have added, noise of mean zero.
+    double sum = 0.0, sum2 = 0.0;
+    for (int p = 0; p < kPixels; ++p) {
+        const double d = shared.pixel_means[p] - every.pixel_means[p];
+        sum += d;
+        sum2 += d * d;
+    }
+    const double mean_difference = sum / kPixels;
+    const double standard_error = std::sqrt((sum2 / kPixels - mean_difference * mean_difference) / (kPixels - 1));
+    const double mean = luminance(Color(every.total / double(kPixels * kSpp)));
+    // Rays: the camera's, a gather's (no cache) and the glossy rays, counted alike.
+    const double glossy_shared = double(shared.counters.rays), glossy_every = double(every.counters.rays);
+    std::printf("glossy share %.3f: rays at %u of %u samples; rays %.0f vs %.0f; pixel mean %.4f vs %.4f "
+                "(difference %+.5f, standard error %.5f)\n",
+                share, expected_count, kSpp, glossy_shared, glossy_every,
+                luminance(Color(shared.total / double(kPixels * kSpp))), mean, mean_difference, standard_error);
+    EXPECT_LT(std::abs(mean_difference), 4.0 * standard_error + 1e-6 * mean);
+    // Without the weight N / c the pixel would lose (1 - c / N) of the rays' light; the test must
+    // be able to see that.
+    EXPECT_LT(standard_error, 0.01 * mean);
+    // The rays saved: one glossy ray at each sample the share leaves out (a few lobe samples
+    // come out empty and trace none).
+    const double saved = glossy_every - glossy_shared, left_out = double(kPixels) * (kSpp - expected_count);
+    EXPECT_GT(saved, 0.9 * left_out);
+    EXPECT_LE(saved, left_out);
+}
+
+/// caustic-area's caustic: a point under the glass sphere, the same for every sample (no jitter),
+/// so that a share of the samples estimating it gives the pixel exactly what all of them do.
+TEST(PixelShare, ACausticEstimateAtAShareOfTheSamplesGivesThePixelTheSameLight) {
+    const auto rs = make_render_scene(make_builtin_scene("caustic-area").value());
+    PhotonTracingSettings tracing;
+    tracing.global_photons = 20000;
+    tracing.caustic_photons = 20000;
+    auto maps = trace_photons(*rs, tracing);
+    ASSERT_TRUE(maps) << maps.error().message;
+    ASSERT_TRUE(maps->caustic);
+    PhotonMapIntegratorSettings settings;
+    settings.gather.rays = 16;
+    settings.use_irradiance_cache = false;
+    const PhotonMapIntegrator integrator(rs, std::make_shared<const PhotonMaps>(std::move(maps).value()), settings);
+    const Camera camera = Camera::create(rs->scene->cameras.at(0), 128, 96).value();
+    const CameraRay ray = camera.generate_ray(68.5f, 58.5f);  // in the caustic (its benchmark region)
+
+    const PixelSums shared = sum_pixels(integrator, ray, 4, true);
+    const PixelSums every = sum_pixels(integrator, ray, 4, false);
+    std::printf("caustic %.5f vs %.5f from %llu vs %llu estimates\n", luminance(Color(shared.caustic)),
+                luminance(Color(every.caustic)), static_cast<unsigned long long>(shared.counters.caustic_points),
+                static_cast<unsigned long long>(every.counters.caustic_points));
+    ASSERT_GT(luminance(Color(every.caustic)), 0.0);
+    EXPECT_EQ(shared.counters.caustic_points * 4, every.counters.caustic_points) << "a quarter of the samples";
+    EXPECT_EQ(every.counters.caustic_skipped, 0u) << "the caustic shows there";
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(shared.caustic[c], every.caustic[c], 1e-5 * every.caustic[c]);
+}
+
+}  // namespace
+}  // namespace photond
