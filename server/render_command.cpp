@@ -203,7 +203,8 @@ void print_statistics(const RenderStatistics& s) {
                      static_cast<unsigned long long>(s.photons->stored_volume), s.photon_map_bytes / 1e6);
     }
     if (s.caustic_points > 0) {
-        std::fprintf(stderr, "  caustic map read at %.1f %% of %llu visible points (the rest too faint to show)\n",
+        std::fprintf(stderr, "  caustic map read at %.1f %% of %llu visible points that estimate it (the rest too faint "
+                     "to show)\n",
                      100.0 * static_cast<double>(s.caustic_points - s.caustic_skipped) / static_cast<double>(s.caustic_points),
                      static_cast<unsigned long long>(s.caustic_points));
     }

@@ -18,13 +18,13 @@ constexpr float kExtrapolationScale = 2.0f;
 /// cache"); shadow rays cost a fraction of the gather ray the cache saves.
 constexpr int kCachedLobeLightSamples = 2;
 /// A pixel's samples that trace glossy rays at a point: this times the glossy lobes' share of
-/// its non-delta reflectance (Bsdf::glossy_share), all of them from a share of 1/4. At 16 spp,
-/// TransmissionTest's cloth (a rough layer over white and grey) traces them at 5 of 16 samples
-/// facing the camera: render 2.61 -> 2.14 s, relMSE 0.003138 -> 0.003293; glossy-objects
-/// 3.00 -> 2.29 s for 0.00707 -> 0.00710 (README.md, "Kept"). 2: relMSE 0.00376; 1: 0.00509.
+/// its non-delta reflectance (Bsdf::glossy_share), all of them from a share of 1/4. Alone, on
+/// TransmissionTest (whose cloth is a rough layer over a white and grey base), 256^2, 16 spp:
+/// render pass 2.61 -> 2.14 s, relMSE against path 0.003138 -> 0.003293; at 2 instead of 4:
+/// 0.00376, at 1: 0.00509 (README.md, "The pipeline", step 5, has both shares' figures).
 constexpr float kGlossyRaysPerLobeShare = 4.0f;
 /// The share of a pixel's samples that estimate the caustic map's light at their points.
-/// cornell-box: 2.57 -> 1.89 s, relMSE 0.002161 -> 0.002175 (README.md, "Kept").
+/// Alone, on cornell-box: 2.57 -> 1.89 s, relMSE 0.002161 -> 0.002175.
 constexpr float kCausticEstimateShare = 0.25f;
 
 }  // namespace

@@ -49,8 +49,9 @@ struct RenderStatistics {
     std::optional<PhotonTracingStatistics> photons;
     size_t photon_map_bytes = 0;
     double caustic_flux_share = 0.0;  // caustic_flux_share (core/photon/photon_tracer.h) of the maps used
-    /// Visible points of the render pass where the caustic map could be read, and those where
-    /// its estimate was skipped as too faint to show (CausticVisibility::may_show).
+    /// Visible points of the render pass where the caustic map could be read (at the samples
+    /// that estimate it: a share of each pixel's), and those where its estimate was skipped as
+    /// too faint to show (CausticVisibility::may_show).
     uint64_t caustic_points = 0;
     uint64_t caustic_skipped = 0;
     /// "hit" when the photon maps came from the cache, "miss" when traced and stored, empty when

@@ -21,7 +21,8 @@ struct RayCounters {
     uint64_t irradiance_misses = 0;   // ... that no record covered (gathered on the spot)
     uint64_t radiance_lookups = 0;    // glossy points that asked the radiance cache
     uint64_t radiance_misses = 0;     // ... that no record covered (BSDF-sampled rays instead)
-    uint64_t caustic_points = 0;      // visible points where the caustic map could be read
+    uint64_t caustic_points = 0;      // visible points where the caustic map could be read (at
+                                      // the pixel's samples that estimate it: SampleContext::pixel_share)
     uint64_t caustic_skipped = 0;     // ... where it was not, its light too faint to show
     uint64_t short_ray_bounces = 0;   // gather hits traced a bounce on (GatherSettings::short_ray_radii)
 

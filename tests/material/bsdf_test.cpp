@@ -753,6 +753,24 @@ TEST(BsdfLobes, GlossyShareIsTheLobeChoicesShareOfTheNonLambertianLobes) {
         previous = share;
     }
     EXPECT_LT(plastic.glossy_share(direction(0.0)), 0.25f);
+    // A rough clear coat over a Lambertian base: the coat's slot counts with the layer's.
+    Material coated = make_material(0.0f, 0.5f, 0.0f, 1.5f, 0.0f);
+    coated.clearcoat = 1.0f;
+    coated.clearcoat_roughness = 0.2f;
+    const Bsdf coat = make_bsdf(coated, Color(0.6f));
+    for (const double theta : {10.0, 70.0}) {
+        const Vec3 wo = direction(theta, 0.3);
+        const float share = coat.glossy_share(wo);
+        EXPECT_GT(share, 0.0f);
+        EXPECT_LT(share, 1.0f);
+        const Vec3 wi = direction(35.0, 0.3 + kPiD);
+        const float all = coat.pdf(wo, wi, kNonDeltaLobes);
+        const float glossy = coat.pdf(wo, wi, kNonDeltaLobes | kExcludeLambertian);
+        EXPECT_NEAR(all, (1.0f - share) * wi.z / static_cast<float>(kPiD) + share * glossy, 1e-4f * all) << theta;
+    }
+    // Rough glass has no Lambertian lobe: all of it is glossy.
+    const Bsdf rough_glass = make_bsdf(make_material(0.0f, 0.3f, 1.0f), Color(1.0f));
+    EXPECT_EQ(rough_glass.glossy_share(direction(30.0)), 1.0f);
     // A wo the frame cannot take: all of it counts as glossy (nothing is left out).
     EXPECT_EQ(plastic.glossy_share(Vec3(1.0f, 0.0f, 0.0f)), 1.0f);
 }
