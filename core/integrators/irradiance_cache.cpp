@@ -60,7 +60,10 @@ IrradianceCache::IrradianceCache(const Bounds3& scene_bounds, const IrradianceCa
 }
 
 IrradianceCache::IrradianceCache(State state)
-    : settings_(state.settings), records_(std::move(state.records)), nodes_(std::move(state.nodes)) {}
+    : settings_(state.settings), records_(std::move(state.records)), nodes_(std::move(state.nodes)) {
+    spheres_.reserve(records_.size());
+    for (const IrradianceRecord& r : records_) spheres_.emplace_back(r.position, r.radius);
+}
 
 Expected<std::unique_ptr<IrradianceCache>> IrradianceCache::from_state(State state) {
     const float a = state.settings.accuracy;
@@ -140,7 +143,8 @@ Expected<std::unique_ptr<IrradianceCache>> IrradianceCache::from_state(State sta
 }
 
 size_t IrradianceCache::memory_bytes() const {
-    size_t bytes = sizeof(*this) + records_.capacity() * sizeof(IrradianceRecord) + nodes_.capacity() * sizeof(Node);
+    size_t bytes = sizeof(*this) + records_.capacity() * sizeof(IrradianceRecord) + nodes_.capacity() * sizeof(Node) +
+                   spheres_.capacity() * sizeof(glm::vec4);
     for (const Node& node : nodes_) bytes += node.records.capacity() * sizeof(uint32_t);
     return bytes;
 }
@@ -206,7 +210,15 @@ double IrradianceCache::weight(const IrradianceRecord& r, const Vec3& p, const V
 template <typename F>
 void IrradianceCache::for_each_weight(const Vec3& p, const Vec3& n, float accuracy_scale, F&& f) const {
     const float a = settings_.accuracy * accuracy_scale;
+    // weight()'s first test, on the compact spheres: most candidates end there.
+    const auto within = [&](uint32_t index) {
+        const glm::vec4& s = spheres_[index];
+        const Vec3 offset = p - Vec3(s);
+        const float reach = a * s.w;
+        return glm::dot(offset, offset) < reach * reach;
+    };
     const auto add = [&](uint32_t index) {
+        if (!within(index)) return;
         if (const double w = weight(records_[index], p, n, a); w > 0.0) f(index, w);
     };
     if (accuracy_scale <= 1.0f) {
@@ -218,6 +230,7 @@ void IrradianceCache::for_each_weight(const Vec3& p, const Vec3& n, float accura
         thread_local std::vector<std::pair<uint32_t, double>> weighed;
         weighed.clear();
         for_each_candidate(p, accuracy_scale, 0.0f, [&](uint32_t index) {
+            if (!within(index)) return;
             if (const double w = weight(records_[index], p, n, a); w > 0.0) weighed.emplace_back(index, w);
         });
         std::sort(weighed.begin(), weighed.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
@@ -315,6 +328,7 @@ void IrradianceCache::insert(IrradianceRecord record, float min_radius, std::spa
     for (uint32_t j : neighbours) {
         IrradianceRecord& r = records_[j];
         r.radius = std::min(r.radius, record.radius + glm::length(record.position - r.position));
+        spheres_[j].w = r.radius;
     }
     // The level whose nodes' half size h satisfies validity <= h < 2 validity; the record goes in
     // every node of that level its domain's bounding cube overlaps (at most 8), so a lookup only
@@ -339,6 +353,7 @@ void IrradianceCache::insert(IrradianceRecord record, float min_radius, std::spa
     }
     if (!filed) nodes_[0].records.push_back(new_index);  // wholly outside the root: the root keeps it
     records_.push_back(record);
+    spheres_.emplace_back(record.position, record.radius);
 }
 
 }  // namespace photond

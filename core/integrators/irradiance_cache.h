@@ -149,6 +149,10 @@ private:
 
     IrradianceCacheSettings settings_;
     std::vector<IrradianceRecord> records_;
+    /// Each record's position and radius (w), beside the records: a lookup meets about 30 times
+    /// as many candidates as it uses (TransmissionTest: 94 a lookup, 3 used), and tests their
+    /// distance here, in an array that stays in cache, before it reads a record.
+    std::vector<glm::vec4> spheres_;
     std::vector<Node> nodes_;
 };
 
