@@ -24,11 +24,6 @@
 
 namespace photond {
 
-/// What one camera sample may use: its own random stream and counters. A camera sample also
-/// carries its place in its pixel's sample pattern: then its first kStratifiedDraws draws of
-/// next_1d/next_2d come from scrambled Sobol' points shared out over the pixel's samples (one
-/// independent pattern per draw), so the pixel's samples of, say, the light at the first hit are
-/// stratified; later draws, and contexts without a pattern, use the random stream.
 /// Which samples of a pixel evaluate a part of its light, and the weight that keeps the pixel's
 /// mean unbiased (SampleContext::pixel_share).
 struct PixelShare {
@@ -36,6 +31,11 @@ struct PixelShare {
     float weight = 1.0f;
 };
 
+/// What one camera sample may use: its own random stream and counters. A camera sample also
+/// carries its place in its pixel's sample pattern: then its first kStratifiedDraws draws of
+/// next_1d/next_2d come from scrambled Sobol' points shared out over the pixel's samples (one
+/// independent pattern per draw), so the pixel's samples of, say, the light at the first hit are
+/// stratified; later draws, and contexts without a pattern, use the random stream.
 struct SampleContext {
     static constexpr uint32_t kStratifiedDraws = 8;  // deeper dimensions gain little
 
@@ -51,8 +51,9 @@ struct SampleContext {
     /// pixel's samples always evaluates it, with weight 1. The pixel's mean stays unbiased even
     /// where the fraction depends on the sample's own point: its samples are identically
     /// distributed, and for any c the weights of the N samples sum to N. The first samples of a
-    /// pixel's pattern are the best stratified over it (a (0, 2)-sequence's prefix). Worth it
-    /// for a part that is costly and varies little across a pixel, or is a small share of it.
+    /// pixel's pattern are the best stratified over it (a prefix of a (0, 2)-sequence: a net
+    /// where c is a power of two). Worth it for a part that is costly and varies little across a
+    /// pixel, or is a small share of its light.
     PixelShare pixel_share(float fraction) const {
         if (sample_count <= 1 || !(fraction < 1.0f)) return {};
         const float wanted = std::ceil(std::max(fraction, 0.0f) * static_cast<float>(sample_count));
