@@ -5,10 +5,10 @@
 
 #include "core/integrators/path.h"
 #include "core/integrators/photon_mapping.h"
-#include "core/photon/photon_tracer.h"
 #include "core/render/tile_renderer.h"
 #include "core/scene/shapes.h"
 
+#include "tests/support/photon_fixtures.h"
 #include "tests/support/render_fixtures.h"
 
 namespace photond {
@@ -56,18 +56,11 @@ TEST(GlossyEmitter, EmitterBehindRoughGlassAgreesWithPath) {
     path_tiles.samples_per_pixel = 1024;
     const double reference = mean_luminance(render_tiles(PathIntegrator(rs), camera, path_tiles).layers.beauty);
 
-    PhotonTracingSettings tracing;
-    tracing.global_photons = 100000;
-    tracing.caustic_photons = 20000;
-    auto maps = trace_photons(*rs, tracing);
-    ASSERT_TRUE(maps) << maps.error().message;
-    PhotonMapIntegratorSettings settings;
-    settings.gather.rays = 128;
-    settings.use_irradiance_cache = false;
-    const PhotonMapIntegrator photon_map(rs, std::make_shared<const PhotonMaps>(std::move(maps).value()), settings);
+    const auto photon_map = test_support::uncached_photon_map(rs, 100000, 20000, 128);
+    ASSERT_TRUE(photon_map);
     TileSettings tiles;
     tiles.samples_per_pixel = 64;
-    const double estimate = mean_luminance(render_tiles(photon_map, camera, tiles).layers.beauty);
+    const double estimate = mean_luminance(render_tiles(*photon_map, camera, tiles).layers.beauty);
     std::printf("emitter behind rough glass, 32x32: path %.4f, photon-map %.4f\n", reference, estimate);
     EXPECT_NEAR(estimate / reference, 1.0, 0.03);
 }

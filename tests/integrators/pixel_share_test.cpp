@@ -9,10 +9,10 @@
 #include <limits>
 
 #include "core/integrators/photon_mapping.h"
-#include "core/photon/photon_tracer.h"
 #include "core/render/tile_renderer.h"
 #include "core/scene/builtin_scenes.h"
 #include "core/scene/shapes.h"
+#include "tests/support/photon_fixtures.h"
 #include "tests/support/render_fixtures.h"
 
 namespace photond {
@@ -20,6 +20,7 @@ namespace {
 
 using test_support::lambertian;
 using test_support::make_render_scene;
+using test_support::uncached_photon_map;
 
 constexpr uint32_t kSpp = 16;
 
@@ -181,15 +182,9 @@ TEST(PixelShare, GlossyRaysAtAShareOfThePixelsSamplesKeepItsMean) {
     scene.environment = Environment{};
     const auto rs = make_render_scene(std::move(scene));
 
-    PhotonTracingSettings tracing;
-    tracing.global_photons = 20000;
-    tracing.caustic_photons = 0;
-    auto maps = trace_photons(*rs, tracing);
-    ASSERT_TRUE(maps) << maps.error().message;
-    PhotonMapIntegratorSettings settings;
-    settings.gather.rays = 64;
-    settings.use_irradiance_cache = false;
-    const PhotonMapIntegrator integrator(rs, std::make_shared<const PhotonMaps>(std::move(maps).value()), settings);
+    const auto photon_map = uncached_photon_map(rs, 20000, 0, 64);
+    ASSERT_TRUE(photon_map);
+    const PhotonMapIntegrator& integrator = *photon_map;
     const Camera camera = Camera::create(rs->scene->cameras.at(0), 4, 3).value();
     const auto share_at = [&](const CameraRay& ray) {
         const std::optional<Hit> hit = rs->tracer->intersect(Ray{ray.origin, ray.direction});
@@ -250,16 +245,9 @@ TEST(PixelShare, GlossyRaysAtAShareOfThePixelsSamplesKeepItsMean) {
 /// so that a share of the samples estimating it gives the pixel exactly what all of them do.
 TEST(PixelShare, ACausticEstimateAtAShareOfTheSamplesGivesThePixelTheSameLight) {
     const auto rs = make_render_scene(make_builtin_scene("caustic-area").value());
-    PhotonTracingSettings tracing;
-    tracing.global_photons = 20000;
-    tracing.caustic_photons = 20000;
-    auto maps = trace_photons(*rs, tracing);
-    ASSERT_TRUE(maps) << maps.error().message;
-    ASSERT_TRUE(maps->caustic);
-    PhotonMapIntegratorSettings settings;
-    settings.gather.rays = 16;
-    settings.use_irradiance_cache = false;
-    const PhotonMapIntegrator integrator(rs, std::make_shared<const PhotonMaps>(std::move(maps).value()), settings);
+    const auto photon_map = uncached_photon_map(rs, 20000, 20000, 16);
+    ASSERT_TRUE(photon_map);
+    const PhotonMapIntegrator& integrator = *photon_map;
     const Camera camera = Camera::create(rs->scene->cameras.at(0), 128, 96).value();
     const CameraRay ray = camera.generate_ray(68.5f, 58.5f);  // in the caustic (its benchmark region)
 

@@ -10,9 +10,9 @@
 #include "core/light/environment_light.h"
 #include "core/light/light_set.h"
 #include "core/math/rng.h"
-#include "core/photon/photon_tracer.h"
 #include "core/scene/shapes.h"
 #include "tests/support/chi_square.h"
+#include "tests/support/photon_fixtures.h"
 #include "tests/support/render_fixtures.h"
 
 namespace photond {
@@ -249,15 +249,9 @@ TEST(EnvironmentLight, ConvexLambertianUnderUniformSkyIsAlbedoTimesRadiance) {
 
     const PathIntegrator path(rs);
     const DirectIntegrator direct(rs);
-    PhotonTracingSettings tracing;
-    tracing.global_photons = 20000;
-    tracing.caustic_photons = 0;
-    auto maps = trace_photons(*rs, tracing);
-    ASSERT_TRUE(maps) << maps.error().message;
-    PhotonMapIntegratorSettings settings;
-    settings.use_irradiance_cache = false;
-    settings.gather.rays = 64;
-    const PhotonMapIntegrator photon_map(rs, std::make_shared<const PhotonMaps>(std::move(maps).value()), settings);
+    const auto uncached = test_support::uncached_photon_map(rs, 20000, 0, 64);
+    ASSERT_TRUE(uncached);
+    const PhotonMapIntegrator& photon_map = *uncached;
 
     for (const Integrator* integrator : std::initializer_list<const Integrator*>{&path, &direct, &photon_map}) {
         const int samples = integrator == &photon_map ? 4000 : 20000;
@@ -304,15 +298,9 @@ TEST(EnvironmentLight, ThinWallsUnderAUniformSkyKeepItsRadiance) {
     // Not `direct`: its shadow rays stop at glass, so the rough pane's lobes see no sky through
     // the other pane.
     const PathIntegrator path(rs);
-    PhotonTracingSettings tracing;
-    tracing.global_photons = 20000;
-    tracing.caustic_photons = 20000;
-    auto maps = trace_photons(*rs, tracing);
-    ASSERT_TRUE(maps) << maps.error().message;
-    PhotonMapIntegratorSettings settings;
-    settings.use_irradiance_cache = false;
-    settings.gather.rays = 64;
-    const PhotonMapIntegrator photon_map(rs, std::make_shared<const PhotonMaps>(std::move(maps).value()), settings);
+    const auto uncached = test_support::uncached_photon_map(rs, 20000, 20000, 64);
+    ASSERT_TRUE(uncached);
+    const PhotonMapIntegrator& photon_map = *uncached;
     for (const Integrator* integrator : std::initializer_list<const Integrator*>{&path, &photon_map}) {
         for (const Vec3 eye : {Vec3(0, 0, 5), Vec3(2, 1, 3), Vec3(-0.5f, 0.3f, -4)}) {
             CameraRay ray;
